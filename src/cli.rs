@@ -1,0 +1,247 @@
+//! The `shpb` command line (clap derive): `run`, `curve`. Errors go to stderr with a non-zero exit
+//! code (2 bad input, 3 numerical instability, 1 other failures).
+
+use crate::contact::LawKind;
+use crate::error::{Error, Result, Validator};
+use crate::io::{RunOutput, check_output, write_contact_csv, write_hdf5};
+use crate::plot::{Curve, xy_plot};
+use crate::scene::{Params, SceneParams};
+use crate::specimen::resolve_pair;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+const SCENES_HELP: &str = "\
+SCENE KINDS (TOML files with a `kind` key; see README.md for full examples):
+  quasistatic    F(δ) of the loading law up to max_displacement_m (paper Fig. 2)
+  constant-rate  spheres pressed at constant approach speed, rate hardening on (Fig. 3)
+  collision      two free spheres with initial velocities; reports coefficient of
+                 restitution, contact time, peak force and energy dissipated
+  force-driven   the paper's Fig. 4 DEM: a force history from CSV drives sphere 1,
+                 sphere 2 rests on a linear medium of impedance Z (default: the
+                 authors' transmission bar, 1.12e4 kg/s)
+Every scene has a [specimen] table (pair = \"ss440c\" or sphere1/sphere2 tables) and an
+optional law = \"burgoyne-daraio\" | \"rate-independent\" | \"hertz\".
+
+EXIT CODES: 0 success, 1 I/O or HDF5 failure, 2 bad input (file, key and allowed range are
+named), 3 numerical instability (step, time and quantity are named).";
+
+/// shpb — split Hopkinson pressure bar virtual experiments (Burgoyne & Daraio 2014 contact law).
+#[derive(Parser, Debug)]
+#[command(name = "shpb", version, about, after_help = SCENES_HELP)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The contact laws selectable on the command line.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum LawArg {
+    /// Eq. 1 with Johnson–Cook rate hardening (the paper's model).
+    BurgoyneDaraio,
+    /// Eq. 1 with the static yield stress.
+    RateIndependent,
+    /// Elastic Hertz.
+    Hertz,
+}
+
+impl From<LawArg> for LawKind {
+    fn from(l: LawArg) -> LawKind {
+        match l {
+            LawArg::BurgoyneDaraio => LawKind::BurgoyneDaraio,
+            LawArg::RateIndependent => LawKind::RateIndependent,
+            LawArg::Hertz => LawKind::Hertz,
+        }
+    }
+}
+
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Run a scene file and write its results (HDF5, optional CSV and PNG).
+    #[command(after_help = SCENES_HELP)]
+    Run {
+        /// The scene TOML file.
+        scene: PathBuf,
+        /// HDF5 output file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Also write the contact history as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Also draw a PNG of force against displacement.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Print the loading curve F(δ) of a specimen as CSV on stdout.
+    Curve {
+        /// Built-in material (the paper's 6.35 mm pair of it) or a pair .toml file.
+        #[arg(long, default_value = "ss440c")]
+        specimen: String,
+        /// Global strain rate for Johnson–Cook hardening, 1/s (0: quasi-static).
+        #[arg(long, default_value_t = 0.0)]
+        rate: f64,
+        /// Largest approach δ, m.
+        #[arg(long, default_value_t = 250e-6)]
+        to: f64,
+        /// Number of points.
+        #[arg(long, default_value_t = 101)]
+        points: usize,
+        /// Contact law.
+        #[arg(long, value_enum, default_value = "burgoyne-daraio")]
+        law: LawArg,
+    },
+}
+
+/// Parses the command line, runs it, prints errors; returns the process exit code.
+pub fn main() -> i32 {
+    let cli = Cli::parse();
+    match dispatch(cli) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("shpb: error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+/// Runs one parsed command.
+pub fn dispatch(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Run {
+            scene,
+            output,
+            csv,
+            plot,
+            force,
+        } => run(
+            &scene,
+            output.as_deref(),
+            csv.as_deref(),
+            plot.as_deref(),
+            force,
+        ),
+        Command::Curve {
+            specimen,
+            rate,
+            to,
+            points,
+            law,
+        } => curve(&specimen, rate, to, points, law.into()),
+    }
+}
+
+fn run(
+    scene: &Path,
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    plot: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    for p in [output, csv, plot].into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    let params = Params::from_file(scene)?;
+    let out = params.run()?;
+    print_summary(&params, &out);
+    if let Some(p) = output {
+        write_hdf5(p, force, &params.text, &out)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = csv {
+        write_contact_csv(p, force, &out.contact)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = plot {
+        plot_run(p, force, &params, &out)?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn print_summary(params: &Params, out: &RunOutput) {
+    println!(
+        "scene: {} (kind {}, law {})",
+        params.source,
+        params.kind,
+        params.contact_law().name()
+    );
+    for it in &out.summary {
+        println!("  {:<40} {:>14.6e} {}", it.key, it.value, it.unit);
+    }
+}
+
+/// Draws the force–displacement curve of a run (with the measured curve for force-driven scenes).
+pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()> {
+    let mut curves = vec![Curve {
+        label: format!("shpb ({})", params.contact_law().name()),
+        x: &out.contact.displacement_m,
+        y: &out.contact.force_n,
+        measured: false,
+    }];
+    let shifted: Vec<f64>;
+    if let SceneParams::ForceDriven {
+        setup,
+        measured_displacement_m: Some(d),
+    } = &params.params
+    {
+        shifted = d.iter().map(|x| x - d[0]).collect();
+        curves.push(Curve {
+            label: "measured (authors' SHPB, offset δ(0) removed)".into(),
+            x: &shifted,
+            y: &setup.drive.force_n,
+            measured: true,
+        });
+    }
+    let title = format!(
+        "{} — {}",
+        params.kind,
+        Path::new(&params.source)
+            .file_name()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default()
+    );
+    xy_plot(
+        path,
+        force,
+        &title,
+        "sphere approach δ (mm)",
+        "force F (kN)",
+        1e3,
+        1e-3,
+        &curves,
+    )
+}
+
+fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Result<()> {
+    let v = Validator::new("command line");
+    let pair = resolve_pair(specimen, Path::new("."), &v, "--specimen")?;
+    v.in_range("--rate", rate, 0.0, 1e9, "1/s")?;
+    v.positive(
+        "--to",
+        to,
+        0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+        "m",
+    )?;
+    if !(2..=10_000_000).contains(&points) {
+        return Err(v.error(
+            "--points",
+            format!("{points} is out of range"),
+            "2 to 10000000",
+        ));
+    }
+    let law = law.build(pair.contact_properties());
+    let s = crate::solver::loading_curve(law.as_ref(), to, points, rate);
+    let stdout = std::io::stdout();
+    let mut w = std::io::BufWriter::new(stdout.lock());
+    let werr = |e| Error::io(Path::new("stdout"), e);
+    writeln!(w, "displacement_m,force_N").map_err(werr)?;
+    for (d, f) in s.displacement_m.iter().zip(&s.force_n) {
+        writeln!(w, "{d:e},{f:e}").map_err(werr)?;
+    }
+    w.flush().map_err(werr)
+}

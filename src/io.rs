@@ -1,0 +1,337 @@
+//! Input and output: CSV tables in, HDF5 and CSV results out, written atomically
+//! (temporary name, then rename; never overwriting without `--force`).
+
+use crate::error::{Error, Result};
+use crate::solver::ContactSeries;
+use hdf5::types::VarLenUnicode;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// A numeric CSV table: `#` comment lines, one header line, then rows of numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvTable {
+    /// The file it came from (for error messages).
+    pub file: String,
+    /// Column names from the header line.
+    pub names: Vec<String>,
+    /// Column data, one vector per name.
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl CsvTable {
+    /// Parses CSV text; `file` names the source in errors.
+    pub fn parse(text: &str, file: &str) -> Result<CsvTable> {
+        let input = |line: usize, key: &str, problem: String, allowed: &str| Error::Input {
+            file: format!("{file}:{line}"),
+            key: key.to_string(),
+            problem,
+            allowed: allowed.to_string(),
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let (hline, header) = lines.next().ok_or_else(|| {
+            input(
+                1,
+                "header",
+                "the file has no header line".into(),
+                "a header line naming the columns, then numeric rows",
+            )
+        })?;
+        let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
+        if names.iter().any(|n| n.is_empty()) {
+            return Err(input(
+                hline,
+                "header",
+                "empty column name".into(),
+                "comma-separated column names",
+            ));
+        }
+        let mut columns = vec![Vec::new(); names.len()];
+        for (line, row) in lines {
+            let cells: Vec<&str> = row.split(',').collect();
+            if cells.len() != names.len() {
+                return Err(input(
+                    line,
+                    "row",
+                    format!(
+                        "{} values where the header has {}",
+                        cells.len(),
+                        names.len()
+                    ),
+                    "one value per header column",
+                ));
+            }
+            for (k, cell) in cells.iter().enumerate() {
+                let v = f64::from_str(cell.trim()).map_err(|_| {
+                    input(
+                        line,
+                        &names[k],
+                        format!("`{}` is not a number", cell.trim()),
+                        "a finite decimal number",
+                    )
+                })?;
+                if !v.is_finite() {
+                    return Err(input(
+                        line,
+                        &names[k],
+                        format!("{v} is not finite"),
+                        "a finite decimal number",
+                    ));
+                }
+                columns[k].push(v);
+            }
+        }
+        if columns[0].is_empty() {
+            return Err(input(
+                hline,
+                "rows",
+                "the file has no data rows".into(),
+                "at least two rows",
+            ));
+        }
+        Ok(CsvTable {
+            file: file.to_string(),
+            names,
+            columns,
+        })
+    }
+
+    /// Reads and parses a CSV file.
+    pub fn read(path: &Path) -> Result<CsvTable> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        CsvTable::parse(&text, &path.display().to_string())
+    }
+
+    /// The column called `name`, or an error listing the columns there are.
+    pub fn column(&self, name: &str) -> Result<&[f64]> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.columns[i].as_slice())
+            .ok_or_else(|| Error::Input {
+                file: self.file.clone(),
+                key: name.to_string(),
+                problem: "column missing".into(),
+                allowed: format!("a header with `{name}` (found: {})", self.names.join(", ")),
+            })
+    }
+
+    /// The column called `name` if present.
+    pub fn optional_column(&self, name: &str) -> Option<&[f64]> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|i| self.columns[i].as_slice())
+    }
+
+    /// The column `name`, checked to be strictly increasing (a time axis).
+    pub fn time_column(&self, name: &str) -> Result<&[f64]> {
+        let t = self.column(name)?;
+        if t.len() < 2 {
+            return Err(Error::Input {
+                file: self.file.clone(),
+                key: name.to_string(),
+                problem: "fewer than two samples".into(),
+                allowed: "at least two strictly increasing times".into(),
+            });
+        }
+        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(Error::Input {
+                file: self.file.clone(),
+                key: name.to_string(),
+                problem: format!(
+                    "not strictly increasing at data row {} ({:e} after {:e})",
+                    i + 2,
+                    t[i + 1],
+                    t[i]
+                ),
+                allowed: "strictly increasing times".into(),
+            });
+        }
+        Ok(t)
+    }
+}
+
+/// Refuses to overwrite `path` unless `force`.
+pub fn check_output(path: &Path, force: bool) -> Result<()> {
+    if path.exists() && !force {
+        return Err(Error::OutputExists(path.to_path_buf()));
+    }
+    Ok(())
+}
+
+/// Writes a file through `write` to a temporary name beside `path`, then renames it into place;
+/// on failure the temporary file is removed, so no half-written output is left.
+pub fn write_atomically(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    check_output(path, force)?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "out".into());
+    // The temporary name keeps the extension (plotters picks the image format from it).
+    let tmp: PathBuf = dir.join(format!(".tmp-{}-{name}", std::process::id()));
+    let result =
+        write(&tmp).and_then(|_| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// A scalar result of a run (peak force, restitution, …) with its unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SummaryItem {
+    /// Name, snake_case (used as HDF5 attribute name).
+    pub key: String,
+    /// Value in SI units.
+    pub value: f64,
+    /// Unit (`N`, `m`, `1`, …).
+    pub unit: &'static str,
+}
+
+/// Shorthand constructor of a [`SummaryItem`].
+pub fn item(key: &str, value: f64, unit: &'static str) -> SummaryItem {
+    SummaryItem {
+        key: key.to_string(),
+        value,
+        unit,
+    }
+}
+
+/// The output of one scene run, ready to be written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// The `/contact` time series.
+    pub contact: ContactSeries,
+    /// Scalar results (attributes of `/summary`).
+    pub summary: Vec<SummaryItem>,
+}
+
+fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
+    move |e| Error::Hdf5 {
+        file: file.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+fn vlu(s: &str) -> VarLenUnicode {
+    VarLenUnicode::from_str(s)
+        .unwrap_or_else(|_| VarLenUnicode::from_str("").expect("empty string is valid"))
+}
+
+/// Writes a string attribute.
+fn string_attr(loc: &hdf5::Location, name: &str, value: &str, file: &Path) -> Result<()> {
+    loc.new_attr::<VarLenUnicode>()
+        .shape(())
+        .create(name)
+        .and_then(|a| a.write_scalar(&vlu(value)))
+        .map_err(h5err(file))
+}
+
+/// Writes a 1-D f64 dataset with a `units` attribute.
+pub fn write_dataset(
+    group: &hdf5::Group,
+    name: &str,
+    data: &[f64],
+    units: &str,
+    file: &Path,
+) -> Result<()> {
+    let ds = group
+        .new_dataset_builder()
+        .with_data(data)
+        .create(name)
+        .map_err(h5err(file))?;
+    string_attr(&ds, "units", units, file)
+}
+
+/// The `/contact` datasets of a series: (name, data, units), absent ones skipped.
+pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static str)> {
+    let mut cols = Vec::new();
+    if let Some(t) = &s.time_s {
+        cols.push(("time", t.as_slice(), "s"));
+    }
+    cols.push(("displacement", s.displacement_m.as_slice(), "m"));
+    cols.push(("force", s.force_n.as_slice(), "N"));
+    if let Some(v) = &s.yield_stress_pa {
+        cols.push(("yield_stress", v.as_slice(), "Pa"));
+    }
+    if let Some(v) = &s.strain_rate_per_s {
+        cols.push(("strain_rate", v.as_slice(), "1/s"));
+    }
+    cols
+}
+
+/// Writes a run to HDF5: `/contact/*` with units, `/summary` attributes, root `shpb_version` and `scene`.
+pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
+        string_attr(&f, "scene", scene_text, path)?;
+        let g = f.create_group("contact").map_err(h5err(path))?;
+        for (name, data, units) in contact_columns(&out.contact) {
+            write_dataset(&g, name, data, units, path)?;
+        }
+        let s = f.create_group("summary").map_err(h5err(path))?;
+        for it in &out.summary {
+            let a = s
+                .new_attr::<f64>()
+                .shape(())
+                .create(it.key.as_str())
+                .map_err(h5err(path))?;
+            a.write_scalar(&it.value).map_err(h5err(path))?;
+        }
+        string_attr(
+            &s,
+            "units",
+            &out.summary
+                .iter()
+                .map(|i| format!("{}={}", i.key, i.unit))
+                .collect::<Vec<_>>()
+                .join(", "),
+            path,
+        )?;
+        f.close().map_err(h5err(path))
+    })
+}
+
+/// Writes the `/contact` series as CSV with a header line (units in the column names).
+pub fn write_contact_csv(path: &Path, force: bool, series: &ContactSeries) -> Result<()> {
+    let cols = contact_columns(series);
+    let mut text = String::new();
+    text.push_str(
+        &cols
+            .iter()
+            .map(|(n, _, u)| csv_name(n, u))
+            .collect::<Vec<_>>()
+            .join(","),
+    );
+    text.push('\n');
+    for i in 0..series.force_n.len() {
+        let row: Vec<String> = cols.iter().map(|(_, d, _)| format!("{:e}", d[i])).collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    write_atomically(path, force, |tmp| {
+        std::fs::write(tmp, &text).map_err(|e| Error::io(path, e))
+    })
+}
+
+/// CSV column name with unit, e.g. `force_N`, `strain_rate_per_s`.
+pub fn csv_name(name: &str, unit: &str) -> String {
+    let u = match unit {
+        "1/s" => "per_s",
+        u => u,
+    };
+    format!("{name}_{u}")
+}

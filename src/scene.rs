@@ -1,0 +1,558 @@
+//! Scene files: one TOML file per virtual test, with a `kind` key, parsed once into validated
+//! [`Params`] (physics code never sees unchecked input), and run into a [`RunOutput`].
+
+use crate::contact::{ContactLaw, LawKind};
+use crate::error::{Error, Result, Validator};
+use crate::io::{CsvTable, RunOutput, SummaryItem, item};
+use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
+use crate::specimen::{SpecimenSpec, SpherePair};
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
+use std::path::{Path, PathBuf};
+
+/// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
+/// radius 9.525 mm; physics.md §5), kg/s.
+pub const AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S: f64 =
+    8110.0 * 4865.5 * std::f64::consts::PI * 9.525e-3 * 9.525e-3;
+
+/// The scene kinds with a one-line description each (shown by `shpb --help`).
+pub const SCENE_KINDS: &[(&str, &str)] = &[
+    (
+        "quasistatic",
+        "F(δ) of the loading law up to max_displacement_m (paper Fig. 2)",
+    ),
+    (
+        "constant-rate",
+        "spheres pressed at constant approach speed with rate hardening (paper Fig. 3)",
+    ),
+    (
+        "collision",
+        "two free spheres with initial velocities: restitution, contact time, peak force, dissipation",
+    ),
+    (
+        "force-driven",
+        "paper Fig. 4 DEM: a CSV force history drives sphere 1, sphere 2 rests on a medium of impedance Z",
+    ),
+];
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct QuasistaticFile {
+    #[allow(dead_code)]
+    kind: String,
+    specimen: SpecimenSpec,
+    #[serde(default)]
+    law: LawKind,
+    max_displacement_m: f64,
+    #[serde(default = "default_points")]
+    points: usize,
+    #[serde(default)]
+    strain_rate_per_s: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConstantRateFile {
+    #[allow(dead_code)]
+    kind: String,
+    specimen: SpecimenSpec,
+    #[serde(default)]
+    law: LawKind,
+    strain_rate_per_s: f64,
+    max_displacement_m: f64,
+    #[serde(default = "default_points")]
+    points: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CollisionFile {
+    #[allow(dead_code)]
+    kind: String,
+    specimen: SpecimenSpec,
+    #[serde(default)]
+    law: LawKind,
+    velocity1_m_s: f64,
+    #[serde(default)]
+    velocity2_m_s: f64,
+    time_step_s: Option<f64>,
+    #[serde(default = "default_steps_per_contact")]
+    steps_per_contact: f64,
+    #[serde(default = "one")]
+    output_every: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ForceDrivenFile {
+    #[allow(dead_code)]
+    kind: String,
+    specimen: SpecimenSpec,
+    #[serde(default)]
+    law: LawKind,
+    force_csv: String,
+    #[serde(default = "default_time_column")]
+    time_column: String,
+    #[serde(default = "default_force_column")]
+    force_column: String,
+    #[serde(default = "default_impedance")]
+    medium_impedance_kg_s: f64,
+    time_step_s: Option<f64>,
+    #[serde(default = "default_steps_per_period")]
+    steps_per_period: f64,
+    end_time_s: Option<f64>,
+    #[serde(default = "one")]
+    output_every: usize,
+}
+
+fn default_points() -> usize {
+    1001
+}
+fn default_steps_per_contact() -> f64 {
+    2000.0
+}
+fn default_steps_per_period() -> f64 {
+    2000.0
+}
+fn one() -> usize {
+    1
+}
+fn default_time_column() -> String {
+    "time_s".into()
+}
+fn default_force_column() -> String {
+    "force_N".into()
+}
+fn default_impedance() -> f64 {
+    AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S
+}
+
+/// Validated parameters of a scene, by kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneParams {
+    /// Loading law F(δ) on a grid (Fig. 2).
+    Quasistatic {
+        /// Largest approach, m.
+        max_displacement_m: f64,
+        /// Number of grid points.
+        points: usize,
+        /// Strain rate at which the curve is evaluated (0: static), 1/s.
+        strain_rate_per_s: f64,
+    },
+    /// Constant approach speed (Fig. 3).
+    ConstantRate {
+        /// Global strain rate of paper Eq. 3, 1/s.
+        strain_rate_per_s: f64,
+        /// Largest approach, m.
+        max_displacement_m: f64,
+        /// Number of samples.
+        points: usize,
+    },
+    /// Free collision.
+    Collision(CollisionSetup),
+    /// Fig. 4 force-driven DEM; `measured` holds the CSV's displacement column when present.
+    ForceDriven {
+        /// Solver inputs.
+        setup: ForceDrivenSetup,
+        /// Measured approach at the drive's sample times, if the CSV has `displacement_m`.
+        measured_displacement_m: Option<Vec<f64>>,
+    },
+}
+
+/// A parsed, validated scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// The scene file (or label).
+    pub source: String,
+    /// The TOML text, stored in the output for provenance.
+    pub text: String,
+    /// Scene kind name.
+    pub kind: String,
+    /// The specimen.
+    pub pair: SpherePair,
+    /// The contact law selected.
+    pub law: LawKind,
+    /// Kind-specific parameters.
+    pub params: SceneParams,
+}
+
+fn parse_as<T: DeserializeOwned>(text: &str, file: &str) -> Result<T> {
+    toml::from_str(text).map_err(|e| Error::Parse {
+        file: file.to_string(),
+        message: e.to_string(),
+    })
+}
+
+fn check_points(v: &Validator, points: usize) -> Result<usize> {
+    if !(2..=10_000_000).contains(&points) {
+        return Err(v.error(
+            "points",
+            format!("{points} is out of range"),
+            "2 to 10000000",
+        ));
+    }
+    Ok(points)
+}
+
+fn check_every(v: &Validator, n: usize) -> Result<usize> {
+    if n == 0 {
+        return Err(v.error("output_every", "0 is out of range", "1 or more"));
+    }
+    Ok(n)
+}
+
+impl Params {
+    /// Reads and validates a scene file.
+    pub fn from_file(path: &Path) -> Result<Params> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let base = path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        Params::from_toml(&text, &path.display().to_string(), &base)
+    }
+
+    /// Validates scene TOML text; relative paths inside it are resolved against `base_dir`.
+    pub fn from_toml(text: &str, file: &str, base_dir: &Path) -> Result<Params> {
+        let v = Validator::new(file);
+        let table: toml::Table = parse_as(text, file)?;
+        let kinds = SCENE_KINDS
+            .iter()
+            .map(|(k, _)| *k)
+            .collect::<Vec<_>>()
+            .join(", ");
+        let kind = match table.get("kind") {
+            Some(toml::Value::String(k)) => k.clone(),
+            Some(_) => return Err(v.error("kind", "not a string", kinds)),
+            None => return Err(v.error("kind", "missing", kinds)),
+        };
+        let sv = v.table("specimen");
+        let (pair, law, params) = match kind.as_str() {
+            "quasistatic" => {
+                let f: QuasistaticFile = parse_as(text, file)?;
+                let pair = f.specimen.build(base_dir, &sv)?;
+                let p = SceneParams::Quasistatic {
+                    max_displacement_m: v.positive(
+                        "max_displacement_m",
+                        f.max_displacement_m,
+                        0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+                        "m",
+                    )?,
+                    points: check_points(&v, f.points)?,
+                    strain_rate_per_s: v.in_range(
+                        "strain_rate_per_s",
+                        f.strain_rate_per_s,
+                        0.0,
+                        1e9,
+                        "1/s",
+                    )?,
+                };
+                (pair, f.law, p)
+            }
+            "constant-rate" => {
+                let f: ConstantRateFile = parse_as(text, file)?;
+                let pair = f.specimen.build(base_dir, &sv)?;
+                let p = SceneParams::ConstantRate {
+                    strain_rate_per_s: v.positive(
+                        "strain_rate_per_s",
+                        f.strain_rate_per_s,
+                        1e9,
+                        "1/s",
+                    )?,
+                    max_displacement_m: v.positive(
+                        "max_displacement_m",
+                        f.max_displacement_m,
+                        0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+                        "m",
+                    )?,
+                    points: check_points(&v, f.points)?,
+                };
+                (pair, f.law, p)
+            }
+            "collision" => {
+                let f: CollisionFile = parse_as(text, file)?;
+                let pair = f.specimen.build(base_dir, &sv)?;
+                let v1 = v.in_range("velocity1_m_s", f.velocity1_m_s, -1e4, 1e4, "m/s")?;
+                let v2 = v.in_range("velocity2_m_s", f.velocity2_m_s, -1e4, 1e4, "m/s")?;
+                if v1 <= v2 {
+                    return Err(v.error("velocity1_m_s", format!("{v1} m/s does not exceed velocity2_m_s = {v2} m/s, so the spheres never meet"), "velocity1_m_s > velocity2_m_s"));
+                }
+                let speed = v1 - v2;
+                let p = pair.contact_properties();
+                let tc = solver::hertz_impact_duration(
+                    pair.reduced_mass_kg(),
+                    p.e_star_pa,
+                    p.radius_m,
+                    speed,
+                );
+                let n = v.in_range("steps_per_contact", f.steps_per_contact, 20.0, 1e8, "")?;
+                let limit = solver::stability_limit(&pair, solver::hertz_peak_force(&pair, speed));
+                let dt = match f.time_step_s {
+                    Some(dt) => v.positive(
+                        "time_step_s",
+                        dt,
+                        limit,
+                        "s (the explicit stability limit 2/ω of this contact)",
+                    )?,
+                    None => tc / n,
+                };
+                let setup = CollisionSetup {
+                    velocity1_m_s: v1,
+                    velocity2_m_s: v2,
+                    dt_s: dt,
+                    max_time_s: 1000.0 * tc,
+                    output_every: check_every(&v, f.output_every)?,
+                };
+                (pair, f.law, SceneParams::Collision(setup))
+            }
+            "force-driven" => {
+                let f: ForceDrivenFile = parse_as(text, file)?;
+                let pair = f.specimen.build(base_dir, &sv)?;
+                let csv_path = base_dir.join(&f.force_csv);
+                let table = CsvTable::read(&csv_path)?;
+                let t = table.time_column(&f.time_column)?.to_vec();
+                let force = table.column(&f.force_column)?.to_vec();
+                let measured_displacement_m =
+                    table.optional_column("displacement_m").map(<[f64]>::to_vec);
+                let drive = ForceHistory {
+                    time_s: t,
+                    force_n: force,
+                };
+                let z = v.in_range(
+                    "medium_impedance_kg_s",
+                    f.medium_impedance_kg_s,
+                    0.0,
+                    1e9,
+                    "kg/s",
+                )?;
+                let n = v.in_range("steps_per_period", f.steps_per_period, 10.0, 1e8, "")?;
+                let peak = drive.peak_n().max(1e-3);
+                let limit = solver::stability_limit(&pair, peak);
+                let dt = match f.time_step_s {
+                    Some(dt) => v.positive("time_step_s", dt, limit, "s (the explicit stability limit 2/ω of this contact at the peak drive force)")?,
+                    None => solver::default_time_step(&pair, peak, z, n),
+                };
+                let last = *drive
+                    .time_s
+                    .last()
+                    .expect("time column has at least two samples");
+                let end = match f.end_time_s {
+                    Some(e) => v.positive("end_time_s", e, 1.0, "s")?,
+                    None => last,
+                };
+                if end / dt > 5e8 {
+                    return Err(v.error(
+                        "end_time_s",
+                        format!("{end:e} s needs {:.1e} steps of {dt:e} s", end / dt),
+                        "at most 5e8 steps",
+                    ));
+                }
+                let setup = ForceDrivenSetup {
+                    drive,
+                    medium_impedance_kg_s: z,
+                    dt_s: dt,
+                    end_time_s: end,
+                    output_every: check_every(&v, f.output_every)?,
+                };
+                (
+                    pair,
+                    f.law,
+                    SceneParams::ForceDriven {
+                        setup,
+                        measured_displacement_m,
+                    },
+                )
+            }
+            other => return Err(v.error("kind", format!("unknown scene kind `{other}`"), kinds)),
+        };
+        Ok(Params {
+            source: file.to_string(),
+            text: text.to_string(),
+            kind,
+            pair,
+            law,
+            params,
+        })
+    }
+
+    /// The contact law of this scene.
+    pub fn contact_law(&self) -> Box<dyn ContactLaw> {
+        self.law.build(self.pair.contact_properties())
+    }
+
+    /// Runs the scene.
+    pub fn run(&self) -> Result<RunOutput> {
+        let law = self.contact_law();
+        let law = law.as_ref();
+        match &self.params {
+            SceneParams::Quasistatic {
+                max_displacement_m,
+                points,
+                strain_rate_per_s,
+            } => {
+                let s =
+                    solver::loading_curve(law, *max_displacement_m, *points, *strain_rate_per_s);
+                let summary = vec![item("max_force", *s.force_n.last().unwrap_or(&0.0), "N")];
+                Ok(RunOutput {
+                    contact: s,
+                    summary,
+                })
+            }
+            SceneParams::ConstantRate {
+                strain_rate_per_s,
+                max_displacement_m,
+                points,
+            } => {
+                let s = solver::constant_rate(
+                    law,
+                    &self.pair,
+                    *strain_rate_per_s,
+                    *max_displacement_m,
+                    *points,
+                );
+                let summary = vec![
+                    item("max_force", *s.force_n.last().unwrap_or(&0.0), "N"),
+                    item(
+                        "approach_speed",
+                        strain_rate_per_s
+                            * (self.pair.sphere1.radius_m + self.pair.sphere2.radius_m),
+                        "m/s",
+                    ),
+                ];
+                Ok(RunOutput {
+                    contact: s,
+                    summary,
+                })
+            }
+            SceneParams::Collision(setup) => {
+                let r = solver::collision(law, &self.pair, setup)?;
+                let p = self.pair.contact_properties();
+                let tc = solver::hertz_impact_duration(
+                    self.pair.reduced_mass_kg(),
+                    p.e_star_pa,
+                    p.radius_m,
+                    setup.velocity1_m_s - setup.velocity2_m_s,
+                );
+                let summary = vec![
+                    item("restitution", r.restitution, "1"),
+                    item("contact_time", r.contact_time_s, "s"),
+                    item("hertz_contact_time", tc, "s"),
+                    item("peak_force", r.peak_force_n, "N"),
+                    item("max_approach", r.max_approach_m, "m"),
+                    item("residual_approach", r.residual_approach_m, "m"),
+                    item("kinetic_energy_before", r.kinetic_energy_before_j, "J"),
+                    item("kinetic_energy_after", r.kinetic_energy_after_j, "J"),
+                    item("energy_dissipated", r.dissipated_j, "J"),
+                    item("time_step", setup.dt_s, "s"),
+                ];
+                Ok(RunOutput {
+                    contact: r.series,
+                    summary,
+                })
+            }
+            SceneParams::ForceDriven {
+                setup,
+                measured_displacement_m,
+            } => {
+                let r = solver::force_driven(law, &self.pair, setup)?;
+                let mut summary = force_driven_summary(
+                    &r.series,
+                    &setup.drive,
+                    measured_displacement_m.as_deref(),
+                );
+                summary.push(item("time_step", setup.dt_s, "s"));
+                summary.push(item("energy_radiated", r.energy.radiated_j, "J"));
+                summary.push(item("external_work", r.energy.external_work_j, "J"));
+                summary.push(item("contact_work", r.energy.contact_work_j, "J"));
+                summary.push(item("kinetic_energy_end", r.kinetic_energy_j, "J"));
+                Ok(RunOutput {
+                    contact: r.series,
+                    summary,
+                })
+            }
+        }
+    }
+}
+
+/// Comparison of a force-driven run with the measured displacement (paper Fig. 4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fig4Comparison {
+    /// Peak contact force of the model, N.
+    pub model_peak_force_n: f64,
+    /// Model approach at its peak force, m.
+    pub model_displacement_at_peak_m: f64,
+    /// Peak measured force, N.
+    pub measured_peak_force_n: f64,
+    /// Measured approach at the peak measured force, m.
+    pub measured_displacement_at_peak_m: f64,
+    /// Measured approach at t = 0 (the reduction's offset; the model starts at δ = 0), m.
+    pub measured_initial_displacement_m: f64,
+}
+
+impl Fig4Comparison {
+    /// Relative error of the model's displacement at peak force against the measured one,
+    /// both counted from t = 0 (the measured offset δ(0) removed).
+    pub fn relative_error(&self) -> f64 {
+        let measured = self.measured_displacement_at_peak_m - self.measured_initial_displacement_m;
+        (self.model_displacement_at_peak_m - measured) / measured
+    }
+}
+
+/// Compares a force-driven series with the measured displacement sampled at the drive's times.
+pub fn compare_fig4(
+    series: &ContactSeries,
+    drive: &ForceHistory,
+    measured_displacement_m: &[f64],
+) -> Fig4Comparison {
+    let k = series.peak_index();
+    let j = solver::argmax(&drive.force_n);
+    Fig4Comparison {
+        model_peak_force_n: series.force_n[k],
+        model_displacement_at_peak_m: series.displacement_m[k],
+        measured_peak_force_n: drive.force_n[j],
+        measured_displacement_at_peak_m: measured_displacement_m[j],
+        measured_initial_displacement_m: measured_displacement_m[0],
+    }
+}
+
+fn force_driven_summary(
+    series: &ContactSeries,
+    drive: &ForceHistory,
+    measured: Option<&[f64]>,
+) -> Vec<SummaryItem> {
+    let k = series.peak_index();
+    let mut out = vec![
+        item("peak_force", series.force_n[k], "N"),
+        item("displacement_at_peak_force", series.displacement_m[k], "m"),
+        item(
+            "time_of_peak_force",
+            series.time_s.as_ref().map(|t| t[k]).unwrap_or(0.0),
+            "s",
+        ),
+        item(
+            "max_displacement",
+            series.displacement_m.iter().cloned().fold(0.0, f64::max),
+            "m",
+        ),
+    ];
+    if let Some(d) = measured {
+        let c = compare_fig4(series, drive, d);
+        out.push(item("measured_peak_force", c.measured_peak_force_n, "N"));
+        out.push(item(
+            "measured_displacement_at_peak_force",
+            c.measured_displacement_at_peak_m,
+            "m",
+        ));
+        out.push(item(
+            "measured_initial_displacement",
+            c.measured_initial_displacement_m,
+            "m",
+        ));
+        out.push(item(
+            "displacement_at_peak_relative_error",
+            c.relative_error(),
+            "1",
+        ));
+    }
+    out
+}
