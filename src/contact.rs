@@ -61,6 +61,24 @@ pub enum Region {
     Plastic,
 }
 
+/// The form of region II (δy < δ ≤ δp) of the loading law.
+///
+/// With α, β fixed by F(δy) = Fy and F(δp) = Fp (physics.md §1), the published law has a slope
+/// jump of 13–17 % at δy, and region II starts *above* the Hertz curve. Together with Thornton
+/// unloading (and with rate hardening, which moves δy) that lets a contact return more energy
+/// than it received in impacts just past yield (restitution above 1). `Smooth` adds the term
+/// γ(δ − δy)(δp − δ), which vanishes at both ends (so δy, Fy, δp, Fp, α, β are the paper's) and whose
+/// γ makes dF/dδ continuous at δy, as physics.md §1 requires.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Region2Form {
+    /// F = δ(α + β ln δ) + γ(δ − δy)(δp − δ), C¹ at δy (default).
+    #[default]
+    Smooth,
+    /// F = δ(α + β ln δ) exactly as printed in the paper (slope jump at δy).
+    Published,
+}
+
 /// How region I joins region III when region II does not exist (δp ≤ δy, physics.md §1).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Degenerate {
@@ -95,13 +113,25 @@ pub struct LoadingCurve {
     pub alpha: f64,
     /// Region II coefficient β, N/m.
     pub beta: f64,
+    /// Region II smoothing coefficient γ, N/m² (0 for the published form).
+    pub gamma: f64,
     /// Whether region II is missing and how the law copes.
     pub degenerate: Degenerate,
 }
 
 impl LoadingCurve {
-    /// Builds Eq. 1 for effective modulus, radius and yield stress (physics.md §1).
+    /// Builds Eq. 1 for effective modulus, radius and yield stress with the C¹ region II (physics.md §1).
     pub fn new(e_star_pa: f64, radius_m: f64, yield_stress_pa: f64) -> LoadingCurve {
+        LoadingCurve::with_form(e_star_pa, radius_m, yield_stress_pa, Region2Form::Smooth)
+    }
+
+    /// Builds Eq. 1 with the chosen form of region II.
+    pub fn with_form(
+        e_star_pa: f64,
+        radius_m: f64,
+        yield_stress_pa: f64,
+        form: Region2Form,
+    ) -> LoadingCurve {
         let k = YIELD_ONSET_FACTOR * PI * yield_stress_pa;
         let delta_y_m = 0.25 * radius_m / (e_star_pa * e_star_pa) * k * k;
         let force_y_n = (1.0 / 6.0) * (radius_m / e_star_pa).powi(2) * k * k * k;
@@ -120,6 +150,7 @@ impl LoadingCurve {
             force_p_n,
             alpha: 0.0,
             beta: 0.0,
+            gamma: 0.0,
             degenerate: Degenerate::No,
         };
         let (dy, dp) = (delta_y_m, fit.delta_p_m);
@@ -127,6 +158,10 @@ impl LoadingCurve {
             let beta = (dy * force_p_n - dp * force_y_n) / (dy * dp * (dp / dy).ln());
             curve.beta = beta;
             curve.alpha = force_y_n / dy - beta * dy.ln();
+            if form == Region2Form::Smooth {
+                let jump = curve.alpha + beta * (dy.ln() + 1.0) - 1.5 * force_y_n / dy;
+                curve.gamma = -jump / (dp - dy);
+            }
         } else {
             curve.degenerate = curve.hertz_plastic_crossing();
         }
@@ -193,7 +228,10 @@ impl LoadingCurve {
         }
         match self.region(delta_m) {
             Region::Hertz => hertz_force(self.e_star_pa, self.radius_m, delta_m),
-            Region::Mixed => delta_m * (self.alpha + self.beta * delta_m.ln()),
+            Region::Mixed => {
+                delta_m * (self.alpha + self.beta * delta_m.ln())
+                    + self.gamma * (delta_m - self.delta_y_m) * (self.fit.delta_p_m - delta_m)
+            }
             Region::Plastic => self.plastic_line(delta_m),
         }
     }
@@ -205,7 +243,11 @@ impl LoadingCurve {
         }
         match self.region(delta_m) {
             Region::Hertz => 2.0 * self.e_star_pa * (self.radius_m * delta_m).sqrt(),
-            Region::Mixed => self.alpha + self.beta * (delta_m.ln() + 1.0),
+            Region::Mixed => {
+                self.alpha
+                    + self.beta * (delta_m.ln() + 1.0)
+                    + self.gamma * (self.fit.delta_p_m + self.delta_y_m - 2.0 * delta_m)
+            }
             Region::Plastic => self.p0_pa * PI * 2.0 * self.radius_m,
         }
     }
@@ -258,6 +300,11 @@ pub trait ContactLaw: Send + Sync {
     /// The virgin loading force at `delta_m` under a constant strain rate (no history).
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
 
+    /// Whether the force depends on the approach speed (then solvers treat the speed implicitly).
+    fn is_rate_dependent(&self) -> bool {
+        false
+    }
+
     /// Approach below which the contact carries no force, given its history (δr), m.
     fn zero_force_approach(&self, history: &ContactHistory) -> f64 {
         history.residual_delta_m.max(0.0)
@@ -306,16 +353,33 @@ pub struct BurgoyneDaraio {
     pub props: ContactProperties,
     /// Whether σy* follows the strain rate (false: the paper's "model without strain rate dependence").
     pub rate_dependent: bool,
+    /// Form of region II.
+    pub region2: Region2Form,
     static_curve: LoadingCurve,
 }
 
 impl BurgoyneDaraio {
-    /// The law for a pair with the given effective properties.
+    /// The law for a pair with the given effective properties (C¹ region II).
     pub fn new(props: ContactProperties, rate_dependent: bool) -> BurgoyneDaraio {
+        BurgoyneDaraio::with_form(props, rate_dependent, Region2Form::Smooth)
+    }
+
+    /// The law with the chosen form of region II.
+    pub fn with_form(
+        props: ContactProperties,
+        rate_dependent: bool,
+        region2: Region2Form,
+    ) -> BurgoyneDaraio {
         BurgoyneDaraio {
             props,
             rate_dependent,
-            static_curve: LoadingCurve::new(props.e_star_pa, props.radius_m, props.yield_stress_pa),
+            region2,
+            static_curve: LoadingCurve::with_form(
+                props.e_star_pa,
+                props.radius_m,
+                props.yield_stress_pa,
+                region2,
+            ),
         }
     }
 
@@ -350,7 +414,7 @@ impl BurgoyneDaraio {
         if s == self.props.yield_stress_pa {
             self.static_curve
         } else {
-            LoadingCurve::new(self.props.e_star_pa, self.props.radius_m, s)
+            LoadingCurve::with_form(self.props.e_star_pa, self.props.radius_m, s, self.region2)
         }
     }
 
@@ -430,6 +494,10 @@ impl ContactLaw for BurgoyneDaraio {
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64 {
         self.curve_at(strain_rate_per_s).force(delta_m)
     }
+
+    fn is_rate_dependent(&self) -> bool {
+        self.rate_dependent && self.props.rate.c != 0.0
+    }
 }
 
 /// The contact laws a scene can select with `law = "..."`.
@@ -453,11 +521,16 @@ impl LawKind {
         ("hertz", LawKind::Hertz),
     ];
 
-    /// Builds the law for a pair's effective properties.
+    /// Builds the law for a pair's effective properties (C¹ region II).
     pub fn build(self, props: ContactProperties) -> Box<dyn ContactLaw> {
+        self.build_with(props, Region2Form::Smooth)
+    }
+
+    /// Builds the law with the chosen form of region II (ignored by Hertz).
+    pub fn build_with(self, props: ContactProperties, region2: Region2Form) -> Box<dyn ContactLaw> {
         match self {
-            LawKind::BurgoyneDaraio => Box::new(BurgoyneDaraio::new(props, true)),
-            LawKind::RateIndependent => Box::new(BurgoyneDaraio::new(props, false)),
+            LawKind::BurgoyneDaraio => Box::new(BurgoyneDaraio::with_form(props, true, region2)),
+            LawKind::RateIndependent => Box::new(BurgoyneDaraio::with_form(props, false, region2)),
             LawKind::Hertz => Box::new(Hertz {
                 e_star_pa: props.e_star_pa,
                 radius_m: props.radius_m,

@@ -1,9 +1,13 @@
 //! Time integration of the two-sphere DEM scenes (paper Sec. III, DEM; physics.md §5).
 //!
 //! Scheme: velocity Verlet for the contact force, with linear dashpots (the bar media) treated by
-//! the trapezoidal rule so that they are unconditionally stable. One contact-law evaluation per
-//! step, so the per-contact history is committed exactly once per step. The strain rate of
-//! paper Eq. 3 uses the step's approach speed (δ_{n+1} − δ_n)/Δt.
+//! the trapezoidal rule so that they are unconditionally stable. The per-contact history is
+//! committed exactly once per step. The strain rate of paper Eq. 3 makes the force depend on the
+//! approach speed like a (log-)viscous damper whose coefficient ∝ 1/δ̇ becomes unbounded as the
+//! spheres stop; an explicit rate would be unstable there, so a rate-dependent law is evaluated
+//! with the end-of-step approach speed u_{n+1}, solving the scalar monotone equation
+//! u = A − B F(δ_{n+1}, u) of the velocity update by bracketed secant iteration (implicit in the rate,
+//! second-order and stable). Rate-independent laws need one evaluation per step.
 //!
 //! Time-step rule: Δt = min(T/`steps_per_period`, m/(2Z)), where T = 2π√(m_red/k) is the period of
 //! the linearised contact with k the Hertz tangent stiffness at the largest force expected, and
@@ -158,9 +162,15 @@ impl<'a> PairStepper<'a> {
             b2.velocity_m_s + 0.5 * dt * (f_now - b2.damping_kg_s * b2.velocity_m_s) / b2.mass_kg;
         b2.position_m += dt * v2h;
         let delta_next = self.approach_m();
-        let eval = self
-            .law
-            .evaluate(&mut self.history, delta_next, (delta_next - delta_now) / dt);
+        let speed = if self.law.is_rate_dependent()
+            && delta_next >= self.history.delta_max_m
+            && delta_next > 0.0
+        {
+            self.implicit_approach_speed(v1h, v2h, external_force_next_n, delta_next)
+        } else {
+            (delta_next - delta_now) / dt
+        };
+        let eval = self.law.evaluate(&mut self.history, delta_next, speed);
         let f_next = eval.force_n;
         let b1 = &mut self.sphere1;
         b1.velocity_m_s = (v1h + 0.5 * dt * (external_force_next_n - f_next) / b1.mass_kg)
@@ -181,6 +191,58 @@ impl<'a> PairStepper<'a> {
         self.step_index += 1;
         self.time_s = self.step_index as f64 * dt;
         self.check_finite()
+    }
+
+    /// Solves u = A − B F(δ, u) for the end-of-step approach speed u (module docs).
+    fn implicit_approach_speed(&self, v1h: f64, v2h: f64, fext_next: f64, delta: f64) -> f64 {
+        let dt = self.dt_s;
+        let (b1, b2) = (&self.sphere1, &self.sphere2);
+        let k1 = 1.0 + 0.5 * dt * b1.damping_kg_s / b1.mass_kg;
+        let k2 = 1.0 + 0.5 * dt * b2.damping_kg_s / b2.mass_kg;
+        let a = (v1h + 0.5 * dt * fext_next / b1.mass_kg) / k1 - v2h / k2;
+        let b = 0.5 * dt / (b1.mass_kg * k1) + 0.5 * dt / (b2.mass_kg * k2);
+        let force = |u: f64| {
+            self.law
+                .evaluate(&mut self.history.clone(), delta, u)
+                .force_n
+        };
+        // g(u) = u − A + B F(u) is increasing in u (F does not fall with the rate): bracket its root.
+        let g = |u: f64| u - a + b * force(u);
+        let u_hi = a - b * force(0.0);
+        let u_lo = a - b * force(u_hi.max(0.0));
+        let (mut lo, mut hi) = (u_lo.min(u_hi), u_lo.max(u_hi));
+        let (mut glo, mut ghi) = (g(lo), g(hi));
+        if glo >= 0.0 {
+            return lo;
+        }
+        if ghi <= 0.0 {
+            return hi;
+        }
+        // Illinois (modified regula falsi): superlinear, never leaves the bracket.
+        let mut side = 0;
+        for _ in 0..100 {
+            let u = (lo * ghi - hi * glo) / (ghi - glo);
+            let gu = g(u);
+            if gu == 0.0 || (hi - lo) <= 1e-13 * (hi.abs() + lo.abs()) + 1e-18 {
+                return u;
+            }
+            if gu < 0.0 {
+                lo = u;
+                glo = gu;
+                if side == -1 {
+                    ghi *= 0.5;
+                }
+                side = -1;
+            } else {
+                hi = u;
+                ghi = gu;
+                if side == 1 {
+                    glo *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        0.5 * (lo + hi)
     }
 
     /// Stops a run that produced a non-finite value, naming step, time and quantity.
