@@ -466,6 +466,11 @@ impl ContactLaw for BurgoyneDaraio {
         }
         // Unloading or reloading below δmax: elastic on the unloading curve.
         if h.unloading_radius_m == 0.0 && h.force_max_n > 0.0 {
+            // At the turning point the approach speed is zero, so σy* = σy there (paper Eq. 2):
+            // unloading starts from the static loading curve at δmax. (The last loading step's
+            // rate is an arbitrary small number whose logarithm would make Fmax depend on Δt.)
+            h.force_max_n = self.static_curve.force(h.delta_max_m);
+            h.yielded = self.static_curve.region(h.delta_max_m) != Region::Hertz;
             if h.yielded {
                 let (rp, dr) = self.thornton_unloading(h.delta_max_m, h.force_max_n);
                 h.unloading_radius_m = rp;

@@ -1,7 +1,7 @@
 //! Scene files: one TOML file per virtual test, with a `kind` key, parsed once into validated
 //! [`Params`] (physics code never sees unchecked input), and run into a [`RunOutput`].
 
-use crate::contact::{ContactLaw, LawKind};
+use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
 use crate::error::{Error, Result, Validator};
 use crate::io::{CsvTable, RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
@@ -43,6 +43,8 @@ struct QuasistaticFile {
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
+    #[serde(default)]
+    region2: Region2Form,
     max_displacement_m: f64,
     #[serde(default = "default_points")]
     points: usize,
@@ -58,6 +60,8 @@ struct ConstantRateFile {
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
+    #[serde(default)]
+    region2: Region2Form,
     strain_rate_per_s: f64,
     max_displacement_m: f64,
     #[serde(default = "default_points")]
@@ -72,6 +76,8 @@ struct CollisionFile {
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
+    #[serde(default)]
+    region2: Region2Form,
     velocity1_m_s: f64,
     #[serde(default)]
     velocity2_m_s: f64,
@@ -90,6 +96,8 @@ struct ForceDrivenFile {
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
+    #[serde(default)]
+    region2: Region2Form,
     force_csv: String,
     #[serde(default = "default_time_column")]
     time_column: String,
@@ -172,6 +180,8 @@ pub struct Params {
     pub pair: SpherePair,
     /// The contact law selected.
     pub law: LawKind,
+    /// Form of region II of the loading law (`smooth` C¹ default, or `published`).
+    pub region2: Region2Form,
     /// Kind-specific parameters.
     pub params: SceneParams,
 }
@@ -227,7 +237,7 @@ impl Params {
             None => return Err(v.error("kind", "missing", kinds)),
         };
         let sv = v.table("specimen");
-        let (pair, law, params) = match kind.as_str() {
+        let (pair, law, region2, params) = match kind.as_str() {
             "quasistatic" => {
                 let f: QuasistaticFile = parse_as(text, file)?;
                 let pair = f.specimen.build(base_dir, &sv)?;
@@ -247,7 +257,7 @@ impl Params {
                         "1/s",
                     )?,
                 };
-                (pair, f.law, p)
+                (pair, f.law, f.region2, p)
             }
             "constant-rate" => {
                 let f: ConstantRateFile = parse_as(text, file)?;
@@ -267,7 +277,7 @@ impl Params {
                     )?,
                     points: check_points(&v, f.points)?,
                 };
-                (pair, f.law, p)
+                (pair, f.law, f.region2, p)
             }
             "collision" => {
                 let f: CollisionFile = parse_as(text, file)?;
@@ -303,7 +313,7 @@ impl Params {
                     max_time_s: 1000.0 * tc,
                     output_every: check_every(&v, f.output_every)?,
                 };
-                (pair, f.law, SceneParams::Collision(setup))
+                (pair, f.law, f.region2, SceneParams::Collision(setup))
             }
             "force-driven" => {
                 let f: ForceDrivenFile = parse_as(text, file)?;
@@ -357,6 +367,7 @@ impl Params {
                 (
                     pair,
                     f.law,
+                    f.region2,
                     SceneParams::ForceDriven {
                         setup,
                         measured_displacement_m,
@@ -371,13 +382,32 @@ impl Params {
             kind,
             pair,
             law,
+            region2,
             params,
         })
     }
 
     /// The contact law of this scene.
     pub fn contact_law(&self) -> Box<dyn ContactLaw> {
-        self.law.build(self.pair.contact_properties())
+        self.law.build_with(self.pair.contact_properties(), self.region2)
+    }
+
+    /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).
+    pub fn warnings(&self) -> Vec<String> {
+        let p = self.pair.contact_properties();
+        let c = LoadingCurve::new(p.e_star_pa, p.radius_m, p.yield_stress_pa);
+        let q = p.e_star_pa / p.yield_stress_pa;
+        match c.degenerate {
+            Degenerate::No => vec![],
+            Degenerate::HertzToPlasticAt(d) => vec![format!(
+                "{}: δp ≤ δy for this pair (q = E*/σy = {q:.3}): region II does not exist; the law goes from Hertz to region III at δ = {d:.4e} m",
+                self.source
+            )],
+            Degenerate::HertzOnly => vec![format!(
+                "{}: δp ≤ δy for this pair (q = E*/σy = {q:.3}) and region III never crosses Hertz: the law stays elastic (Hertz)",
+                self.source
+            )],
+        }
     }
 
     /// Runs the scene.

@@ -218,40 +218,31 @@ fn at_peak(r: &solver::ForceDrivenResult) -> (f64, f64) {
 }
 
 #[test]
-fn force_driven_rate_independent_converges_in_time_step() {
-    // With the static law the problem is smooth: quartering the default step changes the
-    // displacement at peak force and the largest approach by < 1e-5 (second-order scheme).
-    let params = fig4_scene(&fig4_files()[5], "rate-independent");
-    let (a, b) = (
-        at_peak(&run_with_step(&params, 1.0)),
-        at_peak(&run_with_step(&params, 4.0)),
-    );
-    assert!(
-        rel(a.0, b.0) < 1e-5 && rel(a.1, b.1) < 1e-5,
-        "{a:?} vs {b:?}"
-    );
+fn force_driven_converges_in_time_step() {
+    // Halving and quartering the default step changes the displacement at peak force and the
+    // largest approach by < 1e-4: the default rule is converged far below the model-vs-measurement
+    // differences (several %). The rate-dependent law needs the implicit strain rate and the
+    // σy* = σy turning point (contact.rs) for this; with an explicit rate it scattered by 0.5 %.
+    for law in ["rate-independent", "burgoyne-daraio"] {
+        let params = fig4_scene(&fig4_files()[5], law);
+        let base = at_peak(&run_with_step(&params, 1.0));
+        for divide in [2.0, 4.0] {
+            let other = at_peak(&run_with_step(&params, divide));
+            assert!(rel(base.0, other.0) < 1e-4, "{law}: δ at peak {base:?} vs {other:?} (Δt/{divide})");
+            assert!(rel(base.1, other.1) < 1e-4, "{law}: max δ {base:?} vs {other:?} (Δt/{divide})");
+        }
+    }
 }
 
 #[test]
-fn force_driven_rate_dependent_is_step_insensitive_at_peak() {
-    // With rate hardening, every dip of the measured force unloads the contact, and on reloading
-    // past δmax the loading law returns at the (low) current rate: the force drops and the history
-    // depends sensitively on where a step lands (the model, not the scheme, is ill-conditioned
-    // there). The quantities compared with the experiment stay within 0.5 % for steps from the
-    // default down to a quarter of it, an order of magnitude below the model-vs-measurement
-    // differences (3–10 %).
-    let params = fig4_scene(&fig4_files()[5], "burgoyne-daraio");
-    let base = at_peak(&run_with_step(&params, 1.0));
-    for divide in [2.0, 4.0] {
-        let other = at_peak(&run_with_step(&params, divide));
-        assert!(
-            rel(base.0, other.0) < 5e-3,
-            "δ at peak: {base:?} vs {other:?} (Δt/{divide})"
-        );
-        assert!(
-            rel(base.1, other.1) < 5e-3,
-            "max δ: {base:?} vs {other:?} (Δt/{divide})"
-        );
+fn collision_restitution_converges_in_time_step() {
+    // From 250 to 8000 steps per Hertz contact time the restitution of a plastic impact moves by < 1e-5.
+    let pair = SpherePair::paper(Material::builtin("ss440c").unwrap());
+    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let reference = collide(&pair, &law, 5.0, 8000.0).restitution;
+    for n in [250.0, 1000.0, 2000.0] {
+        let e = collide(&pair, &law, 5.0, n).restitution;
+        assert!(rel(e, reference) < 1e-5, "{n} steps: e = {e} vs {reference}");
     }
 }
 
