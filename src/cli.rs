@@ -4,7 +4,7 @@
 use crate::contact::LawKind;
 use crate::error::{Error, Result, Validator};
 use crate::io::{RunOutput, check_output, write_contact_csv, write_hdf5};
-use crate::plot::{Curve, xy_plot};
+use crate::plot::{Axes, Curve, xy_plot};
 use crate::scene::{Params, SceneParams};
 use crate::specimen::resolve_pair;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -83,10 +83,11 @@ pub enum Command {
         #[arg(long, default_value = "ss440c")]
         specimen: String,
         /// Global strain rate for Johnson–Cook hardening, 1/s (0: quasi-static).
-        #[arg(long, default_value_t = 0.0)]
+        // Negative numbers are parsed (not taken for options) so the range check can name them.
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
         rate: f64,
         /// Largest approach δ, m.
-        #[arg(long, default_value_t = 250e-6)]
+        #[arg(long, default_value_t = 250e-6, allow_negative_numbers = true)]
         to: f64,
         /// Number of points.
         #[arg(long, default_value_t = 101)]
@@ -146,6 +147,9 @@ fn run(
         check_output(p, force)?;
     }
     let params = Params::from_file(scene)?;
+    for w in params.warnings() {
+        eprintln!("shpb: warning: {w}");
+    }
     let out = params.run()?;
     print_summary(&params, &out);
     if let Some(p) = output {
@@ -205,16 +209,14 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default()
     );
-    xy_plot(
-        path,
-        force,
-        &title,
-        "sphere approach δ (mm)",
-        "force F (kN)",
-        1e3,
-        1e-3,
-        &curves,
-    )
+    let axes = Axes {
+        title: &title,
+        x_label: "sphere approach δ (mm)",
+        y_label: "force F (kN)",
+        x_scale: 1e3,
+        y_scale: 1e-3,
+    };
+    xy_plot(path, force, &axes, &curves)
 }
 
 fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Result<()> {

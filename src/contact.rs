@@ -300,6 +300,11 @@ pub trait ContactLaw: Send + Sync {
     /// The virgin loading force at `delta_m` under a constant strain rate (no history).
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
 
+    /// Whether the law has a yield stress to report (false for elastic Hertz).
+    fn has_yield_stress(&self) -> bool {
+        true
+    }
+
     /// Whether the force depends on the approach speed (then solvers treat the speed implicitly).
     fn is_rate_dependent(&self) -> bool {
         false
@@ -342,6 +347,10 @@ impl ContactLaw for Hertz {
 
     fn loading_force(&self, delta_m: f64, _strain_rate_per_s: f64) -> f64 {
         hertz_force(self.e_star_pa, self.radius_m, delta_m)
+    }
+
+    fn has_yield_stress(&self) -> bool {
+        false
     }
 }
 

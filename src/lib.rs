@@ -7,14 +7,19 @@
 
 #![warn(missing_docs)]
 
+pub mod apparatus;
+pub mod bar;
 pub mod cli;
 pub mod contact;
 pub mod error;
+pub mod gauge;
 pub mod io;
 pub mod material;
 pub mod plot;
 pub mod scene;
+pub mod shaper;
 pub mod solver;
 pub mod specimen;
+pub mod striker;
 
 pub use error::{Error, Result};

@@ -124,7 +124,13 @@ impl Material {
     pub fn resolve(reference: &str, base_dir: &Path, v: &Validator, key: &str) -> Result<Material> {
         if reference.ends_with(".toml") {
             let path = base_dir.join(reference);
-            let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                v.error(
+                    key,
+                    format!("cannot read {}: {e}", path.display()),
+                    "a readable material .toml file, relative to the scene file's directory",
+                )
+            })?;
             return Material::from_toml(&text, &path.display().to_string());
         }
         Material::builtin(reference).ok_or_else(|| {

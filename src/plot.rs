@@ -25,17 +25,29 @@ const PALETTE: [RGBColor; 5] = [
     RGBColor(150, 60, 170),
 ];
 
-/// Draws curves into a PNG (written atomically); x and y are scaled by the given factors for display.
-pub fn xy_plot(
-    path: &Path,
-    force: bool,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    x_scale: f64,
-    y_scale: f64,
-    curves: &[Curve],
-) -> Result<()> {
+/// Title, axis labels and display scale factors of a plot.
+pub struct Axes<'a> {
+    /// Caption.
+    pub title: &'a str,
+    /// x-axis label with unit.
+    pub x_label: &'a str,
+    /// y-axis label with unit.
+    pub y_label: &'a str,
+    /// Factor applied to x values for display (e.g. 1e3 for m → mm).
+    pub x_scale: f64,
+    /// Factor applied to y values for display.
+    pub y_scale: f64,
+}
+
+/// Draws curves into a PNG (written atomically), scaled as `axes` says.
+pub fn xy_plot(path: &Path, force: bool, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    let (title, x_label, y_label, x_scale, y_scale) = (
+        axes.title,
+        axes.x_label,
+        axes.y_label,
+        axes.x_scale,
+        axes.y_scale,
+    );
     let (mut xmax, mut ymax) = (0.0f64, 0.0f64);
     let (mut xmin, mut ymin) = (0.0f64, 0.0f64);
     for c in curves {

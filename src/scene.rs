@@ -319,7 +319,14 @@ impl Params {
                 let f: ForceDrivenFile = parse_as(text, file)?;
                 let pair = f.specimen.build(base_dir, &sv)?;
                 let csv_path = base_dir.join(&f.force_csv);
-                let table = CsvTable::read(&csv_path)?;
+                let table = CsvTable::read(&csv_path).map_err(|e| match e {
+                    Error::Io { source, .. } => v.error(
+                        "force_csv",
+                        format!("cannot read {}: {source}", csv_path.display()),
+                        "a readable CSV file, absolute or relative to the scene file's directory",
+                    ),
+                    other => other,
+                })?;
                 let t = table.time_column(&f.time_column)?.to_vec();
                 let force = table.column(&f.force_column)?.to_vec();
                 let measured_displacement_m =
@@ -389,7 +396,8 @@ impl Params {
 
     /// The contact law of this scene.
     pub fn contact_law(&self) -> Box<dyn ContactLaw> {
-        self.law.build_with(self.pair.contact_properties(), self.region2)
+        self.law
+            .build_with(self.pair.contact_properties(), self.region2)
     }
 
     /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).

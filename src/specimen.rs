@@ -181,7 +181,15 @@ pub fn resolve_pair(
     key: &str,
 ) -> Result<SpherePair> {
     if reference.ends_with(".toml") {
-        return load_pair_file(&base_dir.join(reference));
+        let path = base_dir.join(reference);
+        if !path.is_file() {
+            return Err(v.error(
+                key,
+                format!("cannot read {}: no such file", path.display()),
+                "a readable pair .toml file, relative to the scene file's directory",
+            ));
+        }
+        return load_pair_file(&path);
     }
     Material::resolve(reference, base_dir, v, key).map(SpherePair::paper)
 }

@@ -228,8 +228,14 @@ fn force_driven_converges_in_time_step() {
         let base = at_peak(&run_with_step(&params, 1.0));
         for divide in [2.0, 4.0] {
             let other = at_peak(&run_with_step(&params, divide));
-            assert!(rel(base.0, other.0) < 1e-4, "{law}: δ at peak {base:?} vs {other:?} (Δt/{divide})");
-            assert!(rel(base.1, other.1) < 1e-4, "{law}: max δ {base:?} vs {other:?} (Δt/{divide})");
+            assert!(
+                rel(base.0, other.0) < 1e-4,
+                "{law}: δ at peak {base:?} vs {other:?} (Δt/{divide})"
+            );
+            assert!(
+                rel(base.1, other.1) < 1e-4,
+                "{law}: max δ {base:?} vs {other:?} (Δt/{divide})"
+            );
         }
     }
 }
@@ -242,7 +248,10 @@ fn collision_restitution_converges_in_time_step() {
     let reference = collide(&pair, &law, 5.0, 8000.0).restitution;
     for n in [250.0, 1000.0, 2000.0] {
         let e = collide(&pair, &law, 5.0, n).restitution;
-        assert!(rel(e, reference) < 1e-5, "{n} steps: e = {e} vs {reference}");
+        assert!(
+            rel(e, reference) < 1e-5,
+            "{n} steps: e = {e} vs {reference}"
+        );
     }
 }
 

@@ -13,6 +13,8 @@
 //! the linearised contact with k the Hertz tangent stiffness at the largest force expected, and
 //! m/Z the relaxation time of a sphere on a dashpot. The explicit limit is Δt < 2/ω = T/π.
 
+pub mod pulse;
+
 use crate::contact::{ContactEval, ContactHistory, ContactLaw, hertz_force};
 use crate::error::{Error, Result};
 use crate::specimen::SpherePair;
@@ -121,11 +123,8 @@ impl<'a> PairStepper<'a> {
             time_s: 0.0,
             step_index: 0,
             history: ContactHistory::default(),
-            contact: ContactEval {
-                force_n: 0.0,
-                yield_stress_pa: f64::NAN,
-                strain_rate_per_s: 0.0,
-            },
+            // What the law reports before contact (the static σy for Burgoyne–Daraio).
+            contact: law.evaluate(&mut ContactHistory::default(), 0.0, 0.0),
             external_force_n: 0.0,
             energy: EnergyLedger::default(),
         }
@@ -353,6 +352,9 @@ pub fn constant_rate(
     let speed = strain_rate_per_s * (pair.sphere1.radius_m + pair.sphere2.radius_m);
     let mut history = ContactHistory::default();
     let mut s = ContactSeries::dynamic(points);
+    if !law.has_yield_stress() {
+        s.yield_stress_pa = None;
+    }
     for i in 0..points {
         let d = max_m * i as f64 / (points - 1) as f64;
         let eval = law.evaluate(&mut history, d, speed);
@@ -411,6 +413,9 @@ pub fn collision(
     let ke0 = st.kinetic_energy_j();
     let approach0 = setup.velocity1_m_s - setup.velocity2_m_s;
     let mut series = ContactSeries::dynamic(1024);
+    if !law.has_yield_stress() {
+        series.yield_stress_pa = None;
+    }
     series.push(0.0, 0.0, &st.contact);
     let mut contact_end = None;
     let mut peak = 0.0f64;
@@ -421,7 +426,7 @@ pub fn collision(
         let d = st.approach_m();
         peak = peak.max(st.contact.force_n);
         max_approach = max_approach.max(d);
-        if st.step_index % setup.output_every == 0 {
+        if st.step_index.is_multiple_of(setup.output_every) {
             series.push(st.time_s, d, &st.contact);
         }
         if st.contact.force_n == 0.0 && peak > 0.0 && st.approach_speed_m_s() < 0.0 {
@@ -433,7 +438,7 @@ pub fn collision(
                 1.0
             };
             contact_end = Some(t_prev + frac.clamp(0.0, 1.0) * setup.dt_s);
-            if st.step_index % setup.output_every != 0 {
+            if !st.step_index.is_multiple_of(setup.output_every) {
                 series.push(st.time_s, d, &st.contact);
             }
             break;
@@ -524,6 +529,9 @@ pub fn force_driven(
     st.external_force_n = setup.drive.at(0.0);
     let steps = (setup.end_time_s / setup.dt_s).ceil() as usize;
     let mut series = ContactSeries::dynamic(steps / setup.output_every + 2);
+    if !law.has_yield_stress() {
+        series.yield_stress_pa = None;
+    }
     series.push(0.0, 0.0, &st.contact);
     for n in 1..=steps {
         st.step(setup.drive.at(n as f64 * setup.dt_s))?;

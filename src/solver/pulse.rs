@@ -1,0 +1,253 @@
+//! The bar apparatus in time: striker → (pulse shaper) → incident bar (→ transmission bar),
+//! all bars on one time step at Courant number 1 (physics.md §6).
+//!
+//! Couplings between bar ends are solved implicitly for the step's end velocities, so they add
+//! no stiffness to the explicit limit of the bars (which sit exactly at it at Courant 1):
+//! * a **butt joint** (striker on bar without shaper, bar pressed on bar) carries compression
+//!   only: while closed, the two half-mass end nodes move as one full node, exactly as a
+//!   continuous bar would; it opens when holding it would need tension;
+//! * a **pulse shaper** is a massless nonlinear spring F(closure): its force is solved from
+//!   F = F_shaper(closure_{n+1}(F)) by bisection (F_shaper does not fall with closure).
+
+use crate::bar::Bar;
+use crate::error::Result;
+use crate::shaper::{PulseShaper, ShaperState};
+
+/// How two bar ends touch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Joint {
+    /// Compression-only butt contact.
+    Butt,
+    /// A copper pulse shaper between the ends.
+    Shaper(PulseShaper),
+}
+
+/// State of a joint between the right end of one bar and the left end of the next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointState {
+    /// The joint's law.
+    pub joint: Joint,
+    /// Shaper memory (unused for butt joints).
+    pub shaper: ShaperState,
+    /// Compressive force carried in the last step, N.
+    pub force_n: f64,
+}
+
+impl JointState {
+    /// A joint with no history.
+    pub fn new(joint: Joint) -> JointState {
+        JointState {
+            joint,
+            shaper: ShaperState::default(),
+            force_n: 0.0,
+        }
+    }
+
+    /// Plastic work dissipated in the shaper so far, J.
+    pub fn dissipated_j(&self) -> f64 {
+        match self.joint {
+            Joint::Butt => 0.0,
+            Joint::Shaper(_) => self.shaper.work_j,
+        }
+    }
+}
+
+/// End-node data needed to solve a joint: current closure, predicted closure rate without the
+/// joint force, and how the closure rate responds to it.
+#[derive(Debug, Clone, Copy)]
+pub struct JointPrediction {
+    /// Closure: displacement of the left bar's end minus that of the right bar's end (> 0 compresses), m.
+    pub closure_m: f64,
+    /// Closure rate at the half step if the joint carried no force, m/s.
+    pub free_rate_m_s: f64,
+    /// Drop of the closure rate per newton of joint force (Δt/m_left + Δt/m_right for lumped ends), m/(s·N).
+    pub compliance: f64,
+}
+
+/// Solves the joint force for one step (≥ 0, compressive), updating the joint's memory.
+pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64 {
+    let f = match state.joint {
+        Joint::Butt => {
+            // Closed joint: force that makes both ends move together (closure rate 0), if compressive.
+            // (0 when the joint stays open, i.e. the ends would not meet within the step).
+            ((p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)).max(0.0)
+        }
+        Joint::Shaper(s) => {
+            let next = |f: f64| p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
+            let mut trial = state.shaper;
+            let f_hi = s.force_n(&mut trial, next(0.0));
+            if f_hi <= 0.0 {
+                0.0
+            } else {
+                let (mut lo, mut hi) = (0.0, f_hi);
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    let mut t = state.shaper;
+                    if s.force_n(&mut t, next(mid)) > mid {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                    if hi - lo <= 1e-12 * hi {
+                        break;
+                    }
+                }
+                0.5 * (lo + hi)
+            }
+        }
+    };
+    if let Joint::Shaper(s) = state.joint {
+        let closure = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
+        s.force_n(&mut state.shaper, closure);
+    }
+    state.force_n = f;
+    f
+}
+
+/// Predicts a joint between the right end of `left` and the left end of `right` (exact for
+/// lumped and Love-rod bars: uses the bars' own free end velocities and end mobilities).
+pub fn predict_joint(left: &Bar, right: &Bar) -> JointPrediction {
+    let closure = left.displacement_m(left.node_count() - 1) - right.displacement_m(0);
+    JointPrediction {
+        closure_m: closure,
+        free_rate_m_s: left.free_end_velocity_m_s(true) - right.free_end_velocity_m_s(false),
+        compliance: left.end_mobility_s_per_kg(true, true)
+            + right.end_mobility_s_per_kg(false, false),
+    }
+}
+
+/// Advances a chain of bars joined end to end by one step; returns the joint forces used.
+pub fn step_chain(bars: &mut [Bar], joints: &mut [JointState]) -> Result<()> {
+    debug_assert_eq!(joints.len() + 1, bars.len());
+    let dt = bars[0].dt_s();
+    let mut forces = vec![0.0; joints.len()];
+    for (k, j) in joints.iter_mut().enumerate() {
+        let p = predict_joint(&bars[k], &bars[k + 1]);
+        forces[k] = solve_joint(j, p, dt);
+    }
+    let n = bars.len();
+    for (k, bar) in bars.iter_mut().enumerate() {
+        let left = if k > 0 { forces[k - 1] } else { 0.0 };
+        let right = if k + 1 < n { -forces[k] } else { 0.0 };
+        bar.step(left, right);
+        bar.check_finite()?;
+    }
+    Ok(())
+}
+
+/// Which bar of the chain a gauge sits on, and where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaugeProbe {
+    /// Channel name.
+    pub name: String,
+    /// Index of the bar in the chain (0 = striker).
+    pub bar: usize,
+    /// Position along that bar from its left end, m.
+    pub x_m: f64,
+    /// Gauge grid length over which the strain is averaged, m (0: a point).
+    pub length_m: f64,
+}
+
+/// Inputs of a pulse run: a chain of bars joined end to end, the first moving at the striker speed.
+#[derive(Debug, Clone)]
+pub struct ChainSetup {
+    /// The bars, left to right (striker first).
+    pub bars: Vec<crate::bar::BarSpec>,
+    /// The joints between consecutive bars.
+    pub joints: Vec<Joint>,
+    /// Initial velocity of the first bar, m/s.
+    pub striker_velocity_m_s: f64,
+    /// Time step, s.
+    pub dt_s: f64,
+    /// End of the run, s.
+    pub end_time_s: f64,
+    /// Gauges to record.
+    pub gauges: Vec<GaugeProbe>,
+    /// Record every n-th step.
+    pub record_every: usize,
+}
+
+/// What a pulse run yields: gauge strains and the energy ledger over time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainResult {
+    /// Recording times, s.
+    pub time_s: Vec<f64>,
+    /// Strain per gauge (positive in tension), in the order of the setup.
+    pub strain: Vec<Vec<f64>>,
+    /// Kinetic + strain energy in all bars at each recording time, J.
+    pub bar_energy_j: Vec<f64>,
+    /// Energy absorbed by non-reflecting ends so far, J.
+    pub absorbed_energy_j: Vec<f64>,
+    /// Work dissipated in the pulse shapers so far, J.
+    pub shaper_energy_j: Vec<f64>,
+    /// Initial kinetic energy of the striker, J.
+    pub striker_energy_j: f64,
+    /// Velocity of the striker's centre of mass at the end, m/s.
+    pub striker_final_velocity_m_s: f64,
+    /// Steps taken.
+    pub steps: usize,
+}
+
+fn gauge_strain(bar: &Bar, g: &GaugeProbe) -> f64 {
+    if g.length_m <= 0.0 {
+        return bar.strain_at(g.x_m);
+    }
+    const POINTS: usize = 8;
+    (0..POINTS)
+        .map(|k| bar.strain_at(g.x_m + g.length_m * ((k as f64 + 0.5) / POINTS as f64 - 0.5)))
+        .sum::<f64>()
+        / POINTS as f64
+}
+
+/// Runs a chain of bars (striker → shaper → incident → transmission …) and records its gauges.
+pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
+    let mut bars = setup
+        .bars
+        .iter()
+        .map(|s| Bar::new(s, setup.dt_s))
+        .collect::<Result<Vec<_>>>()?;
+    bars[0].set_initial_velocity(setup.striker_velocity_m_s);
+    let striker_energy_j = bars[0].kinetic_energy_j();
+    let mut joints: Vec<JointState> = setup.joints.iter().map(|&j| JointState::new(j)).collect();
+    let steps = (setup.end_time_s / setup.dt_s).ceil() as usize;
+    let cap = steps / setup.record_every + 2;
+    let mut out = ChainResult {
+        time_s: Vec::with_capacity(cap),
+        strain: vec![Vec::with_capacity(cap); setup.gauges.len()],
+        bar_energy_j: Vec::with_capacity(cap),
+        absorbed_energy_j: Vec::with_capacity(cap),
+        shaper_energy_j: Vec::with_capacity(cap),
+        striker_energy_j,
+        striker_final_velocity_m_s: 0.0,
+        steps,
+    };
+    let mut record = |bars: &[Bar], joints: &[JointState], t: f64| {
+        out.time_s.push(t);
+        for (k, g) in setup.gauges.iter().enumerate() {
+            out.strain[k].push(gauge_strain(&bars[g.bar], g));
+        }
+        out.bar_energy_j.push(
+            bars.iter()
+                .map(|b| b.kinetic_energy_j() + b.strain_energy_j())
+                .sum(),
+        );
+        out.absorbed_energy_j
+            .push(bars.iter().map(|b| b.absorbed_energy_j()).sum());
+        out.shaper_energy_j
+            .push(joints.iter().map(|j| j.dissipated_j()).sum());
+    };
+    record(&bars, &joints, 0.0);
+    for n in 1..=steps {
+        step_chain(&mut bars, &mut joints)?;
+        if n % setup.record_every == 0 {
+            record(&bars, &joints, n as f64 * setup.dt_s);
+        }
+    }
+    let s = &bars[0];
+    let m: f64 = (0..s.node_count()).map(|i| s.node_mass_kg(i)).sum();
+    out.striker_final_velocity_m_s = (0..s.node_count())
+        .map(|i| s.node_mass_kg(i) * s.velocity_m_s(i))
+        .sum::<f64>()
+        / m;
+    Ok(out)
+}
