@@ -151,7 +151,7 @@ fn run(
         eprintln!("shpb: warning: {w}");
     }
     let out = params.run()?;
-    print_summary(&params, &out);
+    print_summary(&params, &out)?;
     if let Some(p) = output {
         write_hdf5(p, force, &params.text, &out)?;
         eprintln!("wrote {}", p.display());
@@ -167,15 +167,27 @@ fn run(
     Ok(())
 }
 
-fn print_summary(params: &Params, out: &RunOutput) {
-    println!(
-        "scene: {} (kind {}, law {})",
+/// Prints the run summary; a closed pipe (`shpb run … | head`) is not an error.
+fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
+    let stdout = std::io::stdout();
+    let mut w = stdout.lock();
+    let mut text = format!(
+        "scene: {} (kind {}, law {})\n",
         params.source,
         params.kind,
         params.contact_law().name()
     );
     for it in &out.summary {
-        println!("  {:<40} {:>14.6e} {}", it.key, it.value, it.unit);
+        text.push_str(&format!(
+            "  {:<40} {:>14.6e} {}\n",
+            it.key, it.value, it.unit
+        ));
+    }
+    match w.write_all(text.as_bytes()).and_then(|_| w.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::io(Path::new("stdout"), e))
+        }
+        _ => Ok(()),
     }
 }
 
@@ -240,10 +252,18 @@ fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Res
     let s = crate::solver::loading_curve(law.as_ref(), to, points, rate);
     let stdout = std::io::stdout();
     let mut w = std::io::BufWriter::new(stdout.lock());
-    let werr = |e| Error::io(Path::new("stdout"), e);
-    writeln!(w, "displacement_m,force_N").map_err(werr)?;
-    for (d, f) in s.displacement_m.iter().zip(&s.force_n) {
-        writeln!(w, "{d:e},{f:e}").map_err(werr)?;
+    let written = (|| -> std::io::Result<()> {
+        writeln!(w, "displacement_m,force_N")?;
+        for (d, f) in s.displacement_m.iter().zip(&s.force_n) {
+            writeln!(w, "{d:e},{f:e}")?;
+        }
+        w.flush()
+    })();
+    match written {
+        // A closed pipe (`shpb curve | head`) is not an error.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::io(Path::new("stdout"), e))
+        }
+        _ => Ok(()),
     }
-    w.flush().map_err(werr)
 }
