@@ -80,7 +80,7 @@ impl BarGeometry {
 }
 
 /// A validated SHPB set-up.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Apparatus {
     /// The file it came from.
     pub source: String,

@@ -242,9 +242,41 @@ impl BarSpec {
                 format!("fewer than {MAX_NODES}"),
             ));
         }
+        Ok(self.grid_stability_limit_s(cells))
+    }
+
+    /// Stability limit of the grid with `cells` (validated spec and cell counts).
+    fn grid_stability_limit_s(&self, cells: &[usize]) -> f64 {
         let grid = Grid::build(self, cells);
         let (lo, hi) = free_range(self, grid.mass.len());
-        Ok(grid.stability_limit_s(lo, hi))
+        grid.stability_limit_s(lo, hi)
+    }
+
+    /// Largest Δt that [`Bar::new`] accepts (to ~1e-6), s: iterates Δt ← 2/√λ_max(grid(Δt)) down
+    /// from max_k L_k/c_k (the grid, hence its limit, changes with Δt); at least [`Self::courant_limit_s`].
+    pub fn max_time_step_s(&self) -> Result<f64> {
+        self.validate()?;
+        let floor = self.courant_limit_s();
+        let mut dt = self
+            .segments
+            .iter()
+            .map(|s| s.length_m / s.material.wave_speed_m_s())
+            .fold(0.0, f64::max);
+        for _ in 0..200 {
+            if dt <= floor {
+                break;
+            }
+            let cells = self.cells_for_time_step(dt);
+            if cells.iter().fold(0usize, |a, &c| a.saturating_add(c)) >= MAX_NODES {
+                break;
+            }
+            let limit = self.grid_stability_limit_s(&cells);
+            if dt <= limit * (1.0 + STABILITY_SLACK) {
+                return Ok(dt);
+            }
+            dt = limit * (1.0 - 1e-6);
+        }
+        Ok(floor)
     }
 }
 
@@ -557,7 +589,10 @@ impl Bar {
                         culprits.join("; ")
                     ),
                     format!(
-                        "at most {limit:e} s for this grid; every time step up to {:e} s (each segment at least one cell of Courant number ≤ 1) is stable",
+                        "at most {limit:e} s for this grid (a smaller step refines the long segments and lowers it); \
+                         the largest accepted step is {:e} s; every step up to {:e} s (each segment at least one cell \
+                         of Courant number ≤ 1) is stable",
+                        spec.max_time_step_s().unwrap_or_else(|_| spec.courant_limit_s()),
                         spec.courant_limit_s()
                     ),
                 ));

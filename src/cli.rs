@@ -3,7 +3,7 @@
 
 use crate::contact::LawKind;
 use crate::error::{Error, Result, Validator};
-use crate::io::{RunOutput, check_output, write_contact_csv, write_hdf5};
+use crate::io::{RunOutput, check_output, write_csv, write_hdf5};
 use crate::plot::{Axes, Curve, xy_plot};
 use crate::scene::{Params, SceneParams};
 use crate::specimen::resolve_pair;
@@ -157,7 +157,7 @@ fn run(
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = csv {
-        write_contact_csv(p, force, &out.contact)?;
+        write_csv(p, force, &out)?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = plot {
@@ -191,42 +191,71 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
     }
 }
 
-/// Draws the force–displacement curve of a run (with the measured curve for force-driven scenes).
+/// Draws a run: force against displacement for sphere scenes (with the measured curve for
+/// force-driven ones), gauge signals as bar stress against time for bar scenes.
 pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()> {
-    let mut curves = vec![Curve {
-        label: format!("shpb ({})", params.contact_law().name()),
-        x: &out.contact.displacement_m,
-        y: &out.contact.force_n,
-        measured: false,
-    }];
-    let shifted: Vec<f64>;
-    if let SceneParams::ForceDriven {
-        setup,
-        measured_displacement_m: Some(d),
-    } = &params.params
-    {
-        shifted = d.iter().map(|x| x - d[0]).collect();
-        curves.push(Curve {
-            label: "measured (authors' SHPB, offset δ(0) removed)".into(),
-            x: &shifted,
-            y: &setup.drive.force_n,
-            measured: true,
-        });
+    let name = Path::new(&params.source)
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let title = format!("{} — {}", params.kind, name);
+    if let Some(contact) = &out.contact {
+        let mut curves = vec![Curve {
+            label: format!("shpb ({})", params.contact_law().name()),
+            x: &contact.displacement_m,
+            y: &contact.force_n,
+            measured: false,
+        }];
+        let shifted: Vec<f64>;
+        if let SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m: Some(d),
+        } = &params.params
+        {
+            shifted = d.iter().map(|x| x - d[0]).collect();
+            curves.push(Curve {
+                label: "measured (authors' SHPB, offset δ(0) removed)".into(),
+                x: &shifted,
+                y: &setup.drive.force_n,
+                measured: true,
+            });
+        }
+        let axes = Axes {
+            title: &title,
+            x_label: "sphere approach δ (mm)",
+            y_label: "force F (kN)",
+            x_scale: 1e3,
+            y_scale: 1e-3,
+        };
+        return xy_plot(path, force, &axes, &curves);
     }
-    let title = format!(
-        "{} — {}",
-        params.kind,
-        Path::new(&params.source)
-            .file_name()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_default()
-    );
+    let e = match &params.params {
+        SceneParams::Pulse { apparatus, .. } => apparatus.material.youngs_modulus_pa,
+        _ => 1.0,
+    };
+    let t = out.time_s.as_deref().unwrap_or(&[]);
+    let stresses: Vec<Vec<f64>> = out
+        .gauges
+        .iter()
+        .map(|g| g.strain.iter().map(|s| -e * s).collect())
+        .collect();
+    let curves: Vec<Curve> = out
+        .gauges
+        .iter()
+        .zip(&stresses)
+        .map(|(g, s)| Curve {
+            label: format!("{} gauge", g.name),
+            x: t,
+            y: s,
+            measured: false,
+        })
+        .collect();
     let axes = Axes {
         title: &title,
-        x_label: "sphere approach δ (mm)",
-        y_label: "force F (kN)",
-        x_scale: 1e3,
-        y_scale: 1e-3,
+        x_label: "time after impact (µs)",
+        y_label: "bar stress at the gauge, compression positive (MPa)",
+        x_scale: 1e6,
+        y_scale: 1e-6,
     };
     xy_plot(path, force, &axes, &curves)
 }

@@ -212,10 +212,40 @@ pub fn item(key: &str, value: f64, unit: &'static str) -> SummaryItem {
 /// The output of one scene run, ready to be written.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutput {
-    /// The `/contact` time series.
-    pub contact: ContactSeries,
+    /// The `/contact` time series (absent for scenes without spheres).
+    pub contact: Option<ContactSeries>,
+    /// The `/time` axis of the gauge and energy series, s.
+    pub time_s: Option<Vec<f64>>,
+    /// `/gauges/<name>/{strain,voltage}`.
+    pub gauges: Vec<GaugeTrace>,
+    /// `/energy/<name>`, J, on the `/time` axis.
+    pub energy: Vec<(String, Vec<f64>)>,
     /// Scalar results (attributes of `/summary`).
     pub summary: Vec<SummaryItem>,
+}
+
+/// One recorded gauge channel: bar strain and the digitised voltage on the `/time` axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaugeTrace {
+    /// Channel name.
+    pub name: String,
+    /// Bar strain at the gauge (positive in tension), noise-free.
+    pub strain: Vec<f64>,
+    /// Recorded voltage: bridge, amplifier, noise and quantisation, V.
+    pub voltage_v: Vec<f64>,
+}
+
+impl RunOutput {
+    /// An output with only a contact series and a summary.
+    pub fn contact_only(contact: ContactSeries, summary: Vec<SummaryItem>) -> RunOutput {
+        RunOutput {
+            contact: Some(contact),
+            time_s: None,
+            gauges: Vec::new(),
+            energy: Vec::new(),
+            summary,
+        }
+    }
 }
 
 fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
@@ -278,9 +308,29 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
         let f = hdf5::File::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
         string_attr(&f, "scene", scene_text, path)?;
-        let g = f.create_group("contact").map_err(h5err(path))?;
-        for (name, data, units) in contact_columns(&out.contact) {
-            write_dataset(&g, name, data, units, path)?;
+        if let Some(contact) = &out.contact {
+            let g = f.create_group("contact").map_err(h5err(path))?;
+            for (name, data, units) in contact_columns(contact) {
+                write_dataset(&g, name, data, units, path)?;
+            }
+        }
+        if let Some(t) = &out.time_s {
+            let root = f.group("/").map_err(h5err(path))?;
+            write_dataset(&root, "time", t, "s", path)?;
+        }
+        if !out.gauges.is_empty() {
+            let g = f.create_group("gauges").map_err(h5err(path))?;
+            for tr in &out.gauges {
+                let c = g.create_group(&tr.name).map_err(h5err(path))?;
+                write_dataset(&c, "strain", &tr.strain, "1", path)?;
+                write_dataset(&c, "voltage", &tr.voltage_v, "V", path)?;
+            }
+        }
+        if !out.energy.is_empty() {
+            let g = f.create_group("energy").map_err(h5err(path))?;
+            for (name, data) in &out.energy {
+                write_dataset(&g, name, data, "J", path)?;
+            }
         }
         let s = f.create_group("summary").map_err(h5err(path))?;
         for it in &out.summary {
@@ -305,20 +355,30 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
     })
 }
 
-/// Writes the `/contact` series as CSV with a header line (units in the column names).
-pub fn write_contact_csv(path: &Path, force: bool, series: &ContactSeries) -> Result<()> {
-    let cols = contact_columns(series);
-    let mut text = String::new();
-    text.push_str(
-        &cols
-            .iter()
-            .map(|(n, _, u)| csv_name(n, u))
-            .collect::<Vec<_>>()
-            .join(","),
-    );
+/// Writes a run as CSV with one header line (units in the column names): the contact series,
+/// or for bar scenes the time axis with each gauge's strain and voltage.
+pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
+    let mut cols: Vec<(String, &[f64])> = Vec::new();
+    if let Some(c) = &out.contact {
+        for (n, d, u) in contact_columns(c) {
+            cols.push((csv_name(n, u), d));
+        }
+    } else if let Some(t) = &out.time_s {
+        cols.push(("time_s".into(), t));
+        for g in &out.gauges {
+            cols.push((format!("{}_strain", g.name), &g.strain));
+            cols.push((format!("{}_voltage_V", g.name), &g.voltage_v));
+        }
+    }
+    let rows = cols.iter().map(|(_, d)| d.len()).min().unwrap_or(0);
+    let mut text = cols
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect::<Vec<_>>()
+        .join(",");
     text.push('\n');
-    for i in 0..series.force_n.len() {
-        let row: Vec<String> = cols.iter().map(|(_, d, _)| format!("{:e}", d[i])).collect();
+    for i in 0..rows {
+        let row: Vec<String> = cols.iter().map(|(_, d)| format!("{:e}", d[i])).collect();
         text.push_str(&row.join(","));
         text.push('\n');
     }

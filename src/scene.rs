@@ -1,6 +1,8 @@
 //! Scene files: one TOML file per virtual test, with a `kind` key, parsed once into validated
 //! [`Params`] (physics code never sees unchecked input), and run into a [`RunOutput`].
 
+use crate::apparatus::{Apparatus, IncidentEnd, PulseOptions, ShaperOverride};
+use crate::bar::Dispersion;
 use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
 use crate::error::{Error, Result, Validator};
 use crate::io::{CsvTable, RunOutput, SummaryItem, item};
@@ -113,6 +115,40 @@ struct ForceDrivenFile {
     output_every: usize,
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PulseFile {
+    #[allow(dead_code)]
+    kind: String,
+    bars: String,
+    pressure: String,
+    #[serde(default)]
+    shaper: ShaperOverride,
+    #[serde(default = "default_cell_size")]
+    cell_size_m: f64,
+    #[serde(default = "default_incident_end")]
+    incident_end: String,
+    #[serde(default = "default_dispersion")]
+    dispersion: String,
+    end_time_s: Option<f64>,
+    #[serde(default = "default_gauge_length")]
+    gauge_length_m: f64,
+}
+
+fn default_gauge_length() -> f64 {
+    2e-3
+}
+
+fn default_cell_size() -> f64 {
+    1e-3
+}
+fn default_incident_end() -> String {
+    "transmission".into()
+}
+fn default_dispersion() -> String {
+    "none".into()
+}
+
 fn default_points() -> usize {
     1001
 }
@@ -158,6 +194,15 @@ pub enum SceneParams {
     },
     /// Free collision.
     Collision(CollisionSetup),
+    /// Striker, shaper and bars: the gauge signals of a bar test without specimen.
+    Pulse {
+        /// The bar set-up.
+        apparatus: Box<Apparatus>,
+        /// Gas-gun gauge pressure, Pa.
+        pressure_pa: f64,
+        /// Solver options (striker velocity from the gun).
+        options: PulseOptions,
+    },
     /// Fig. 4 force-driven DEM; `measured` holds the CSV's displacement column when present.
     ForceDriven {
         /// Solver inputs.
@@ -381,6 +426,84 @@ impl Params {
                     },
                 )
             }
+            "pulse" => {
+                let f: PulseFile = parse_as(text, file)?;
+                let set_up = base_dir.join(&f.bars);
+                if !set_up.is_file() {
+                    return Err(v.error("bars", format!("cannot read {}: no such file", set_up.display()), "a bar set-up .toml file (e.g. bars/authors.toml), relative to the scene file"));
+                }
+                let apparatus = Apparatus::from_file(&set_up)?;
+                let pressure_pa = crate::striker::pressure_from_text(&f.pressure, &v, "pressure")?;
+                let velocity = apparatus.striker_velocity_m_s(pressure_pa, &v, "pressure")?;
+                let shaper = f.shaper.apply(apparatus.shaper, &v.table("shaper"))?;
+                let end = match f.incident_end.as_str() {
+                    "transmission" => IncidentEnd::Transmission,
+                    "free" => IncidentEnd::Free,
+                    "absorbing" => IncidentEnd::Absorbing,
+                    other => {
+                        return Err(v.error(
+                            "incident_end",
+                            format!("unknown end `{other}`"),
+                            "transmission, free, absorbing",
+                        ));
+                    }
+                };
+                let dispersion = match f.dispersion.as_str() {
+                    "none" => Dispersion::None,
+                    "love-rod" => Dispersion::LoveRod,
+                    other => {
+                        return Err(v.error(
+                            "dispersion",
+                            format!("unknown model `{other}`"),
+                            "none, love-rod",
+                        ));
+                    }
+                };
+                let cell = v.in_range("cell_size_m", f.cell_size_m, 1e-5, 0.05, "m")?;
+                let c0 = apparatus.material.wave_speed_m_s();
+                let gauge_d = apparatus
+                    .gauges
+                    .channels
+                    .iter()
+                    .map(|c| c.distance_from_specimen_m)
+                    .fold(0.0, f64::max);
+                // Default: the incident pulse passes its gauge, reflects and passes it again.
+                let default_end = (apparatus.incident.length_m + gauge_d) / c0
+                    + 4.0 * apparatus.striker.length_m / c0
+                    + 200e-6;
+                let end_time_s = match f.end_time_s {
+                    Some(e) => v.positive("end_time_s", e, 0.1, "s")?,
+                    None => default_end,
+                };
+                let gauge_length_m =
+                    v.in_range("gauge_length_m", f.gauge_length_m, 0.0, 0.05, "m")?;
+                let options = PulseOptions {
+                    striker_velocity_m_s: velocity,
+                    shaper,
+                    end,
+                    cell_size_m: cell,
+                    dispersion,
+                    end_time_s,
+                    gauge_length_m,
+                };
+                // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
+                for spec in &apparatus.pulse_chain(&options).bars {
+                    crate::bar::Bar::new(spec, cell / c0)?;
+                }
+                let pair = SpherePair::paper(
+                    crate::material::Material::builtin("ss440c").expect("built-in"),
+                );
+                (
+                    pair,
+                    LawKind::default(),
+                    Region2Form::default(),
+                    SceneParams::Pulse {
+                        apparatus: Box::new(apparatus),
+                        pressure_pa,
+                        options,
+                    },
+                )
+            }
             other => return Err(v.error("kind", format!("unknown scene kind `{other}`"), kinds)),
         };
         Ok(Params {
@@ -431,10 +554,7 @@ impl Params {
                 let s =
                     solver::loading_curve(law, *max_displacement_m, *points, *strain_rate_per_s);
                 let summary = vec![item("max_force", *s.force_n.last().unwrap_or(&0.0), "N")];
-                Ok(RunOutput {
-                    contact: s,
-                    summary,
-                })
+                Ok(RunOutput::contact_only(s, summary))
             }
             SceneParams::ConstantRate {
                 strain_rate_per_s,
@@ -457,10 +577,7 @@ impl Params {
                         "m/s",
                     ),
                 ];
-                Ok(RunOutput {
-                    contact: s,
-                    summary,
-                })
+                Ok(RunOutput::contact_only(s, summary))
             }
             SceneParams::Collision(setup) => {
                 let r = solver::collision(law, &self.pair, setup)?;
@@ -483,11 +600,13 @@ impl Params {
                     item("energy_dissipated", r.dissipated_j, "J"),
                     item("time_step", setup.dt_s, "s"),
                 ];
-                Ok(RunOutput {
-                    contact: r.series,
-                    summary,
-                })
+                Ok(RunOutput::contact_only(r.series, summary))
             }
+            SceneParams::Pulse {
+                apparatus,
+                pressure_pa,
+                options,
+            } => run_pulse(apparatus, *pressure_pa, options),
             SceneParams::ForceDriven {
                 setup,
                 measured_displacement_m,
@@ -503,10 +622,7 @@ impl Params {
                 summary.push(item("external_work", r.energy.external_work_j, "J"));
                 summary.push(item("contact_work", r.energy.contact_work_j, "J"));
                 summary.push(item("kinetic_energy_end", r.kinetic_energy_j, "J"));
-                Ok(RunOutput {
-                    contact: r.series,
-                    summary,
-                })
+                Ok(RunOutput::contact_only(r.series, summary))
             }
         }
     }
@@ -593,4 +709,104 @@ fn force_driven_summary(
         ));
     }
     out
+}
+
+/// Runs a `pulse` scene: simulates the chain, digitises every gauge, and summarises each pulse.
+fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) -> Result<RunOutput> {
+    let chain = apparatus.pulse_chain(options);
+    let r = crate::solver::pulse::simulate_chain(&chain)?;
+    let e = apparatus.material.youngs_modulus_pa;
+    let mut summary = vec![
+        item("pressure", pressure_pa, "Pa"),
+        item("striker_velocity", options.striker_velocity_m_s, "m/s"),
+        item("striker_energy", r.striker_energy_j, "J"),
+        item(
+            "striker_final_velocity",
+            r.striker_final_velocity_m_s,
+            "m/s",
+        ),
+        item("time_step", chain.dt_s, "s"),
+    ];
+    let mut gauges = Vec::new();
+    let mut time = None;
+    for (k, probe) in chain.gauges.iter().enumerate() {
+        let ch = apparatus
+            .gauges
+            .channel(&probe.name)
+            .expect("probes come from the gauge set-up");
+        let n = (options.end_time_s * ch.digitiser.sample_rate_hz).floor() as usize;
+        let (t, v) = ch.record(&r.time_s, &r.strain[k], 0.0, n);
+        let strain = resample(&r.time_s, &r.strain[k], &t);
+        if let Some(m) = crate::gauge::pulse_metrics(&t, &strain, true) {
+            summary.push(item(
+                &format!("{}_peak_stress", probe.name),
+                -e * m.peak,
+                "Pa",
+            ));
+            summary.push(item(
+                &format!("{}_rise_10_90", probe.name),
+                m.rise_10_90_s,
+                "s",
+            ));
+            summary.push(item(
+                &format!("{}_duration_10", probe.name),
+                m.duration_10_s,
+                "s",
+            ));
+            summary.push(item(&format!("{}_start_10", probe.name), m.start_10_s, "s"));
+        }
+        gauges.push(crate::io::GaugeTrace {
+            name: probe.name.clone(),
+            strain,
+            voltage_v: v,
+        });
+        time = Some(t);
+    }
+    let t = time.unwrap_or_else(|| r.time_s.clone());
+    let striker = vec![r.striker_energy_j; t.len()];
+    let bars = resample(&r.time_s, &r.bar_energy_j, &t);
+    let absorbed = resample(&r.time_s, &r.absorbed_energy_j, &t);
+    let shaper = resample(&r.time_s, &r.shaper_energy_j, &t);
+    let total: Vec<f64> = (0..t.len())
+        .map(|i| bars[i] + absorbed[i] + shaper[i])
+        .collect();
+    let worst = total
+        .iter()
+        .map(|x| (x - r.striker_energy_j).abs())
+        .fold(0.0, f64::max)
+        / r.striker_energy_j;
+    summary.push(item("energy_balance_max_relative_error", worst, "1"));
+    Ok(RunOutput {
+        contact: None,
+        time_s: Some(t),
+        gauges,
+        energy: vec![
+            ("striker".into(), striker),
+            ("bars".into(), bars),
+            ("absorbed".into(), absorbed),
+            ("shaper".into(), shaper),
+            ("total".into(), total),
+        ],
+        summary,
+    })
+}
+
+/// Linear interpolation of (t, y) at the times `at` (end values held outside).
+pub fn resample(t: &[f64], y: &[f64], at: &[f64]) -> Vec<f64> {
+    let mut j = 0usize;
+    at.iter()
+        .map(|&x| {
+            if x <= t[0] {
+                return y[0];
+            }
+            if x >= t[t.len() - 1] {
+                return y[y.len() - 1];
+            }
+            while t[j + 1] <= x {
+                j += 1;
+            }
+            let w = (x - t[j]) / (t[j + 1] - t[j]);
+            y[j] + w * (y[j + 1] - y[j])
+        })
+        .collect()
 }

