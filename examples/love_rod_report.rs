@@ -150,19 +150,24 @@ fn main() -> shpb::Result<()> {
         "The simulated Love rod reproduces the Rayleigh–Love relation to {worst_sim_vs_rl:.1e} in c/c0 or \
          better at every a/Λ (the scheme's own dispersion at Courant 1 is fourth order in kΔx; see the \
          convergence table), so column (i) is the Love theory itself. Against Bancroft's exact first mode, \
-         the Love rod is good to {:.2} % in c/c0 up to a/Λ = 0.15, which is about the fit's own accuracy (it \
-         gives {:.5} instead of 1 at a/Λ = 0). Above that, the Love rod **underestimates dispersion** \
-         (its phase velocity is too high): by {:.1} % of c0 at a/Λ = 0.2, {:.1} % at 0.3 and {:.1} % at 0.5, \
-         because lateral inertia alone cannot give the first mode's approach to the Rayleigh-wave speed. \
-         For this 19.05 mm bar, a/Λ = 0.15 corresponds to Λ = {:.0} mm, i.e. {:.0} kHz: the 20–60 µs rises \
-         of the SHPB pulses (physics.md §6) sit mostly below it, where the Love rod is adequate, but their \
-         sharpest features exceed it, so the data reduction should use the Bancroft correction (physics.md §7).\n",
+         the Love rod is good to {:.2} % in c/c0 up to a/Λ = 0.15, comparable with the fit's own offset \
+         (it gives {:.5} instead of 1 at a/Λ = 0). Above that, the Love rod **underestimates dispersion** \
+         (its phase velocity is too high): by {:.1} % of c0 at a/Λ = 0.2, {:.1} % at 0.3 and {:.1} % at 0.5. \
+         Its lateral-inertia term reproduces the exact (Pochhammer–Chree) first mode only to first order, \
+         c/c0 ≈ 1 − ν²(ka)²/4; beyond that the shear of the cross-section, which the Love rod omits, slows \
+         the real mode further (toward the Rayleigh-wave speed, the fit's A ≈ 0.57 c0). For this 19.05 mm \
+         bar a/Λ = 0.15 is Λ = {:.0} mm, i.e. {:.0} kHz: the bulk of the 20–60 µs SHPB rises (physics.md §6) \
+         lies below it, where the Love rod is adequate, but components above it (sharp corners, the onset \
+         of a shaper's force) travel measurably slower than Love predicts, so the data reduction should \
+         use the Bancroft correction (physics.md §7), and a simulated Love-rod record is reliable only in \
+         its content below ~{:.0} kHz.\n",
         100.0 * small,
         bancroft(0.0),
         100.0 * at(0.2),
         100.0 * at(0.3),
         100.0 * at(0.5),
         a / 0.15 * 1e3,
+        c0 * rayleigh_love_velocity_ratio(nu, 0.15) / (a / 0.15) / 1e3,
         c0 * rayleigh_love_velocity_ratio(nu, 0.15) / (a / 0.15) / 1e3
     );
 
@@ -192,7 +197,8 @@ fn main() -> shpb::Result<()> {
     let _ = writeln!(
         w,
         "\nIn parentheses: relative error against Rayleigh–Love. Halving the cell size divides it by ≈ 16 \
-         until the measurement floor (~1e-8) is reached.\n"
+         until the measurement's own floor (about 1e-6 at large a/Λ) \
+         is reached.\n"
     );
     let _ = writeln!(w, "## Scheme notes\n");
     let _ = writeln!(

@@ -96,6 +96,32 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "burgoyne-daraio")]
         law: LawArg,
     },
+    /// Print the striker velocity the gas gun gives at a pressure (units psi, kPa, Pa, MPa, bar).
+    Gun {
+        /// Gauge pressure with unit, e.g. 10psi or 68.9kPa.
+        #[arg(long, allow_hyphen_values = true)]
+        pressure: String,
+        /// Bar set-up file with the gun's parameters.
+        #[arg(long, default_value = "bars/authors.toml")]
+        bars: PathBuf,
+    },
+    /// Convert a raw gauge record (the authors' CSV: time_s, incident_V, transmission_V) to bar strain.
+    Strain {
+        /// The record.
+        record: PathBuf,
+        /// Bar set-up file whose gauge channels (bridge, gain, polarity) read the record.
+        #[arg(long, default_value = "bars/authors.toml")]
+        bars: PathBuf,
+        /// HDF5 output (/time, /gauges/<name>/{strain,voltage}).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// CSV output.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
 }
 
 /// Parses the command line, runs it, prints errors; returns the process exit code.
@@ -133,7 +159,124 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             points,
             law,
         } => curve(&specimen, rate, to, points, law.into()),
+        Command::Gun { pressure, bars } => gun(&pressure, &bars),
+        Command::Strain {
+            record,
+            bars,
+            output,
+            csv,
+            force,
+        } => strain(&record, &bars, output.as_deref(), csv.as_deref(), force),
     }
+}
+
+/// Prints a line on stdout; a closed pipe (`shpb … | head`) is not an error.
+fn say(line: &str) -> Result<()> {
+    let stdout = std::io::stdout();
+    let mut w = stdout.lock();
+    match writeln!(w, "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::io(Path::new("stdout"), e))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Reads a bar set-up file named on the command line.
+fn load_apparatus(bars: &Path) -> Result<crate::apparatus::Apparatus> {
+    if !bars.is_file() {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "--bars".into(),
+            problem: format!("cannot read {}: no such file", bars.display()),
+            allowed: "a bar set-up .toml file such as bars/authors.toml".into(),
+        });
+    }
+    crate::apparatus::Apparatus::from_file(bars)
+}
+
+fn gun(pressure: &str, bars: &Path) -> Result<()> {
+    let apparatus = load_apparatus(bars)?;
+    let p = crate::striker::cli_pressure(pressure)?;
+    let v = apparatus.striker_velocity_m_s(p, &Validator::new("command line"), "--pressure")?;
+    let e = 0.5 * apparatus.striker_mass_kg() * v * v;
+    let z = apparatus.material.density_kg_m3 * apparatus.material.wave_speed_m_s();
+    say(&format!(
+        "pressure            {:.4} psi = {:.1} kPa (gauge)",
+        p / crate::striker::PSI_PA,
+        p / 1e3
+    ))?;
+    say(&format!("striker velocity    {v:.4} m/s"))?;
+    say(&format!(
+        "striker energy      {e:.4} J (mass {:.4} kg)",
+        apparatus.striker_mass_kg()
+    ))?;
+    say(&format!(
+        "elastic bar stress  {:.2} MPa (ρ c0 v / 2, without shaper)",
+        0.5 * z * v / 1e6
+    ))?;
+    Ok(())
+}
+
+fn strain(
+    record: &Path,
+    bars: &Path,
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    for p in [output, csv].into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    let apparatus = load_apparatus(bars)?;
+    let rec = crate::gauge::RawRecord::read(record)?;
+    let mut gauges = Vec::new();
+    for (name, volts) in [
+        ("incident", &rec.incident_v),
+        ("transmission", &rec.transmission_v),
+    ] {
+        let ch = apparatus.gauges.channel(name).ok_or_else(|| Error::Input {
+            file: apparatus.source.clone(),
+            key: "gauges".into(),
+            problem: format!("no `{name}` channel in the gauge set-up"),
+            allowed: "channels named incident and transmission".into(),
+        })?;
+        gauges.push(crate::io::GaugeTrace {
+            name: name.to_string(),
+            strain: ch.strains_from_voltages(volts),
+            voltage_v: volts.clone(),
+        });
+    }
+    let out = RunOutput {
+        contact: None,
+        time_s: Some(rec.time_s.clone()),
+        gauges,
+        energy: Vec::new(),
+        summary: Vec::new(),
+    };
+    let text = format!(
+        "record = \"{}\"\nbars = \"{}\"\n",
+        record.display(),
+        bars.display()
+    );
+    if let Some(p) = output {
+        write_hdf5(p, force, &text, &out)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = csv {
+        write_csv(p, force, &out)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if output.is_none() && csv.is_none() {
+        let peak = |s: &[f64]| s.iter().cloned().fold(0.0, f64::min);
+        say(&format!(
+            "{} samples; most compressive strain: incident {:.4e}, transmission {:.4e}",
+            rec.time_s.len(),
+            peak(&out.gauges[0].strain),
+            peak(&out.gauges[1].strain)
+        ))?;
+    }
+    Ok(())
 }
 
 fn run(
@@ -171,12 +314,16 @@ fn run(
 fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
     let stdout = std::io::stdout();
     let mut w = stdout.lock();
-    let mut text = format!(
-        "scene: {} (kind {}, law {})\n",
-        params.source,
-        params.kind,
-        params.contact_law().name()
-    );
+    let mut text = if matches!(params.params, SceneParams::Pulse { .. }) {
+        format!("scene: {} (kind {})\n", params.source, params.kind)
+    } else {
+        format!(
+            "scene: {} (kind {}, law {})\n",
+            params.source,
+            params.kind,
+            params.contact_law().name()
+        )
+    };
     for it in &out.summary {
         text.push_str(&format!(
             "  {:<40} {:>14.6e} {}\n",

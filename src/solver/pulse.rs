@@ -6,8 +6,11 @@
 //! * a **butt joint** (striker on bar without shaper, bar pressed on bar) carries compression
 //!   only: while closed, the two half-mass end nodes move as one full node, exactly as a
 //!   continuous bar would; it opens when holding it would need tension;
-//! * a **pulse shaper** is a massless nonlinear spring F(closure): its force is solved from
-//!   F = F_shaper(closure_{n+1}(F)) by bisection (F_shaper does not fall with closure).
+//! * a **pulse shaper** is a massless nonlinear spring F(closure): its force at level n is
+//!   evaluated at the Newmark average closure (c^{n+1}(F) + 2c^n + c^{n−1})/4 (the β = 1/4
+//!   "average acceleration" rule: unconditionally stable and, for an elastic spring, energy
+//!   conserving) and solved by bisection (F_shaper does not fall with closure). The work it takes
+//!   from the bars is F^n (c^{n+1} − c^{n−1})/2, the same discrete work the bars' ledgers count.
 
 use crate::bar::Bar;
 use crate::error::Result;
@@ -31,6 +34,8 @@ pub struct JointState {
     pub shaper: ShaperState,
     /// Compressive force carried in the last step, N.
     pub force_n: f64,
+    /// Work the joint has taken from the bars, J (plastic dissipation plus elastic energy held).
+    pub work_j: f64,
 }
 
 impl JointState {
@@ -40,15 +45,13 @@ impl JointState {
             joint,
             shaper: ShaperState::default(),
             force_n: 0.0,
+            work_j: 0.0,
         }
     }
 
     /// Plastic work dissipated in the shaper so far, J.
     pub fn dissipated_j(&self) -> f64 {
-        match self.joint {
-            Joint::Butt => 0.0,
-            Joint::Shaper(_) => self.shaper.work_j,
-        }
+        self.work_j
     }
 }
 
@@ -58,6 +61,8 @@ impl JointState {
 pub struct JointPrediction {
     /// Closure: displacement of the left bar's end minus that of the right bar's end (> 0 compresses), m.
     pub closure_m: f64,
+    /// Closure at the previous level c^{n−1}, m.
+    pub previous_closure_m: f64,
     /// Closure rate at the half step if the joint carried no force, m/s.
     pub free_rate_m_s: f64,
     /// Drop of the closure rate per newton of joint force (Δt/m_left + Δt/m_right for lumped ends), m/(s·N).
@@ -73,7 +78,10 @@ pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64
             ((p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)).max(0.0)
         }
         Joint::Shaper(s) => {
-            let next = |f: f64| p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
+            let next = |f: f64| {
+                let c_next = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
+                0.25 * (c_next + 2.0 * p.closure_m + p.previous_closure_m)
+            };
             let mut trial = state.shaper;
             let f_hi = s.force_n(&mut trial, next(0.0));
             if f_hi <= 0.0 {
@@ -96,10 +104,14 @@ pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64
             }
         }
     };
+    let c_next = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
     if let Joint::Shaper(s) = state.joint {
-        let closure = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
-        s.force_n(&mut state.shaper, closure);
+        s.force_n(
+            &mut state.shaper,
+            0.25 * (c_next + 2.0 * p.closure_m + p.previous_closure_m),
+        );
     }
+    state.work_j += f * 0.5 * (c_next - p.previous_closure_m);
     state.force_n = f;
     f
 }
@@ -107,9 +119,12 @@ pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64
 /// Predicts a joint between the right end of `left` and the left end of `right` (exact for
 /// lumped and Love-rod bars: uses the bars' own free end velocities and end mobilities).
 pub fn predict_joint(left: &Bar, right: &Bar) -> JointPrediction {
-    let closure = left.displacement_m(left.node_count() - 1) - right.displacement_m(0);
+    let il = left.node_count() - 1;
+    let closure = left.displacement_m(il) - right.displacement_m(0);
+    let last_rate = left.half_step_velocity_m_s(il) - right.half_step_velocity_m_s(0);
     JointPrediction {
         closure_m: closure,
+        previous_closure_m: closure - left.dt_s() * last_rate,
         free_rate_m_s: left.free_end_velocity_m_s(true) - right.free_end_velocity_m_s(false),
         compliance: left.end_mobility_s_per_kg(true, true)
             + right.end_mobility_s_per_kg(false, false),
