@@ -361,11 +361,26 @@ pub enum IncidentEnd {
     Free,
     /// A non-reflecting end.
     Absorbing,
+    /// The two-sphere specimen, then the transmission bar (a full SHPB test).
+    Specimen,
 }
 
-/// Options of a pulse run (what a `pulse` scene sets).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The specimen of a full test: the sphere pair and its contact law.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpecimenSetup {
+    /// The spheres (sphere 1 on the incident bar).
+    pub pair: crate::specimen::SpherePair,
+    /// Contact law.
+    pub law: crate::contact::LawKind,
+    /// Form of region II of the loading law.
+    pub region2: crate::contact::Region2Form,
+}
+
+/// Options of a bar run (what a `pulse` or `shpb` scene sets).
+#[derive(Debug, Clone, PartialEq)]
 pub struct PulseOptions {
+    /// The specimen, when `end` is `IncidentEnd::Specimen`.
+    pub specimen: Option<SpecimenSetup>,
     /// Striker impact velocity, m/s.
     pub striker_velocity_m_s: f64,
     /// Pulse shaper (None: striker on bar).
@@ -390,9 +405,10 @@ impl Apparatus {
         let dt = o.cell_size_m / c0;
         let (shaper, end, dispersion) = (o.shaper, o.end, o.dispersion);
         let incident_right = match end {
-            IncidentEnd::Transmission | IncidentEnd::Free => EndCondition::Free,
             IncidentEnd::Absorbing => EndCondition::Absorbing,
+            _ => EndCondition::Free,
         };
+        let with_transmission = matches!(end, IncidentEnd::Transmission | IncidentEnd::Specimen);
         let mut bars = vec![
             self.bar_spec(
                 "striker",
@@ -413,7 +429,8 @@ impl Apparatus {
             Some(s) => Joint::Shaper(s),
             None => Joint::Butt,
         }];
-        if end == IncidentEnd::Transmission {
+        let mut end_masses = Vec::new();
+        if with_transmission {
             let far = if self.transmission_absorbing {
                 EndCondition::Absorbing
             } else {
@@ -426,15 +443,25 @@ impl Apparatus {
                 far,
                 dispersion,
             ));
-            joints.push(Joint::Butt);
+            match &o.specimen {
+                Some(sp) if end == IncidentEnd::Specimen => {
+                    joints.push(Joint::Spheres {
+                        props: sp.pair.contact_properties(),
+                        law: sp.law,
+                        region2: sp.region2,
+                    });
+                    // Each sphere's mass joins its bar's end node (the paper's DEM).
+                    end_masses.push((1, true, sp.pair.sphere1.mass_kg));
+                    end_masses.push((2, false, sp.pair.sphere2.mass_kg));
+                }
+                _ => joints.push(Joint::Butt),
+            }
         }
         let mut gauges = Vec::new();
         for ch in &self.gauges.channels {
             let (bar, x) = match ch.bar.as_str() {
                 "incident" => (1, self.incident.length_m - ch.distance_from_specimen_m),
-                "transmission" if end == IncidentEnd::Transmission => {
-                    (2, ch.distance_from_specimen_m)
-                }
+                "transmission" if with_transmission => (2, ch.distance_from_specimen_m),
                 _ => continue,
             };
             gauges.push(GaugeProbe {
@@ -453,6 +480,7 @@ impl Apparatus {
             end_time_s: o.end_time_s,
             gauges,
             record_every,
+            end_masses,
         }
     }
 }

@@ -16,6 +16,7 @@ pub mod gauge;
 pub mod io;
 pub mod material;
 pub mod plot;
+pub mod reduce;
 pub mod scene;
 pub mod shaper;
 pub mod solver;

@@ -120,6 +120,11 @@ struct ForceDrivenFile {
 struct PulseFile {
     #[allow(dead_code)]
     kind: String,
+    specimen: Option<SpecimenSpec>,
+    #[serde(default)]
+    law: LawKind,
+    #[serde(default)]
+    region2: Region2Form,
     bars: String,
     pressure: String,
     #[serde(default)]
@@ -426,8 +431,31 @@ impl Params {
                     },
                 )
             }
-            "pulse" => {
+            "pulse" | "shpb" => {
                 let f: PulseFile = parse_as(text, file)?;
+                let is_test = kind == "shpb";
+                let specimen = match (&f.specimen, is_test) {
+                    (Some(spec), true) => Some(crate::apparatus::SpecimenSetup {
+                        pair: spec.build(base_dir, &sv)?,
+                        law: f.law,
+                        region2: f.region2,
+                    }),
+                    (None, true) => {
+                        return Err(v.error(
+                            "specimen",
+                            "missing",
+                            "a [specimen] table (pair = \"ss440c\", or sphere1/sphere2)",
+                        ));
+                    }
+                    (Some(_), false) => {
+                        return Err(v.error(
+                            "specimen",
+                            "a pulse scene has no specimen",
+                            "kind = \"shpb\" for a test with spheres",
+                        ));
+                    }
+                    (None, false) => None,
+                };
                 let set_up = base_dir.join(&f.bars);
                 if !set_up.is_file() {
                     return Err(v.error("bars", format!("cannot read {}: no such file", set_up.display()), "a bar set-up .toml file (e.g. bars/authors.toml), relative to the scene file"));
@@ -437,6 +465,7 @@ impl Params {
                 let velocity = apparatus.striker_velocity_m_s(pressure_pa, &v, "pressure")?;
                 let shaper = f.shaper.apply(apparatus.shaper, &v.table("shaper"))?;
                 let end = match f.incident_end.as_str() {
+                    _ if is_test => IncidentEnd::Specimen,
                     "transmission" => IncidentEnd::Transmission,
                     "free" => IncidentEnd::Free,
                     "absorbing" => IncidentEnd::Absorbing,
@@ -478,6 +507,7 @@ impl Params {
                 let gauge_length_m =
                     v.in_range("gauge_length_m", f.gauge_length_m, 0.0, 0.05, "m")?;
                 let options = PulseOptions {
+                    specimen: specimen.clone(),
                     striker_velocity_m_s: velocity,
                     shaper,
                     end,
@@ -767,26 +797,55 @@ fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) ->
     let bars = resample(&r.time_s, &r.bar_energy_j, &t);
     let absorbed = resample(&r.time_s, &r.absorbed_energy_j, &t);
     let shaper = resample(&r.time_s, &r.shaper_energy_j, &t);
+    let contact_work = resample(&r.time_s, &r.contact_energy_j, &t);
     let total: Vec<f64> = (0..t.len())
-        .map(|i| bars[i] + absorbed[i] + shaper[i])
+        .map(|i| bars[i] + absorbed[i] + shaper[i] + contact_work[i])
         .collect();
+    if let Some(c) = &r.contact {
+        let k = c.peak_index();
+        summary.push(item("peak_contact_force", c.force_n[k], "N"));
+        summary.push(item(
+            "displacement_at_peak_contact_force",
+            c.displacement_m[k],
+            "m",
+        ));
+        summary.push(item(
+            "time_of_peak_contact_force",
+            c.time_s.as_ref().map(|t| t[k]).unwrap_or(0.0),
+            "s",
+        ));
+        summary.push(item(
+            "max_displacement",
+            c.displacement_m.iter().cloned().fold(0.0, f64::max),
+            "m",
+        ));
+        summary.push(item(
+            "contact_work_end",
+            *r.contact_energy_j.last().unwrap_or(&0.0),
+            "J",
+        ));
+    }
     let worst = total
         .iter()
         .map(|x| (x - r.striker_energy_j).abs())
         .fold(0.0, f64::max)
         / r.striker_energy_j;
     summary.push(item("energy_balance_max_relative_error", worst, "1"));
+    let mut energy = vec![
+        ("striker".into(), striker),
+        ("bars".into(), bars),
+        ("absorbed".into(), absorbed),
+        ("shaper".into(), shaper),
+    ];
+    if r.contact.is_some() {
+        energy.push(("contact".into(), contact_work));
+    }
+    energy.push(("total".into(), total));
     Ok(RunOutput {
-        contact: None,
+        contact: r.contact,
         time_s: Some(t),
         gauges,
-        energy: vec![
-            ("striker".into(), striker),
-            ("bars".into(), bars),
-            ("absorbed".into(), absorbed),
-            ("shaper".into(), shaper),
-            ("total".into(), total),
-        ],
+        energy,
         summary,
     })
 }

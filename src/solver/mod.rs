@@ -294,7 +294,7 @@ impl ContactSeries {
     }
 
     /// Appends one sample.
-    fn push(&mut self, t: f64, delta: f64, eval: &ContactEval) {
+    pub fn push(&mut self, t: f64, delta: f64, eval: &ContactEval) {
         if let Some(v) = self.time_s.as_mut() {
             v.push(t);
         }

@@ -13,8 +13,10 @@
 //!   from the bars is F^n (c^{n+1} − c^{n−1})/2, the same discrete work the bars' ledgers count.
 
 use crate::bar::Bar;
+use crate::contact::{ContactEval, ContactHistory, ContactLaw, LawKind, Region2Form};
 use crate::error::Result;
 use crate::shaper::{PulseShaper, ShaperState};
+use crate::specimen::ContactProperties;
 
 /// How two bar ends touch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,27 +25,64 @@ pub enum Joint {
     Butt,
     /// A copper pulse shaper between the ends.
     Shaper(PulseShaper),
+    /// The two-sphere specimen: each sphere's mass sits on its bar's end node (added by the
+    /// caller) and the spheres touch through a contact law (paper Eq. 1–3).
+    Spheres {
+        /// Effective contact properties of the pair.
+        props: ContactProperties,
+        /// The contact law.
+        law: LawKind,
+        /// Form of region II.
+        region2: Region2Form,
+    },
 }
 
 /// State of a joint between the right end of one bar and the left end of the next.
-#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointState {
     /// The joint's law.
     pub joint: Joint,
-    /// Shaper memory (unused for butt joints).
+    /// Shaper memory (unused for other joints).
     pub shaper: ShaperState,
+    /// The contact law of a `Spheres` joint.
+    pub law: Option<Box<dyn ContactLaw>>,
+    /// Contact memory of a `Spheres` joint.
+    pub history: ContactHistory,
+    /// Last contact evaluation of a `Spheres` joint.
+    pub contact: ContactEval,
+    /// Sphere approach δ at which the last force was evaluated, m.
+    pub approach_m: f64,
     /// Compressive force carried in the last step, N.
     pub force_n: f64,
-    /// Work the joint has taken from the bars, J (plastic dissipation plus elastic energy held).
+    /// Work the joint has taken from the bars, J (dissipation plus elastic energy held).
     pub work_j: f64,
 }
 
 impl JointState {
     /// A joint with no history.
     pub fn new(joint: Joint) -> JointState {
+        let law = match joint {
+            Joint::Spheres {
+                props,
+                law,
+                region2,
+            } => Some(law.build_with(props, region2)),
+            _ => None,
+        };
+        let contact = match &law {
+            Some(l) => l.evaluate(&mut ContactHistory::default(), 0.0, 0.0),
+            None => ContactEval {
+                force_n: 0.0,
+                yield_stress_pa: 0.0,
+                strain_rate_per_s: 0.0,
+            },
+        };
         JointState {
             joint,
             shaper: ShaperState::default(),
+            law,
+            history: ContactHistory::default(),
+            contact,
+            approach_m: 0.0,
             force_n: 0.0,
             work_j: 0.0,
         }
@@ -69,8 +108,34 @@ pub struct JointPrediction {
     pub compliance: f64,
 }
 
+/// Root of F = law(F) for a law that does not grow with F (more force, less closure), in
+/// [0, law(0)], by bisection to 1e-12 relative.
+fn solve_force(law: impl Fn(f64) -> f64) -> f64 {
+    let f_hi = law(0.0);
+    if f_hi <= 0.0 {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, f_hi);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if law(mid) > mid {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-12 * hi {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// Solves the joint force for one step (≥ 0, compressive), updating the joint's memory.
 pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64 {
+    let c_next = |f: f64| p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
+    // Newmark-average closure and centred closure rate at level n for a force f.
+    let c_avg = |f: f64| 0.25 * (c_next(f) + 2.0 * p.closure_m + p.previous_closure_m);
+    let rate = |f: f64| (c_next(f) - p.previous_closure_m) / (2.0 * dt_s);
     let f = match state.joint {
         Joint::Butt => {
             // Closed joint: force that makes both ends move together (closure rate 0), if compressive.
@@ -78,40 +143,27 @@ pub fn solve_joint(state: &mut JointState, p: JointPrediction, dt_s: f64) -> f64
             ((p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)).max(0.0)
         }
         Joint::Shaper(s) => {
-            let next = |f: f64| {
-                let c_next = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
-                0.25 * (c_next + 2.0 * p.closure_m + p.previous_closure_m)
-            };
-            let mut trial = state.shaper;
-            let f_hi = s.force_n(&mut trial, next(0.0));
-            if f_hi <= 0.0 {
-                0.0
-            } else {
-                let (mut lo, mut hi) = (0.0, f_hi);
-                for _ in 0..80 {
-                    let mid = 0.5 * (lo + hi);
-                    let mut t = state.shaper;
-                    if s.force_n(&mut t, next(mid)) > mid {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                    if hi - lo <= 1e-12 * hi {
-                        break;
-                    }
-                }
-                0.5 * (lo + hi)
-            }
+            let shaper = state.shaper;
+            solve_force(|f| s.force_n(&mut shaper.clone(), c_avg(f)))
+        }
+        Joint::Spheres { .. } => {
+            let law = state.law.as_ref().expect("sphere joints carry their law");
+            let h = state.history;
+            solve_force(|f| law.evaluate(&mut h.clone(), c_avg(f), rate(f)).force_n)
         }
     };
-    let c_next = p.closure_m + dt_s * (p.free_rate_m_s - p.compliance * f);
-    if let Joint::Shaper(s) = state.joint {
-        s.force_n(
-            &mut state.shaper,
-            0.25 * (c_next + 2.0 * p.closure_m + p.previous_closure_m),
-        );
+    match state.joint {
+        Joint::Shaper(s) => {
+            s.force_n(&mut state.shaper, c_avg(f));
+        }
+        Joint::Spheres { .. } => {
+            let law = state.law.as_ref().expect("sphere joints carry their law");
+            state.approach_m = c_avg(f);
+            state.contact = law.evaluate(&mut state.history, state.approach_m, rate(f));
+        }
+        Joint::Butt => {}
     }
-    state.work_j += f * 0.5 * (c_next - p.previous_closure_m);
+    state.work_j += f * 0.5 * (c_next(f) - p.previous_closure_m);
     state.force_n = f;
     f
 }
@@ -180,6 +232,8 @@ pub struct ChainSetup {
     pub gauges: Vec<GaugeProbe>,
     /// Record every n-th step.
     pub record_every: usize,
+    /// Lumped masses added to bar ends before the run: (bar index, right end?, kg) — the spheres.
+    pub end_masses: Vec<(usize, bool, f64)>,
 }
 
 /// What a pulse run yields: gauge strains and the energy ledger over time.
@@ -193,8 +247,12 @@ pub struct ChainResult {
     pub bar_energy_j: Vec<f64>,
     /// Energy absorbed by non-reflecting ends so far, J.
     pub absorbed_energy_j: Vec<f64>,
-    /// Work dissipated in the pulse shapers so far, J.
+    /// Work taken by the pulse shaper and butt joints so far, J.
     pub shaper_energy_j: Vec<f64>,
+    /// Work taken by the sphere contact so far (dissipated plus elastic energy held), J.
+    pub contact_energy_j: Vec<f64>,
+    /// The sphere contact's history (approach, force, σy*, strain rate), if the chain has one.
+    pub contact: Option<crate::solver::ContactSeries>,
     /// Initial kinetic energy of the striker, J.
     pub striker_energy_j: f64,
     /// Velocity of the striker's centre of mass at the end, m/s.
@@ -250,6 +308,16 @@ pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
         bar_energy_j: Vec::with_capacity(cap),
         absorbed_energy_j: Vec::with_capacity(cap),
         shaper_energy_j: Vec::with_capacity(cap),
+        contact_energy_j: Vec::with_capacity(cap),
+        contact: joints
+            .iter()
+            .any(|j| j.law.is_some())
+            .then(|| crate::solver::ContactSeries {
+                time_s: Some(Vec::with_capacity(cap)),
+                yield_stress_pa: Some(Vec::with_capacity(cap)),
+                strain_rate_per_s: Some(Vec::with_capacity(cap)),
+                ..Default::default()
+            }),
         striker_energy_j,
         striker_final_velocity_m_s: 0.0,
         steps,
@@ -266,8 +334,26 @@ pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
         );
         out.absorbed_energy_j
             .push(bars.iter().map(|b| b.absorbed_energy_j()).sum());
-        out.shaper_energy_j
-            .push(joints.iter().map(|j| j.dissipated_j()).sum());
+        out.shaper_energy_j.push(
+            joints
+                .iter()
+                .filter(|j| j.law.is_none())
+                .map(|j| j.dissipated_j())
+                .sum(),
+        );
+        out.contact_energy_j.push(
+            joints
+                .iter()
+                .filter(|j| j.law.is_some())
+                .map(|j| j.dissipated_j())
+                .sum(),
+        );
+        if let (Some(c), Some(j)) = (
+            out.contact.as_mut(),
+            joints.iter().find(|j| j.law.is_some()),
+        ) {
+            c.push(t, j.approach_m, &j.contact);
+        }
     };
     record(&bars, &joints, 0.0);
     for n in 1..=steps {

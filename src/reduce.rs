@@ -1,0 +1,1 @@
+//! The laboratory data reduction (physics.md §7). (Being written.)
