@@ -395,6 +395,8 @@ pub struct PulseOptions {
     pub end_time_s: f64,
     /// Gauge grid length over which strain is averaged, m.
     pub gauge_length_m: f64,
+    /// Interval of the x–t stress snapshots of the bars, s (None: none).
+    pub snapshot_interval_s: Option<f64>,
 }
 
 impl Apparatus {
@@ -481,6 +483,10 @@ impl Apparatus {
             gauges,
             record_every,
             end_masses,
+            snapshot_every: o
+                .snapshot_interval_s
+                .map(|i| ((i / dt).round() as usize).max(1)),
+            snapshot_spacing_m: 5e-3,
         }
     }
 }

@@ -252,6 +252,7 @@ fn strain(
         time_s: Some(rec.time_s.clone()),
         gauges,
         energy: Vec::new(),
+        bars: Vec::new(),
         summary: Vec::new(),
     };
     let text = format!(
@@ -346,6 +347,9 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
     let title = format!("{} — {}", params.kind, name);
+    if let (Some(contact), SceneParams::Pulse { apparatus, .. }) = (&out.contact, &params.params) {
+        return plot_test(path, force, &title, apparatus, out, contact);
+    }
     if let Some(contact) = &out.contact {
         let mut curves = vec![Curve {
             label: format!("shpb ({})", params.contact_law().name()),
@@ -405,6 +409,87 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
         y_scale: 1e-6,
     };
     xy_plot(path, force, &axes, &curves)
+}
+
+/// The three-panel figure of a full virtual test (gauges, F–δ, x–t diagram).
+fn plot_test(
+    path: &Path,
+    force: bool,
+    title: &str,
+    apparatus: &crate::apparatus::Apparatus,
+    out: &RunOutput,
+    contact: &crate::solver::ContactSeries,
+) -> Result<()> {
+    let e = apparatus.material.youngs_modulus_pa;
+    let t = out.time_s.as_deref().unwrap_or(&[]);
+    let stresses: Vec<Vec<f64>> = out
+        .gauges
+        .iter()
+        .map(|g| g.strain.iter().map(|s| -e * s).collect())
+        .collect();
+    let gauge_curves: Vec<Curve> = out
+        .gauges
+        .iter()
+        .zip(&stresses)
+        .map(|(g, s)| Curve {
+            label: format!("{} gauge", g.name),
+            x: t,
+            y: s,
+            measured: false,
+        })
+        .collect();
+    let gauge_title = format!("{title}: gauge signals");
+    let gauge_axes = Axes {
+        title: &gauge_title,
+        x_label: "time after impact (µs)",
+        y_label: "bar stress, compression positive (MPa)",
+        x_scale: 1e6,
+        y_scale: 1e-6,
+    };
+    let fd_curves = vec![Curve {
+        label: "true contact (simulation)".into(),
+        x: &contact.displacement_m,
+        y: &contact.force_n,
+        measured: false,
+    }];
+    let fd_axes = Axes {
+        title: "force against sphere approach",
+        x_label: "sphere approach δ (mm)",
+        y_label: "force F (kN)",
+        x_scale: 1e3,
+        y_scale: 1e-3,
+    };
+    // Positions along the apparatus with the specimen at 0: striker and incident bar to the left.
+    let (li, ls) = (apparatus.incident.length_m, apparatus.striker.length_m);
+    let shifted: Vec<Vec<f64>> = out
+        .bars
+        .iter()
+        .map(|b| {
+            let offset = match b.name.as_str() {
+                "striker" => -li - ls,
+                "incident" => -li,
+                _ => 0.0,
+            };
+            b.x_m.iter().map(|x| x + offset).collect()
+        })
+        .collect();
+    let fields: Vec<crate::plot::Field> = out
+        .bars
+        .iter()
+        .zip(&shifted)
+        .map(|(b, x)| crate::plot::Field {
+            x_m: x,
+            time_s: &b.time_s,
+            stress_pa: &b.stress_pa,
+        })
+        .collect();
+    crate::plot::test_figure(
+        path,
+        force,
+        (&gauge_axes, &gauge_curves),
+        (&fd_axes, &fd_curves),
+        &fields,
+    )
 }
 
 fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Result<()> {

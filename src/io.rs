@@ -220,6 +220,8 @@ pub struct RunOutput {
     pub gauges: Vec<GaugeTrace>,
     /// `/energy/<name>`, J, on the `/time` axis.
     pub energy: Vec<(String, Vec<f64>)>,
+    /// `/bars/<name>/{snapshots,x,time}`: decimated x–t stress fields.
+    pub bars: Vec<crate::solver::pulse::BarSnapshots>,
     /// Scalar results (attributes of `/summary`).
     pub summary: Vec<SummaryItem>,
 }
@@ -243,6 +245,7 @@ impl RunOutput {
             time_s: None,
             gauges: Vec::new(),
             energy: Vec::new(),
+            bars: Vec::new(),
             summary,
         }
     }
@@ -324,6 +327,32 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
                 let c = g.create_group(&tr.name).map_err(h5err(path))?;
                 write_dataset(&c, "strain", &tr.strain, "1", path)?;
                 write_dataset(&c, "voltage", &tr.voltage_v, "V", path)?;
+            }
+        }
+        if !out.bars.is_empty() {
+            let g = f.create_group("bars").map_err(h5err(path))?;
+            for b in &out.bars {
+                let c = g.create_group(&b.name).map_err(h5err(path))?;
+                write_dataset(&c, "x", &b.x_m, "m", path)?;
+                write_dataset(&c, "time", &b.time_s, "s", path)?;
+                let flat: Vec<f64> = b.stress_pa.iter().flatten().copied().collect();
+                let field = ndarray::Array2::from_shape_vec((b.time_s.len(), b.x_m.len()), flat)
+                    .map_err(|e| Error::Hdf5 {
+                        file: path.display().to_string(),
+                        message: e.to_string(),
+                    })?;
+                let ds = c
+                    .new_dataset_builder()
+                    .with_data(&field)
+                    .create("snapshots")
+                    .map_err(h5err(path))?;
+                string_attr(&ds, "units", "Pa", path)?;
+                string_attr(
+                    &ds,
+                    "description",
+                    "axial stress (tension positive), rows: time, columns: x",
+                    path,
+                )?;
             }
         }
         if !out.energy.is_empty() {

@@ -39,23 +39,26 @@ pub struct Axes<'a> {
     pub y_scale: f64,
 }
 
-/// Draws curves into a PNG (written atomically), scaled as `axes` says.
-pub fn xy_plot(path: &Path, force: bool, axes: &Axes, curves: &[Curve]) -> Result<()> {
-    let (title, x_label, y_label, x_scale, y_scale) = (
-        axes.title,
-        axes.x_label,
-        axes.y_label,
-        axes.x_scale,
-        axes.y_scale,
-    );
-    let (mut xmax, mut ymax) = (0.0f64, 0.0f64);
-    let (mut xmin, mut ymin) = (0.0f64, 0.0f64);
+/// A drawing area of the bitmap backend.
+type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
+
+/// Converts a plotters error into the crate's error for `path`.
+fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Io {
+        file: path.display().to_string(),
+        source: std::io::Error::other(e.to_string()),
+    }
+}
+
+/// Data range of the scaled curves, padded so a flat curve still has an axis.
+fn range(curves: &[Curve], axes: &Axes) -> (f64, f64, f64, f64) {
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for c in curves {
         for (&x, &y) in c.x.iter().zip(c.y) {
-            xmax = xmax.max(x * x_scale);
-            ymax = ymax.max(y * y_scale);
-            xmin = xmin.min(x * x_scale);
-            ymin = ymin.min(y * y_scale);
+            xmax = xmax.max(x * axes.x_scale);
+            ymax = ymax.max(y * axes.y_scale);
+            xmin = xmin.min(x * axes.x_scale);
+            ymin = ymin.min(y * axes.y_scale);
         }
     }
     if xmax <= xmin {
@@ -64,56 +67,172 @@ pub fn xy_plot(path: &Path, force: bool, axes: &Axes, curves: &[Curve]) -> Resul
     if ymax <= ymin {
         ymax = ymin + 1.0;
     }
-    let perr = |e: String| Error::Io {
-        file: path.display().to_string(),
-        source: std::io::Error::other(e),
-    };
+    (xmin, xmax * 1.03, ymin - 0.02 * (ymax - ymin), ymax * 1.08)
+}
+
+/// Draws line curves with axes and a legend into one panel.
+fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    let (xmin, xmax, ymin, ymax) = range(curves, axes);
+    let mut chart = ChartBuilder::on(area)
+        .caption(axes.title, ("sans-serif", 24))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xmin..xmax, ymin..ymax)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(axes.x_label)
+        .y_desc(axes.y_label)
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(perr(path))?;
+    for (i, c) in curves.iter().enumerate() {
+        let pts: Vec<(f64, f64)> =
+            c.x.iter()
+                .zip(c.y)
+                .map(|(&x, &y)| (x * axes.x_scale, y * axes.y_scale))
+                .collect();
+        let color = if c.measured {
+            RGBColor(140, 20, 20)
+        } else {
+            PALETTE[i % PALETTE.len()]
+        };
+        let series = if c.measured {
+            chart.draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(3)))
+        } else {
+            chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+        }
+        .map_err(perr(path))?;
+        series.label(c.label.clone()).legend(move |(x, y)| {
+            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+        });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 17))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(perr(path))?;
+    Ok(())
+}
+
+/// Draws curves into a PNG (written atomically), scaled as `axes` says.
+pub fn xy_plot(path: &Path, force: bool, axes: &Axes, curves: &[Curve]) -> Result<()> {
     write_atomically(path, force, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 700)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| perr(e.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 26))
-            .margin(15)
-            .x_label_area_size(55)
-            .y_label_area_size(75)
-            .build_cartesian_2d(xmin..xmax * 1.03, ymin..ymax * 1.08)
-            .map_err(|e| perr(e.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .label_style(("sans-serif", 18))
-            .draw()
-            .map_err(|e| perr(e.to_string()))?;
-        for (i, c) in curves.iter().enumerate() {
-            let pts: Vec<(f64, f64)> =
-                c.x.iter()
-                    .zip(c.y)
-                    .map(|(&x, &y)| (x * x_scale, y * y_scale))
-                    .collect();
-            let color = if c.measured {
-                RGBColor(140, 20, 20)
-            } else {
-                PALETTE[i % PALETTE.len()]
-            };
-            let series = if c.measured {
-                chart.draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(3)))
-            } else {
-                chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
-            }
-            .map_err(|e| perr(e.to_string()))?;
-            series.label(c.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-            });
+        root.fill(&WHITE).map_err(perr(path))?;
+        draw_xy(&root, path, axes, curves)?;
+        root.present().map_err(perr(path))
+    })
+}
+
+/// A stress field over position and time (a Lagrange x–t diagram): rows of `stress_pa` at
+/// `time_s`, columns at `x_m` (positions along the apparatus).
+pub struct Field<'a> {
+    /// Positions, m.
+    pub x_m: &'a [f64],
+    /// Times, s.
+    pub time_s: &'a [f64],
+    /// Stress rows, Pa (tension positive).
+    pub stress_pa: &'a [Vec<f64>],
+}
+
+/// Diverging colour: compression blue, tension red, zero white.
+fn stress_colour(s: f64, scale: f64) -> RGBColor {
+    let a = (s / scale).clamp(-1.0, 1.0);
+    let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
+    if a < 0.0 {
+        RGBColor(fade(a), fade(a), 255)
+    } else {
+        RGBColor(255, fade(a), fade(a))
+    }
+}
+
+/// Draws x–t fields (several bars side by side) as coloured cells.
+fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result<()> {
+    let (mut xmin, mut xmax, mut tmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+    let mut magnitudes: Vec<f64> = Vec::new();
+    for f in fields {
+        for &x in f.x_m {
+            xmin = xmin.min(x);
+            xmax = xmax.max(x);
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 18))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(|e| perr(e.to_string()))?;
-        root.present().map_err(|e| perr(e.to_string()))
+        tmax = f.time_s.iter().cloned().fold(tmax, f64::max);
+        magnitudes.extend(f.stress_pa.iter().flatten().map(|v| v.abs()));
+    }
+    // Full colour at the 99.5th percentile, so one hot spot does not wash out the waves.
+    magnitudes.sort_by(|a, b| a.total_cmp(b));
+    let smax = magnitudes
+        .get(magnitudes.len() * 995 / 1000)
+        .copied()
+        .unwrap_or(1.0);
+    if !xmin.is_finite() || xmax <= xmin || tmax <= 0.0 {
+        return Ok(());
+    }
+    let smax = smax.max(1.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "{title} (blue: compression, red: tension, full colour at {:.0} MPa)",
+                smax / 1e6
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xmin * 1e3..xmax * 1e3, 0.0..tmax * 1e6)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("position along the bars (mm, 0 = specimen)")
+        .y_desc("time (µs)")
+        .label_style(("sans-serif", 16))
+        .draw()
+        .map_err(perr(path))?;
+    for f in fields {
+        for (k, row) in f.stress_pa.iter().enumerate() {
+            let t0 = if k == 0 { 0.0 } else { f.time_s[k - 1] };
+            let t1 = f.time_s[k];
+            for j in 0..f.x_m.len().saturating_sub(1) {
+                let s = 0.5 * (row[j] + row[j + 1]);
+                let rect = Rectangle::new(
+                    [(f.x_m[j] * 1e3, t0 * 1e6), (f.x_m[j + 1] * 1e3, t1 * 1e6)],
+                    stress_colour(s, smax).filled(),
+                );
+                chart.plotting_area().draw(&rect).map_err(perr(path))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The figure of a full virtual test: gauge signals, force–displacement (true and
+/// reconstructed), and the x–t diagram of the bars' stress.
+pub fn test_figure(
+    path: &Path,
+    force: bool,
+    gauges: (&Axes, &[Curve]),
+    force_displacement: (&Axes, &[Curve]),
+    fields: &[Field],
+) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1600, 1300)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let (top, bottom) = root.split_vertically(620);
+        let (left, right) = top.split_horizontally(800);
+        draw_xy(&left, path, gauges.0, gauges.1)?;
+        draw_xy(&right, path, force_displacement.0, force_displacement.1)?;
+        draw_field(
+            &bottom,
+            path,
+            "x–t (Lagrange) diagram of the bar stress",
+            fields,
+        )?;
+        root.present().map_err(perr(path))
     })
 }

@@ -515,6 +515,7 @@ impl Params {
                     dispersion,
                     end_time_s,
                     gauge_length_m,
+                    snapshot_interval_s: is_test.then_some(2e-6),
                 };
                 // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
                 for spec in &apparatus.pulse_chain(&options).bars {
@@ -846,6 +847,7 @@ fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) ->
         time_s: Some(t),
         gauges,
         energy,
+        bars: r.snapshots,
         summary,
     })
 }

@@ -234,6 +234,23 @@ pub struct ChainSetup {
     pub record_every: usize,
     /// Lumped masses added to bar ends before the run: (bar index, right end?, kg) — the spheres.
     pub end_masses: Vec<(usize, bool, f64)>,
+    /// Record the stress field of every bar every this many steps (None: no snapshots).
+    pub snapshot_every: Option<usize>,
+    /// Spacing of the snapshot points along the bars, m.
+    pub snapshot_spacing_m: f64,
+}
+
+/// The decimated x–t stress field of one bar (for Lagrange diagrams).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarSnapshots {
+    /// Bar name.
+    pub name: String,
+    /// Positions along the bar, m.
+    pub x_m: Vec<f64>,
+    /// Snapshot times, s.
+    pub time_s: Vec<f64>,
+    /// Axial stress (tension positive), one row per time, Pa.
+    pub stress_pa: Vec<Vec<f64>>,
 }
 
 /// What a pulse run yields: gauge strains and the energy ledger over time.
@@ -253,6 +270,8 @@ pub struct ChainResult {
     pub contact_energy_j: Vec<f64>,
     /// The sphere contact's history (approach, force, σy*, strain rate), if the chain has one.
     pub contact: Option<crate::solver::ContactSeries>,
+    /// Stress fields of the bars over time, if requested.
+    pub snapshots: Vec<BarSnapshots>,
     /// Initial kinetic energy of the striker, J.
     pub striker_energy_j: f64,
     /// Velocity of the striker's centre of mass at the end, m/s.
@@ -318,6 +337,22 @@ pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
                 strain_rate_per_s: Some(Vec::with_capacity(cap)),
                 ..Default::default()
             }),
+        snapshots: match setup.snapshot_every {
+            Some(_) => bars
+                .iter()
+                .map(|b| {
+                    let len = b.node_position_m(b.node_count() - 1);
+                    let n = ((len / setup.snapshot_spacing_m).round() as usize).max(1);
+                    BarSnapshots {
+                        name: b.name().to_string(),
+                        x_m: (0..=n).map(|k| len * k as f64 / n as f64).collect(),
+                        time_s: Vec::new(),
+                        stress_pa: Vec::new(),
+                    }
+                })
+                .collect(),
+            None => Vec::new(),
+        },
         striker_energy_j,
         striker_final_velocity_m_s: 0.0,
         steps,
@@ -356,8 +391,20 @@ pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
         }
     };
     record(&bars, &joints, 0.0);
+    let snapshot = |bars: &[Bar], snaps: &mut [BarSnapshots], t: f64| {
+        for (b, s) in bars.iter().zip(snaps.iter_mut()) {
+            s.time_s.push(t);
+            s.stress_pa
+                .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+        }
+    };
     for n in 1..=steps {
         step_chain(&mut bars, &mut joints)?;
+        if let Some(k) = setup.snapshot_every
+            && n % k == 0
+        {
+            snapshot(&bars, &mut out.snapshots, n as f64 * setup.dt_s);
+        }
         if n % setup.record_every == 0 {
             record(&bars, &joints, n as f64 * setup.dt_s);
         }
