@@ -315,7 +315,8 @@ fn run(
 fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
     let stdout = std::io::stdout();
     let mut w = stdout.lock();
-    let mut text = if matches!(params.params, SceneParams::Pulse { .. }) {
+    let mut text = if matches!(&params.params, SceneParams::Pulse { options, .. } if options.specimen.is_none())
+    {
         format!("scene: {} (kind {})\n", params.source, params.kind)
     } else {
         format!(

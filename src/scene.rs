@@ -206,7 +206,7 @@ pub enum SceneParams {
         /// Gas-gun gauge pressure, Pa.
         pressure_pa: f64,
         /// Solver options (striker velocity from the gun).
-        options: PulseOptions,
+        options: Box<PulseOptions>,
     },
     /// Fig. 4 force-driven DEM; `measured` holds the CSV's displacement column when present.
     ForceDriven {
@@ -521,17 +521,21 @@ impl Params {
                 for spec in &apparatus.pulse_chain(&options).bars {
                     crate::bar::Bar::new(spec, cell / c0)?;
                 }
-                let pair = SpherePair::paper(
-                    crate::material::Material::builtin("ss440c").expect("built-in"),
-                );
+                // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads.
+                let pair = match specimen {
+                    Some(sp) => sp.pair,
+                    None => SpherePair::paper(
+                        crate::material::Material::builtin("ss440c").expect("built-in"),
+                    ),
+                };
                 (
                     pair,
-                    LawKind::default(),
-                    Region2Form::default(),
+                    f.law,
+                    f.region2,
                     SceneParams::Pulse {
                         apparatus: Box::new(apparatus),
                         pressure_pa,
-                        options,
+                        options: Box::new(options),
                     },
                 )
             }
