@@ -3,7 +3,7 @@
 //! Run with `cargo bench`; report ratios, not absolute times (DEVELOPERS.md).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use shpb::contact::{ContactHistory, ContactLaw, LawKind};
+use shpb::contact::{ContactHistory, LawKind};
 use shpb::material::Material;
 use shpb::scene::Params;
 use shpb::specimen::SpherePair;
