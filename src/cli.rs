@@ -385,23 +385,8 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
         SceneParams::Pulse { apparatus, .. } => apparatus.material.youngs_modulus_pa,
         _ => 1.0,
     };
-    let t = out.time_s.as_deref().unwrap_or(&[]);
-    let stresses: Vec<Vec<f64>> = out
-        .gauges
-        .iter()
-        .map(|g| g.strain.iter().map(|s| -e * s).collect())
-        .collect();
-    let curves: Vec<Curve> = out
-        .gauges
-        .iter()
-        .zip(&stresses)
-        .map(|(g, s)| Curve {
-            label: format!("{} gauge", g.name),
-            x: t,
-            y: s,
-            measured: false,
-        })
-        .collect();
+    let stresses = gauge_stresses(out, e);
+    let curves = gauge_curves(out, &stresses);
     let axes = Axes {
         title: &title,
         x_label: "time after impact (µs)",
@@ -410,6 +395,29 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
         y_scale: 1e-6,
     };
     xy_plot(path, force, &axes, &curves)
+}
+
+/// Bar stress at each gauge, compression positive (−E ε), Pa.
+fn gauge_stresses(out: &RunOutput, e_pa: f64) -> Vec<Vec<f64>> {
+    out.gauges
+        .iter()
+        .map(|g| g.strain.iter().map(|s| -e_pa * s).collect())
+        .collect()
+}
+
+/// One curve per gauge against the run's time axis.
+fn gauge_curves<'a>(out: &'a RunOutput, stresses: &'a [Vec<f64>]) -> Vec<Curve<'a>> {
+    let t = out.time_s.as_deref().unwrap_or(&[]);
+    out.gauges
+        .iter()
+        .zip(stresses)
+        .map(|(g, s)| Curve {
+            label: format!("{} gauge", g.name),
+            x: t,
+            y: s,
+            measured: false,
+        })
+        .collect()
 }
 
 /// The three-panel figure of a full virtual test (gauges, F–δ, x–t diagram).
@@ -422,23 +430,8 @@ fn plot_test(
     contact: &crate::solver::ContactSeries,
 ) -> Result<()> {
     let e = apparatus.material.youngs_modulus_pa;
-    let t = out.time_s.as_deref().unwrap_or(&[]);
-    let stresses: Vec<Vec<f64>> = out
-        .gauges
-        .iter()
-        .map(|g| g.strain.iter().map(|s| -e * s).collect())
-        .collect();
-    let gauge_curves: Vec<Curve> = out
-        .gauges
-        .iter()
-        .zip(&stresses)
-        .map(|(g, s)| Curve {
-            label: format!("{} gauge", g.name),
-            x: t,
-            y: s,
-            measured: false,
-        })
-        .collect();
+    let stresses = gauge_stresses(out, e);
+    let gauge_curves = gauge_curves(out, &stresses);
     let gauge_title = format!("{title}: gauge signals");
     let gauge_axes = Axes {
         title: &gauge_title,

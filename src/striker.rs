@@ -55,23 +55,13 @@ impl GasGun {
         v: &Validator,
         key: &str,
     ) -> Result<f64> {
-        let allowed = format!(
-            "{:.3} to {:.3} psi ({:.0} to {:.0} Pa gauge)",
-            self.min_pressure_pa / PSI_PA,
-            self.max_pressure_pa / PSI_PA,
+        let allowed = check_range(
+            p_gauge_pa,
             self.min_pressure_pa,
-            self.max_pressure_pa
-        );
-        if !p_gauge_pa.is_finite()
-            || p_gauge_pa < self.min_pressure_pa
-            || p_gauge_pa > self.max_pressure_pa
-        {
-            return Err(v.error(
-                key,
-                format!("{:.4} psi is outside the gun's range", p_gauge_pa / PSI_PA),
-                allowed,
-            ));
-        }
+            self.max_pressure_pa,
+            v,
+            key,
+        )?;
         let ke = self.kinetic_energy_j(p_gauge_pa, area_m2);
         if ke <= 0.0 {
             return Err(v.error(
@@ -85,6 +75,31 @@ impl GasGun {
         }
         Ok((2.0 * ke / mass_kg).sqrt())
     }
+}
+
+/// Checks a gauge pressure against the gun's range; returns the range text for later errors.
+fn check_range(
+    p_gauge_pa: f64,
+    min_pa: f64,
+    max_pa: f64,
+    v: &Validator,
+    key: &str,
+) -> Result<String> {
+    let allowed = format!(
+        "{:.3} to {:.3} psi ({:.0} to {:.0} Pa gauge)",
+        min_pa / PSI_PA,
+        max_pa / PSI_PA,
+        min_pa,
+        max_pa
+    );
+    if !p_gauge_pa.is_finite() || p_gauge_pa < min_pa || p_gauge_pa > max_pa {
+        return Err(v.error(
+            key,
+            format!("{:.4} psi is outside the gun's range", p_gauge_pa / PSI_PA),
+            allowed,
+        ));
+    }
+    Ok(allowed)
 }
 
 /// Parses a pressure with unit: `10psi`, `68.9kPa`, `68948Pa`, `0.1MPa`, `1bar` (gauge pressure), to Pa.
@@ -179,23 +194,8 @@ impl Gun {
         match self {
             Gun::Adiabatic(g) => g.velocity_m_s(p_gauge_pa, mass_kg, area_m2, v, key),
             Gun::Linear(g) => {
-                let allowed = format!(
-                    "{:.3} to {:.3} psi ({:.0} to {:.0} Pa gauge)",
-                    g.min_pressure_pa / PSI_PA,
-                    g.max_pressure_pa / PSI_PA,
-                    g.min_pressure_pa,
-                    g.max_pressure_pa
-                );
-                if !p_gauge_pa.is_finite()
-                    || p_gauge_pa < g.min_pressure_pa
-                    || p_gauge_pa > g.max_pressure_pa
-                {
-                    return Err(v.error(
-                        key,
-                        format!("{:.4} psi is outside the gun's range", p_gauge_pa / PSI_PA),
-                        allowed,
-                    ));
-                }
+                let allowed =
+                    check_range(p_gauge_pa, g.min_pressure_pa, g.max_pressure_pa, v, key)?;
                 let v2 = g.k_m2_per_s2_per_pa * (p_gauge_pa - g.loss_pressure_pa);
                 if v2 <= 0.0 {
                     return Err(v.error(key, "too low to overcome the pressure loss", allowed));
