@@ -105,6 +105,31 @@ pub enum Command {
         #[arg(long, default_value = "bars/authors.toml")]
         bars: PathBuf,
     },
+    /// Reduce a gauge record like the lab: forces at both faces, sphere approach, strain rate.
+    ///
+    /// Accepts the authors' raw CSV (time_s, incident_V, transmission_V) or an HDF5 file written by
+    /// `shpb run` (/time, /gauges/{incident,transmission}/strain). Writes /reduction/{time,
+    /// displacement, force_front, force_back, force_3wave, strain_rate, equilibrium_ratio,
+    /// approach_velocity}.
+    Reduce {
+        /// The record (.csv or .h5).
+        record: PathBuf,
+        /// Bar set-up file (bars, gauge distances, bridge, gain, polarity).
+        #[arg(long, default_value = "bars/authors.toml")]
+        bars: PathBuf,
+        /// HDF5 output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// CSV output.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Skip the Bancroft dispersion correction.
+        #[arg(long)]
+        no_dispersion: bool,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
     /// Convert a raw gauge record (the authors' CSV: time_s, incident_V, transmission_V) to bar strain.
     Strain {
         /// The record.
@@ -160,6 +185,26 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             law,
         } => curve(&specimen, rate, to, points, law.into()),
         Command::Gun { pressure, bars } => gun(&pressure, &bars),
+        Command::Reduce {
+            record,
+            bars,
+            output,
+            csv,
+            no_dispersion,
+            force,
+        } => {
+            if !bars.is_file() {
+                load_apparatus(&bars)?;
+            }
+            crate::reduce::reduce_command(
+                &record,
+                &bars,
+                output.as_deref(),
+                csv.as_deref(),
+                force,
+                no_dispersion,
+            )
+        }
         Command::Strain {
             record,
             bars,
