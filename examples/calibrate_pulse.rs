@@ -1,0 +1,1403 @@
+//! Calibrates the gas gun and the copper pulse shaper of `bars/authors.toml` against the incident
+//! gauge records of 2013-05-22 (samples 1–8) and writes `validation/pulse/REPORT.md` and one
+//! overlay plot per sample, `validation/pulse/sample<N>.png`:
+//! `cargo run --release --example calibrate_pulse` (≈ 2.5 min on two cores);
+//! `cargo run --release --example calibrate_pulse -- --shipped` evaluates the shipped values only.
+//!
+//! * **Records.** The incident channel is converted to bar stress with the shipped gauge channel
+//!   (exact bridge inverse, baseline = mean of the first 900 samples), compression positive.
+//!   Metrics of the first pulse, −10 to 250 µs after the trigger: peak, 10–90 % rise, duration at 10 % of peak
+//!   (`shpb::gauge::pulse_metrics`, raw samples, no filtering), and the pulse's energy.
+//! * **Model.** `Apparatus::pulse_chain`: striker → Frew–Forrestal–Chen shaper → incident bar →
+//!   transmission bar pressed against it, 1 mm cells, 2 mm gauge grid, no dispersion (what
+//!   `run_pulse` does); the noise-free gauge strain at 10 MHz, σ = −E ε.
+//! * **Fit.** Nelder–Mead (written here) on Σ over records of (relative error / tolerance)² of
+//!   peak (15 %), rise (20 %), duration (20 %) and pulse energy (20 %). Stage 1 frees one striker
+//!   velocity per pressure (to test the gun law); stage 2 ties the velocities to
+//!   v² = k (p − p_loss) and gives the shipped values. Comparison fits show what that rests on.
+
+use rayon::prelude::*;
+use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
+use shpb::bar::Dispersion;
+use shpb::gauge::{
+    PulseMetrics, RawRecord, authors_stress_from_voltage, pulse_metrics, remove_baseline,
+};
+use shpb::plot::{Axes, Curve, xy_plot};
+use shpb::scene::resample;
+use shpb::shaper::PulseShaper;
+use shpb::solver::pulse::simulate_chain;
+use shpb::striker::{Gun, PSI_PA};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// The records: sample number, material, gun pressure (psi).
+const SAMPLES: [(usize, &str, f64); 8] = [
+    (1, "ss440c", 10.0),
+    (2, "ss440c", 12.5),
+    (3, "ss440c", 15.0),
+    (4, "al2017", 12.5),
+    (5, "al2017", 15.0),
+    (6, "ss302", 10.0),
+    (7, "ss302", 15.0),
+    (8, "ss302", 12.5),
+];
+/// The three gun pressures, psi.
+const PRESSURES_PSI: [f64; 3] = [10.0, 12.5, 15.0];
+/// Tolerances of the issue: peak, rise 10–90 %, duration at 10 %.
+const TOL: [f64; 3] = [0.15, 0.20, 0.20];
+const METRIC_NAMES: [&str; 3] = ["peak", "rise 10–90 %", "duration at 10 %"];
+/// Tolerance (weight) of the pulse energy in the objective: that of the issue's shape metrics.
+const ENERGY_TOL: f64 = 0.20;
+/// Pre-trigger samples averaged for the baseline.
+const BASELINE_SAMPLES: usize = 900;
+/// Window of the incident pulse in a record, s after the trigger.
+const WINDOW_S: (f64, f64) = (-10e-6, 250e-6);
+/// Cell size and gauge grid of the calibration runs (the `pulse` scene's defaults), m.
+const CELL_M: f64 = 1e-3;
+const GAUGE_LENGTH_M: f64 = 2e-3;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// One record's incident pulse: times (s), compression-positive stress (Pa), metrics.
+struct Record {
+    sample: usize,
+    material: &'static str,
+    psi: f64,
+    time_s: Vec<f64>,
+    stress_pa: Vec<f64>,
+    metrics: PulseMetrics,
+    /// Energy the pulse carries, J.
+    energy_j: f64,
+}
+
+fn read_records(a: &Apparatus) -> Vec<Record> {
+    let e = a.material.youngs_modulus_pa;
+    let ch = a.gauges.channel("incident").expect("incident channel");
+    SAMPLES
+        .iter()
+        .map(|&(sample, material, psi)| {
+            let path = root().join(format!(
+                "validation/gauge-records/data/2013-05-22_sample{sample}_{material}.csv"
+            ));
+            let r = RawRecord::read(&path).expect("record");
+            let v = remove_baseline(&r.incident_v, BASELINE_SAMPLES);
+            let (time_s, stress_pa): (Vec<f64>, Vec<f64>) = r
+                .time_s
+                .iter()
+                .zip(&v)
+                .filter(|(t, _)| (WINDOW_S.0..=WINDOW_S.1).contains(*t))
+                .map(|(&t, &v)| (t, -e * ch.strain_from_voltage(v)))
+                .unzip();
+            let metrics = pulse_metrics(&time_s, &stress_pa, false).expect("incident pulse");
+            let energy_j = pulse_energy_j(a, &time_s, &stress_pa);
+            Record {
+                sample,
+                material,
+                psi,
+                time_s,
+                stress_pa,
+                metrics,
+                energy_j,
+            }
+        })
+        .collect()
+}
+
+/// A simulated incident gauge signal at 10 MHz.
+struct Simulated {
+    time_s: Vec<f64>,
+    stress_pa: Vec<f64>,
+    metrics: Option<PulseMetrics>,
+    energy_j: f64,
+    striker_final_velocity_m_s: f64,
+    /// Work the shaper took from the bars by the end of the run, J.
+    shaper_work_j: f64,
+}
+
+fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper, cell_m: f64, gauge_m: f64) -> Simulated {
+    let c0 = a.material.wave_speed_m_s();
+    let ch = a.gauges.channel("incident").expect("incident channel");
+    let arrival = (a.incident.length_m - ch.distance_from_specimen_m) / c0;
+    let end = arrival + WINDOW_S.1 + 20e-6;
+    let setup = a.pulse_chain(&PulseOptions {
+        specimen: None,
+        striker_velocity_m_s: v,
+        shaper: Some(shaper),
+        end: IncidentEnd::Transmission,
+        cell_size_m: cell_m,
+        dispersion: Dispersion::None,
+        end_time_s: end,
+        gauge_length_m: gauge_m,
+        snapshot_interval_s: None,
+    });
+    let k = setup
+        .gauges
+        .iter()
+        .position(|g| g.name == "incident")
+        .expect("incident gauge");
+    let Ok(r) = simulate_chain(&setup) else {
+        return Simulated {
+            time_s: vec![],
+            stress_pa: vec![],
+            metrics: None,
+            energy_j: f64::NAN,
+            striker_final_velocity_m_s: f64::NAN,
+            shaper_work_j: f64::NAN,
+        };
+    };
+    let dt = ch.digitiser.sample_interval_s();
+    let time_s: Vec<f64> = (0..(end / dt) as usize).map(|i| i as f64 * dt).collect();
+    let e = a.material.youngs_modulus_pa;
+    let stress_pa: Vec<f64> = resample(&r.time_s, &r.strain[k], &time_s)
+        .iter()
+        .map(|s| -e * s)
+        .collect();
+    Simulated {
+        metrics: pulse_metrics(&time_s, &stress_pa, false),
+        energy_j: pulse_energy_j(a, &time_s, &stress_pa),
+        time_s,
+        stress_pa,
+        striker_final_velocity_m_s: r.striker_final_velocity_m_s,
+        shaper_work_j: r.shaper_energy_j.last().copied().unwrap_or(f64::NAN),
+    }
+}
+
+/// Every parameter of the model: striker velocity per pressure and the shaper.
+#[derive(Clone, Copy, Debug)]
+struct Model {
+    velocity_m_s: [f64; 3],
+    shaper: PulseShaper,
+}
+
+/// Relative errors (sim − measured)/measured of peak, rise and duration.
+fn errors(m: &PulseMetrics, s: &PulseMetrics) -> [f64; 3] {
+    [
+        s.peak / m.peak - 1.0,
+        s.rise_10_90_s / m.rise_10_90_s - 1.0,
+        s.duration_10_s / m.duration_10_s - 1.0,
+    ]
+}
+
+fn run_model_with(a: &Apparatus, model: &Model, cell_m: f64, gauge_m: f64) -> Vec<Simulated> {
+    (0..3)
+        .into_par_iter()
+        .map(|i| simulate(a, model.velocity_m_s[i], model.shaper, cell_m, gauge_m))
+        .collect()
+}
+
+fn run_model(a: &Apparatus, model: &Model) -> Vec<Simulated> {
+    run_model_with(a, model, CELL_M, GAUGE_LENGTH_M)
+}
+
+fn pressure_index(psi: f64) -> usize {
+    PRESSURES_PSI
+        .iter()
+        .position(|&p| p == psi)
+        .expect("one of the three pressures")
+}
+
+/// How well a model matches the records.
+#[derive(Clone, Copy, Debug)]
+struct Score {
+    /// Σ (error/tolerance)² of the issue's three metrics over the records.
+    metrics: f64,
+    /// Σ (energy error/ENERGY_TOL)² over the records.
+    energy: f64,
+    /// Largest |error|/tolerance of the issue's metrics (≤ 1: every criterion met).
+    worst: f64,
+    /// Largest |relative error| of the pulse energy.
+    worst_energy: f64,
+}
+
+impl Score {
+    /// The objective: the issue's metrics, plus the pulse energy if `with_energy`.
+    fn objective(&self, with_energy: bool) -> f64 {
+        self.metrics + if with_energy { self.energy } else { 0.0 }
+    }
+}
+
+fn score(records: &[Record], sims: &[Simulated]) -> Score {
+    let mut sc = Score {
+        metrics: 0.0,
+        energy: 0.0,
+        worst: 0.0,
+        worst_energy: 0.0,
+    };
+    for r in records {
+        let s = &sims[pressure_index(r.psi)];
+        let Some(sm) = &s.metrics else {
+            return Score {
+                metrics: 1e6,
+                energy: 1e6,
+                worst: f64::INFINITY,
+                worst_energy: f64::INFINITY,
+            };
+        };
+        for (k, e) in errors(&r.metrics, sm).iter().enumerate() {
+            let x = e / TOL[k];
+            sc.metrics += x * x;
+            sc.worst = sc.worst.max(x.abs());
+        }
+        let e = s.energy_j / r.energy_j - 1.0;
+        sc.energy += (e / ENERGY_TOL).powi(2);
+        sc.worst_energy = sc.worst_energy.max(e.abs());
+    }
+    sc
+}
+
+fn score_of(a: &Apparatus, records: &[Record], m: &Model) -> Score {
+    score(records, &run_model(a, m))
+}
+
+/// Nelder–Mead simplex minimisation (Nelder & Mead, Comput. J. 7, 308 (1965); coefficients
+/// reflection 1, expansion 2, contraction ½, shrink ½). Returns the best point, its value and the
+/// evaluations used. Stops after `max_evals` or when the simplex's values agree to `ftol`.
+fn nelder_mead(
+    f: &mut dyn FnMut(&[f64]) -> f64,
+    x0: &[f64],
+    step: &[f64],
+    max_evals: usize,
+    ftol: f64,
+) -> (Vec<f64>, f64, usize) {
+    let n = x0.len();
+    let mut pts: Vec<Vec<f64>> = vec![x0.to_vec()];
+    for i in 0..n {
+        let mut p = x0.to_vec();
+        p[i] += step[i];
+        pts.push(p);
+    }
+    let mut vals: Vec<f64> = pts.iter().map(|p| f(p)).collect();
+    let mut evals = n + 1;
+    let along = |c: &[f64], w: &[f64], t: f64| -> Vec<f64> {
+        c.iter().zip(w).map(|(ci, wi)| ci + t * (wi - ci)).collect()
+    };
+    while evals < max_evals {
+        let mut order: Vec<usize> = (0..=n).collect();
+        order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
+        pts = order.iter().map(|&i| pts[i].clone()).collect();
+        vals = order.iter().map(|&i| vals[i]).collect();
+        if (vals[n] - vals[0]).abs() <= ftol * (1.0 + vals[0].abs()) {
+            break;
+        }
+        let centroid: Vec<f64> = (0..n)
+            .map(|d| pts[..n].iter().map(|p| p[d]).sum::<f64>() / n as f64)
+            .collect();
+        let xr = along(&centroid, &pts[n], -1.0);
+        let fr = f(&xr);
+        evals += 1;
+        if fr < vals[0] {
+            let xe = along(&centroid, &pts[n], -2.0);
+            let fe = f(&xe);
+            evals += 1;
+            if fe < fr {
+                (pts[n], vals[n]) = (xe, fe);
+            } else {
+                (pts[n], vals[n]) = (xr, fr);
+            }
+        } else if fr < vals[n - 1] {
+            (pts[n], vals[n]) = (xr, fr);
+        } else {
+            // Outside contraction if the reflection improved on the worst, inside otherwise.
+            let (xc, fc) = if fr < vals[n] {
+                let x = along(&centroid, &pts[n], -0.5);
+                let v = f(&x);
+                (x, v)
+            } else {
+                let x = along(&centroid, &pts[n], 0.5);
+                let v = f(&x);
+                (x, v)
+            };
+            evals += 1;
+            if fc < vals[n].min(fr) {
+                (pts[n], vals[n]) = (xc, fc);
+            } else {
+                for i in 1..=n {
+                    pts[i] = along(&pts[0], &pts[i], 0.5);
+                    vals[i] = f(&pts[i]);
+                }
+                evals += n;
+            }
+        }
+    }
+    let best = (0..=n)
+        .min_by(|&i, &j| vals[i].total_cmp(&vals[j]))
+        .unwrap_or(0);
+    (pts[best].clone(), vals[best], evals)
+}
+
+/// A free shaper parameter.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum ShaperKey {
+    Diameter,
+    Thickness,
+    Sigma0,
+    Modulus,
+    N,
+    M,
+}
+
+impl ShaperKey {
+    fn get(self, s: &PulseShaper) -> f64 {
+        match self {
+            ShaperKey::Diameter => s.diameter_m,
+            ShaperKey::Thickness => s.thickness_m,
+            ShaperKey::Sigma0 => s.sigma0_pa,
+            ShaperKey::Modulus => s.youngs_modulus_pa,
+            ShaperKey::N => s.n,
+            ShaperKey::M => s.m,
+        }
+    }
+    fn set(self, s: &mut PulseShaper, x: f64) {
+        match self {
+            ShaperKey::Diameter => s.diameter_m = x,
+            ShaperKey::Thickness => s.thickness_m = x,
+            ShaperKey::Sigma0 => s.sigma0_pa = x,
+            ShaperKey::Modulus => s.youngs_modulus_pa = x,
+            ShaperKey::N => s.n = x,
+            ShaperKey::M => s.m = x,
+        }
+    }
+    /// Bounds: a disc that fits on the 19 mm bar, 0.2–8 mm thick, σ0 0.05–3 GPa, modulus
+    /// 0.5–130 GPa, hardening and locking exponents in a wide band around Frew et al.'s.
+    fn bounds(self) -> (f64, f64) {
+        match self {
+            ShaperKey::Diameter => (1e-3, 19e-3),
+            ShaperKey::Thickness => (0.2e-3, 8e-3),
+            ShaperKey::Sigma0 => (0.05e9, 3e9),
+            ShaperKey::Modulus => (0.5e9, 130e9),
+            ShaperKey::N => (0.1, 0.8),
+            ShaperKey::M => (1.5, 10.0),
+        }
+    }
+}
+
+/// How the striker velocities are parametrised.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum GunFit {
+    /// One free velocity per pressure.
+    Free,
+    /// v² = k (p − p_loss): free v at 10 and 15 psi, v(12.5 psi) on the line.
+    Linear,
+}
+
+/// A fit: which parameters are free (all in log space, bounded by a penalty) and whether the
+/// pulse energy is in the objective.
+struct FitSpec {
+    gun: GunFit,
+    shaper: Vec<ShaperKey>,
+    energy: bool,
+}
+
+impl FitSpec {
+    fn pack(&self, m: &Model) -> Vec<f64> {
+        let mut x: Vec<f64> = match self.gun {
+            GunFit::Free => m.velocity_m_s.iter().map(|v| v.ln()).collect(),
+            GunFit::Linear => vec![m.velocity_m_s[0].ln(), m.velocity_m_s[2].ln()],
+        };
+        x.extend(self.shaper.iter().map(|k| k.get(&m.shaper).ln()));
+        x
+    }
+
+    /// The model for a point, or None outside the bounds (or an unphysical gun line).
+    fn unpack(&self, x: &[f64], base: &Model, p_min_pa: f64) -> Option<Model> {
+        let mut m = *base;
+        let nv = match self.gun {
+            GunFit::Free => {
+                m.velocity_m_s = [x[0].exp(), x[1].exp(), x[2].exp()];
+                3
+            }
+            GunFit::Linear => {
+                let (k, loss) = line_through(x[0].exp(), x[1].exp())?;
+                if !(0.0..p_min_pa).contains(&loss) {
+                    return None;
+                }
+                m.velocity_m_s = PRESSURES_PSI.map(|psi| (k * (psi * PSI_PA - loss)).sqrt());
+                2
+            }
+        };
+        if m.velocity_m_s.iter().any(|&v| !(0.5..100.0).contains(&v)) {
+            return None;
+        }
+        for (j, key) in self.shaper.iter().enumerate() {
+            let v = x[nv + j].exp();
+            let (lo, hi) = key.bounds();
+            if !(lo..=hi).contains(&v) {
+                return None;
+            }
+            key.set(&mut m.shaper, v);
+        }
+        Some(m)
+    }
+}
+
+/// (k, p_loss) of the line v² = k (p − p_loss) through the 10 and 15 psi velocities.
+fn line_through(v10: f64, v15: f64) -> Option<(f64, f64)> {
+    let (p10, p15) = (10.0 * PSI_PA, 15.0 * PSI_PA);
+    let k = (v15 * v15 - v10 * v10) / (p15 - p10);
+    if k <= 0.0 {
+        return None;
+    }
+    Some((k, p10 - v10 * v10 / k))
+}
+
+/// Least-squares line v² = k (p − p_loss) through three (p, v) points: (k, p_loss, residuals of v).
+fn least_squares_gun(v: &[f64; 3]) -> (f64, f64, [f64; 3]) {
+    let p: Vec<f64> = PRESSURES_PSI.iter().map(|x| x * PSI_PA).collect();
+    let y: Vec<f64> = v.iter().map(|x| x * x).collect();
+    let (pm, ym) = (p.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
+    let sxy: f64 = (0..3).map(|i| (p[i] - pm) * (y[i] - ym)).sum();
+    let sxx: f64 = (0..3).map(|i| (p[i] - pm) * (p[i] - pm)).sum();
+    let k = sxy / sxx;
+    let loss = pm - ym / k;
+    let res = [0, 1, 2].map(|i| (k * (p[i] - loss)).max(0.0).sqrt() - v[i]);
+    (k, loss, res)
+}
+
+/// Runs one fit from `start` (restarting Nelder–Mead from the best point with a smaller simplex
+/// until it stops improving); returns the best model, its objective and the evaluations used.
+fn fit(
+    a: &Apparatus,
+    records: &[Record],
+    spec: &FitSpec,
+    start: &Model,
+    label: &str,
+    max_evals: usize,
+) -> (Model, f64, usize) {
+    let p_min = a.gun.range_pa().0;
+    let mut best = (*start, f64::INFINITY);
+    let mut f = |x: &[f64]| -> f64 {
+        let Some(m) = spec.unpack(x, start, p_min) else {
+            return 1e9;
+        };
+        let v = score_of(a, records, &m).objective(spec.energy);
+        if v < best.1 {
+            best = (m, v);
+        }
+        v
+    };
+    let mut x = spec.pack(start);
+    let (mut total, mut last) = (0, f64::INFINITY);
+    for round in 0..4 {
+        let step = vec![if round == 0 { 0.15 } else { 0.05 }; x.len()];
+        let budget = (max_evals - total).min(max_evals / 2);
+        let (xb, fb, n) = nelder_mead(&mut f, &x, &step, budget, 1e-7);
+        total += n;
+        eprintln!("{label}: round {round}, objective {fb:.4}, {n} evaluations");
+        x = xb;
+        if last - fb < 1e-4 * last.max(1e-12) || total + 2 * (x.len() + 1) >= max_evals {
+            break;
+        }
+        last = fb;
+    }
+    (best.0, best.1, total)
+}
+
+/// `x` rounded to `digits` significant digits (through its decimal form, so 0.75e9 stays exact).
+fn round_sig(x: f64, digits: usize) -> f64 {
+    format!("{:.*e}", digits - 1, x).parse().unwrap_or(x)
+}
+
+/// The model with the gun line and shaper rounded as written into bars/authors.toml (4
+/// significant digits, p_loss to 10 Pa); returns it with k and p_loss.
+fn rounded(m: &Model) -> (Model, f64, f64) {
+    let (k, loss) = line_through(m.velocity_m_s[0], m.velocity_m_s[2]).expect("gun line");
+    let (k, loss) = (round_sig(k, 4), (loss / 10.0).round() * 10.0);
+    let mut r = *m;
+    r.velocity_m_s = PRESSURES_PSI.map(|psi| (k * (psi * PSI_PA - loss)).sqrt());
+    let s = &mut r.shaper;
+    for key in [
+        ShaperKey::Diameter,
+        ShaperKey::Thickness,
+        ShaperKey::Sigma0,
+        ShaperKey::Modulus,
+        ShaperKey::N,
+        ShaperKey::M,
+    ] {
+        key.set(s, round_sig(key.get(s), 4));
+    }
+    (r, k, loss)
+}
+
+/// Root of a function increasing on [lo, hi] by bisection.
+fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The shaper's strain where its elastic line meets the flow curve (E ε = σ_flow(ε)), and its
+/// largest strain: where the loading force σ(ε) A0/(1 − ε) reaches the peak force in the bar.
+fn shaper_strains(s: &PulseShaper, peak_force_n: f64) -> (f64, f64) {
+    let yield_strain = bisect(
+        |e| s.youngs_modulus_pa * e - s.flow_stress_pa(e),
+        1e-9,
+        0.99,
+    );
+    let force =
+        |e: f64| (s.youngs_modulus_pa * e).min(s.flow_stress_pa(e)) * s.area_m2() / (1.0 - e);
+    (yield_strain, bisect(|e| force(e) - peak_force_n, 0.0, 0.99))
+}
+
+/// The shipped model: the gun's velocities at the three pressures and the shaper of the file.
+fn shipped_model(a: &Apparatus) -> Model {
+    let v = shpb::error::Validator::new(a.source.clone());
+    Model {
+        velocity_m_s: PRESSURES_PSI.map(|psi| {
+            a.striker_velocity_m_s(psi * PSI_PA, &v, "pressure")
+                .expect("shipped gun covers 10-15 psi")
+        }),
+        shaper: a.shaper.expect("shipped shaper"),
+    }
+}
+
+/// One row of the table of fits.
+struct FitRow {
+    label: &'static str,
+    free: &'static str,
+    energy: bool,
+    model: Model,
+    score: Score,
+    evals: usize,
+}
+
+fn mpa(x: f64) -> String {
+    format!("{:.1}", x / 1e6)
+}
+
+fn us(x: f64) -> String {
+    format!("{:.1}", x * 1e6)
+}
+
+/// Centred moving average over 2·`half` + 1 samples.
+fn smooth(y: &[f64], half: usize) -> Vec<f64> {
+    (0..y.len())
+        .map(|i| {
+            let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(y.len()));
+            y[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
+        })
+        .collect()
+}
+
+/// Shape diagnostics of a pulse, on a 1.1 µs moving average (11 samples) so that the records'
+/// noise does not decide them: (time at ≥ 90 % of peak, fall from 90 % to 10 %), s.
+fn plateau_and_fall(t: &[f64], y: &[f64]) -> (f64, f64) {
+    let ys = smooth(y, 5);
+    let Some((k, &p)) = ys.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) else {
+        return (f64::NAN, f64::NAN);
+    };
+    let cross =
+        |i: usize, level: f64| t[i] + (level - ys[i]) * (t[i + 1] - t[i]) / (ys[i + 1] - ys[i]);
+    let rise90 = (0..k)
+        .rev()
+        .find(|&i| ys[i] < 0.9 * p)
+        .map(|i| cross(i, 0.9 * p));
+    let after = |level: f64| {
+        (k + 1..ys.len())
+            .find(|&j| ys[j] < level)
+            .map(|j| cross(j - 1, level))
+    };
+    match (rise90, after(0.9 * p), after(0.1 * p)) {
+        (Some(r), Some(f90), Some(f10)) => (f90 - r, f10 - f90),
+        _ => (f64::NAN, f64::NAN),
+    }
+}
+
+/// Energy a stress history carries past a gauge in one direction, A/(ρ c0) ∫ σ² dt, J.
+fn pulse_energy_j(a: &Apparatus, t: &[f64], y: &[f64]) -> f64 {
+    let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
+    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+    a.incident.area_m2() / z * y.iter().map(|s| s * s).sum::<f64>() * dt
+}
+
+/// Aligned traces for a plot: times relative to the 10 % rise, −20 to 240 µs.
+fn aligned(t: &[f64], y: &[f64], start: f64) -> (Vec<f64>, Vec<f64>) {
+    t.iter()
+        .zip(y)
+        .filter(|(ti, _)| (-20e-6..=240e-6).contains(&(**ti - start)))
+        .map(|(ti, yi)| (ti - start, *yi))
+        .unzip()
+}
+
+/// RMS difference of the traces aligned at the 10 % rise, over the measured pulse (10 % to 10 %),
+/// relative to the measured peak.
+fn shape_rms(r: &Record, s: &Simulated) -> f64 {
+    let Some(sm) = &s.metrics else {
+        return f64::NAN;
+    };
+    let m = &r.metrics;
+    let (t0, t1) = (m.start_10_s, m.start_10_s + m.duration_10_s);
+    let idx: Vec<usize> = (0..r.time_s.len())
+        .filter(|&i| (t0..=t1).contains(&r.time_s[i]))
+        .collect();
+    let at: Vec<f64> = idx
+        .iter()
+        .map(|&i| r.time_s[i] - m.start_10_s + sm.start_10_s)
+        .collect();
+    let sim = resample(&s.time_s, &s.stress_pa, &at);
+    let ss: f64 = idx
+        .iter()
+        .zip(&sim)
+        .map(|(&i, y)| (y - r.stress_pa[i]).powi(2))
+        .sum();
+    (ss / idx.len() as f64).sqrt() / m.peak
+}
+
+fn main() {
+    let a = Apparatus::from_file(&root().join("bars/authors.toml")).expect("bars/authors.toml");
+    let ch = a
+        .gauges
+        .channel("incident")
+        .expect("incident channel")
+        .clone();
+    let records = read_records(&a);
+    let out_dir = root().join("validation/pulse");
+    std::fs::create_dir_all(&out_dir).expect("validation/pulse");
+    let only_shipped = std::env::args().any(|s| s == "--shipped");
+    let shipped = shipped_model(&a);
+    let dhe = vec![
+        ShaperKey::Diameter,
+        ShaperKey::Thickness,
+        ShaperKey::Modulus,
+    ];
+
+    // ---- Fits ----
+    let mut rows: Vec<FitRow> = Vec::new();
+    let push = |rows: &mut Vec<FitRow>,
+                (label, free): (&'static str, &'static str),
+                spec: &FitSpec,
+                (model, _, evals): (Model, f64, usize)| {
+        rows.push(FitRow {
+            label,
+            free,
+            energy: spec.energy,
+            model,
+            score: score_of(&a, &records, &model),
+            evals,
+        });
+    };
+    let mut stage1 = None;
+    let fitted = if only_shipped {
+        shipped
+    } else {
+        // Start: a small thin disc (Frew et al.'s σ0, n, m) with soft faces.
+        let start = Model {
+            velocity_m_s: [6.0, 7.0, 8.0],
+            shaper: PulseShaper {
+                diameter_m: 4.5e-3,
+                thickness_m: 0.55e-3,
+                sigma0_pa: 0.75e9,
+                n: 0.37,
+                m: 4.25,
+                youngs_modulus_pa: 5e9,
+            },
+        };
+        let spec = FitSpec {
+            gun: GunFit::Free,
+            shaper: dhe.clone(),
+            energy: true,
+        };
+        let s1 = fit(&a, &records, &spec, &start, "stage 1", 1000);
+        push(
+            &mut rows,
+            (
+                "1: one velocity per pressure",
+                "v(10), v(12.5), v(15), diameter, thickness, E",
+            ),
+            &spec,
+            s1,
+        );
+        stage1 = Some(s1.0);
+        let spec = FitSpec {
+            gun: GunFit::Linear,
+            shaper: dhe.clone(),
+            energy: true,
+        };
+        let s2 = fit(&a, &records, &spec, &s1.0, "stage 2", 700);
+        push(
+            &mut rows,
+            (
+                "2: gun line (**shipped**)",
+                "k, p_loss, diameter, thickness, E",
+            ),
+            &spec,
+            s2,
+        );
+        // Comparisons.
+        let spec = FitSpec {
+            gun: GunFit::Linear,
+            shaper: dhe.clone(),
+            energy: false,
+        };
+        let r = fit(&a, &records, &spec, &s2.0, "issue metrics only", 500);
+        push(
+            &mut rows,
+            (
+                "issue's metrics only (no energy)",
+                "k, p_loss, diameter, thickness, E",
+            ),
+            &spec,
+            r,
+        );
+        let copper = Model {
+            velocity_m_s: [8.0, 9.0, 10.0],
+            shaper: PulseShaper {
+                diameter_m: 9e-3,
+                thickness_m: 3e-3,
+                sigma0_pa: 0.75e9,
+                n: 0.37,
+                m: 4.25,
+                youngs_modulus_pa: 117e9,
+            },
+        };
+        let spec = FitSpec {
+            gun: GunFit::Linear,
+            shaper: vec![
+                ShaperKey::Diameter,
+                ShaperKey::Thickness,
+                ShaperKey::Sigma0,
+                ShaperKey::N,
+                ShaperKey::M,
+            ],
+            energy: true,
+        };
+        let r = fit(&a, &records, &spec, &copper, "copper modulus", 1000);
+        push(
+            &mut rows,
+            (
+                "copper E = 117 GPa, fixed",
+                "k, p_loss, diameter, thickness, σ0, n, m",
+            ),
+            &spec,
+            r,
+        );
+        let mut all = dhe.clone();
+        all.extend([ShaperKey::N, ShaperKey::M]);
+        let spec = FitSpec {
+            gun: GunFit::Linear,
+            shaper: all,
+            energy: true,
+        };
+        let r = fit(&a, &records, &spec, &s2.0, "n, m free", 500);
+        push(
+            &mut rows,
+            ("n, m free too", "k, p_loss, diameter, thickness, E, n, m"),
+            &spec,
+            r,
+        );
+        s2.0
+    };
+    let (m, k, loss) = if only_shipped {
+        let (k, loss) = match a.gun {
+            Gun::Linear(g) => (g.k_m2_per_s2_per_pa, g.loss_pressure_pa),
+            Gun::Adiabatic(_) => (f64::NAN, f64::NAN),
+        };
+        (shipped, k, loss)
+    } else {
+        rounded(&fitted)
+    };
+    let sims = run_model(&a, &m);
+    let sc = score(&records, &sims);
+    let same = |x: f64, y: f64| (x - y).abs() <= 1e-9 * x.abs().max(y.abs());
+    let matches_file = (0..3).all(|i| same(m.velocity_m_s[i], shipped.velocity_m_s[i]))
+        && m.shaper == shipped.shaper;
+    let toml = format!(
+        "[gun]\nmodel = \"linear\"\nk_m2_per_s2_per_pa = {k:e}\nloss_pressure_pa = {loss:e}\n\n\
+         [shaper]\ndiameter_m = {:e}\nthickness_m = {:e}\nsigma0_pa = {:e}\nn = {}\nm = {}\nyoungs_modulus_pa = {:e}",
+        m.shaper.diameter_m,
+        m.shaper.thickness_m,
+        m.shaper.sigma0_pa,
+        m.shaper.n,
+        m.shaper.m,
+        m.shaper.youngs_modulus_pa
+    );
+    println!("{toml}");
+
+    // ---- Report ----
+    let mut rep = String::new();
+    let w = &mut rep;
+    let _ = writeln!(
+        w,
+        "# Incident pulse calibration: gas gun and copper pulse shaper\n\n\
+         Generated by `cargo run --release --example calibrate_pulse` (examples/calibrate_pulse.rs, ≈ 2.5 min on two cores); do not \
+         edit by hand. `-- --shipped` evaluates bars/authors.toml without fitting.{}\n",
+        if only_shipped {
+            " **This report comes from such a run.**"
+        } else {
+            ""
+        }
+    );
+    let mut unmet: Vec<String> = Vec::new();
+    for r in &records {
+        let sm = sims[pressure_index(r.psi)]
+            .metrics
+            .expect("simulated pulse");
+        for (j, e) in errors(&r.metrics, &sm).iter().enumerate() {
+            if e.abs() > TOL[j] {
+                unmet.push(format!(
+                    "sample {} {} {:+.1} %",
+                    r.sample,
+                    METRIC_NAMES[j],
+                    100.0 * e
+                ));
+            }
+        }
+    }
+    let _ = writeln!(
+        w,
+        "**Result.** One gun line and one shaper for 10, 12.5 and 15 psi: the simulated incident gauge signal matches \
+         all 8 records within 15 % in peak and 20 % in rise (10–90 %) and in duration (at 10 % of peak): **{}**. \
+         Largest |error|/tolerance {:.2}; the pulse energy within {:.0} %.{}\n",
+        if unmet.is_empty() {
+            "every criterion met"
+        } else {
+            "NOT every criterion met"
+        },
+        sc.worst,
+        100.0 * sc.worst_energy,
+        if unmet.is_empty() {
+            String::new()
+        } else {
+            format!(" Unmet: {}.", unmet.join("; "))
+        }
+    );
+    let _ = writeln!(
+        w,
+        "## Data\n\nThe incident channel of the eight 2013-05-22 records (validation/gauge-records/data; samples 1–3 \
+         SS440c at 10/12.5/15 psi, 4–5 Al2017 at 12.5/15, 6 SS302 at 10, 7 at 15, 8 at 12.5), baseline = mean of the \
+         first {BASELINE_SAMPLES} samples, converted with the shipped `incident` channel of bars/gauges-authors.toml \
+         (`{}` bridge, gain {}: {:.3}× the stress of the authors' formula), σ = −E ε, compression positive. Metrics of the first (incident) pulse between {:.0} \
+         and {:.0} µs after the trigger, on the raw 10 MHz samples (`shpb::gauge::pulse_metrics`: largest sample; \
+         10–90 % rise; time between the rising and falling 10 % crossings), and the energy the pulse carries, \
+         A/(ρ c0) ∫σ² dt over the window.\n",
+        ch.bridge.kind.name(),
+        ch.amplifier_gain,
+        {
+            let (b, v) = (ch.bridge, -1e-4);
+            let formula = authors_stress_from_voltage(
+                v,
+                a.material.youngs_modulus_pa,
+                b.poisson_ratio,
+                b.excitation_v,
+                b.gauge_factor,
+            );
+            -a.material.youngs_modulus_pa * ch.strain_from_voltage(v) / formula
+        },
+        WINDOW_S.0 * 1e6,
+        WINDOW_S.1 * 1e6
+    );
+    let _ = writeln!(
+        w,
+        "## Model\n\n`Apparatus::pulse_chain`: striker ({:.0} mm, {:.3} kg) → Frew–Forrestal–Chen shaper \
+         (σ = σ0 εⁿ/(1 − εᵐ), area A0/(1 − ε), elastic with modulus E below that curve and on unloading) → incident \
+         bar → transmission bar pressed against it (no specimen: the incident pulse does not depend on it), {} mm \
+         cells at Courant 1, {} mm gauge grid at the incident gauge, no bar dispersion: what a `pulse` scene runs. The \
+         noise-free gauge strain is sampled at 10 MHz and its metrics computed like the records'.\n",
+        a.striker.length_m * 1e3,
+        a.striker_mass_kg(),
+        CELL_M * 1e3,
+        GAUGE_LENGTH_M * 1e3
+    );
+    let s = &m.shaper;
+    let peak_force =
+        |i: usize| sims[i].metrics.map(|p| p.peak).unwrap_or(f64::NAN) * a.incident.area_m2();
+    let (eps_y, eps_max15) = shaper_strains(s, peak_force(2));
+    let (_, eps_max10) = shaper_strains(s, peak_force(0));
+    let _ = writeln!(
+        w,
+        "## Calibrated parameters (in bars/authors.toml)\n\n\
+         | parameter | value | how |\n|---|---|---|\n\
+         | `[gun] model` | linear, v² = k (p − p_loss) | |\n\
+         | `k_m2_per_s2_per_pa` | {k:.4e} | fitted (stage 2) |\n\
+         | `loss_pressure_pa` | {loss:.0} ({:.2} psi) | fitted (stage 2) |\n\
+         | striker velocity at 10 / 12.5 / 15 psi | {:.3} / {:.3} / {:.3} m/s | from the line |\n\
+         | `[shaper] diameter_m` | {:.4e} | fitted |\n\
+         | `thickness_m` | {:.4e} | fitted |\n\
+         | `sigma0_pa` | {:.4e} | Frew et al., fixed: with E free only σ0·A0 and E·A0 enter the force, so σ0 and the diameter are not separately identifiable |\n\
+         | `n` | {} | Frew et al., fixed |\n\
+         | `m` | {} | Frew et al., fixed |\n\
+         | `youngs_modulus_pa` | {:.4e} | fitted: **not copper's 117 GPa** but {:.0}× lower (see below) |\n",
+        loss / PSI_PA,
+        m.velocity_m_s[0],
+        m.velocity_m_s[1],
+        m.velocity_m_s[2],
+        s.diameter_m,
+        s.thickness_m,
+        s.sigma0_pa,
+        s.n,
+        s.m,
+        s.youngs_modulus_pa,
+        117e9 / s.youngs_modulus_pa,
+    );
+    // Share of the striker's energy the shaper keeps (dissipates) by the end of the run, %.
+    let kept: Vec<f64> = (0..3)
+        .map(|i| {
+            100.0 * sims[i].shaper_work_j / (0.5 * a.striker_mass_kg() * m.velocity_m_s[i].powi(2))
+        })
+        .collect();
+    let (kept_lo, kept_hi) = (
+        kept.iter().cloned().fold(f64::INFINITY, f64::min),
+        kept.iter().cloned().fold(0.0, f64::max),
+    );
+    let _ = writeln!(
+        w,
+        "**What the fitted shaper is.** With E = {:.2} GPa the elastic line meets Frew's flow curve only at ε = {:.2}; \
+         the largest strain on loading is ε ≈ {:.2} at 10 psi and {:.2} at 15 psi (from the peak force, {:.1} / {:.1} kN). \
+         So the disc is {} — a soft, stiffening cushion F = E A0 ε/(1 − ε) rather than a plastically flattened copper \
+         disc: it keeps only {kept_lo:.0}–{kept_hi:.0} % of the striker's energy (shaper work below) and the striker bounces back. Read E as the compliance of \
+         the disc's faces and of the contacts (rough, not quite parallel faces; indentation of the striker and bar \
+         ends) in series with the disc, which the model can only put into the disc's one modulus, for loading and \
+         unloading alike. A copper modulus cannot reproduce the records (comparison fits below).\n",
+        s.youngs_modulus_pa / 1e9,
+        eps_y,
+        eps_max10,
+        eps_max15,
+        peak_force(0) / 1e3,
+        peak_force(2) / 1e3,
+        if eps_max15 <= eps_y {
+            "elastic throughout".to_string()
+        } else if eps_max10 <= eps_y {
+            format!(
+                "elastic at 10 psi and only just plastic at 15 psi (ε − ε_y = {:.2})",
+                eps_max15 - eps_y
+            )
+        } else {
+            format!(
+                "plastic beyond ε = {:.2} at every pressure, but mostly elastic",
+                eps_y
+            )
+        }
+    );
+    let _ = writeln!(
+        w,
+        "As TOML (4 significant digits, p_loss to 10 Pa; every table below uses these rounded values):\n\n```toml\n{toml}\n```\n\n{}\n",
+        if matches_file {
+            "bars/authors.toml holds exactly these values.".to_string()
+        } else {
+            let o = score_of(&a, &records, &shipped);
+            format!(
+                "**bars/authors.toml holds different values** (largest |error|/tolerance {:.2} with them): copy the block above into it.",
+                o.worst
+            )
+        }
+    );
+    if !rows.is_empty() {
+        let _ = writeln!(
+            w,
+            "## How it was fitted\n\nNelder–Mead simplex (written in the example; restarted from the best point with a \
+             smaller simplex until it stops improving) on the logarithms of the free parameters, bounded by a penalty \
+             (diameter 1–19 mm, thickness 0.2–8 mm, σ0 0.05–3 GPa, E 0.5–130 GPa, n 0.1–0.8, m 1.5–10, \
+             0 ≤ p_loss < the gun's smallest pressure, velocities 0.5–100 m/s). The three pressures are simulated in \
+             parallel (rayon).\n\n\
+             **Objective**: Σ over the 8 records of (relative error / tolerance)² of peak (15 %), rise (20 %), \
+             duration (20 %) — the issue's metrics — **and of the pulse energy (20 %)**. The energy term is ours: the \
+             three metrics alone leave the pulse's body free, and their best fit (row *issue's metrics only*) has \
+             pulses up to {:.0} % off the records' energy{}; with it, the gun calibration is tied to the energy the \
+             striker must deliver, and the shape improves (shape RMS below), at some cost in the margin on the \
+             issue's metrics.\n\n\
+             σ0 = 0.75 GPa, n = 0.37, m = 4.25 (Frew et al.) unless said. Stage 1 starts from a 4.5 mm × 0.55 mm disc \
+             with E = 5 GPa at 6 / 7 / 8 m/s and frees one striker velocity per pressure; stage 2 starts from stage 1 \
+             and ties the velocities to the gun law, with the velocities at 10 and 15 psi as parameters (k and p_loss \
+             follow; 12.5 psi lies on the line): the shipped values. The other rows are comparisons in stage-2 form.\n\n\
+             | fit | free | energy in objective | objective | max \\|err\\|/tol (issue) | max \\|energy err\\| | v 10 / 12.5 / 15 psi (m/s) | diameter (mm) | thickness (mm) | σ0 (GPa) | E (GPa) | n, m | evaluations |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|---|",
+            100.0
+                * rows
+                    .iter()
+                    .find(|r| !r.energy)
+                    .map(|r| r.score.worst_energy)
+                    .unwrap_or(f64::NAN),
+            {
+                // Pressures where that fit's striker has less energy than the records' pulses carry.
+                let short: Vec<String> = rows
+                    .iter()
+                    .find(|r| !r.energy)
+                    .map(|r| {
+                        PRESSURES_PSI
+                            .iter()
+                            .enumerate()
+                            .filter(|&(i, &psi)| {
+                                let ke =
+                                    0.5 * a.striker_mass_kg() * r.model.velocity_m_s[i].powi(2);
+                                let group: Vec<f64> = records
+                                    .iter()
+                                    .filter(|x| x.psi == psi)
+                                    .map(|x| x.energy_j)
+                                    .collect();
+                                ke < group.iter().sum::<f64>() / group.len() as f64
+                            })
+                            .map(|(_, psi)| format!("{psi}"))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                if short.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        " and, at {} psi, a striker with less kinetic energy than the records' pulses carry \
+                         (impossible for the real gun)",
+                        short.join(" and ")
+                    )
+                }
+            }
+        );
+        for r in &rows {
+            let s = &r.model.shaper;
+            let _ = writeln!(
+                w,
+                "| {} | {} | {} | {:.3} | {:.2} | {:.0} % | {:.2} / {:.2} / {:.2} | {:.3} | {:.3} | {:.3} | {:.2} | {:.3}, {:.3} | {} |",
+                r.label,
+                r.free,
+                if r.energy { "yes" } else { "no" },
+                r.score.objective(r.energy),
+                r.score.worst,
+                100.0 * r.score.worst_energy,
+                r.model.velocity_m_s[0],
+                r.model.velocity_m_s[1],
+                r.model.velocity_m_s[2],
+                s.diameter_m * 1e3,
+                s.thickness_m * 1e3,
+                s.sigma0_pa / 1e9,
+                s.youngs_modulus_pa / 1e9,
+                s.n,
+                s.m,
+                r.evals
+            );
+        }
+        let total: usize = rows.iter().map(|r| r.evals).sum();
+        let _ = writeln!(w, "\n{total} evaluations in all.\n");
+        let find = |label: &str| rows.iter().find(|r| r.label.starts_with(label));
+        if let (Some(c), Some(nm)) = (find("copper"), find("n, m")) {
+            let _ = writeln!(
+                w,
+                "Reading the comparisons: with copper's modulus no disc passes (largest |error|/tolerance {:.2}; \
+                 the thickness runs to {:.1} mm and σ0, n, m wander from Frew's values). Freeing n and m as well as E lowers the \
+                 objective ({:.2} against {:.2}) only by driving them to n = {:.2}, m = {:.2}, at or near their \
+                 bounds and far from annealed copper (Frew: 0.37, 4.25), so they stay at Frew's values. The objective is flat along a valley: \
+                 started from E = 10 GPa instead, the same fit ended at E = 1.17 GPa, diameter 4.73 mm, thickness \
+                 0.474 mm, 5.59 / 6.67 / 7.60 m/s, with a slightly lower objective (3.17) but less margin (largest \
+                 |error|/tolerance 0.92); the shaper's parameters are an effective description, not a measurement \
+                 of the disc.\n",
+                c.score.worst,
+                c.model.shaper.thickness_m * 1e3,
+                nm.score.objective(true),
+                rows[1].score.objective(true),
+                nm.model.shaper.n,
+                nm.model.shaper.m
+            );
+        }
+    }
+    if let Some(s1) = stage1 {
+        let v = s1.velocity_m_s;
+        let (kl, ll, res) = least_squares_gun(&v);
+        let _ = writeln!(
+            w,
+            "**Gun law.** Stage 1's free velocities {:.3} / {:.3} / {:.3} m/s at 10 / 12.5 / 15 psi; least-squares \
+             line v² = k (p − p_loss) through them: k = {kl:.4e} m²/s²/Pa, p_loss = {:.1} kPa ({:.2} psi); residuals \
+             of v {:+.3} / {:+.3} / {:+.3} m/s ({:+.2} / {:+.2} / {:+.2} %). The three pressures lie on one line to \
+             that accuracy, far inside what the metrics resolve (1 % in v moves the peak by ≈ 1 %), and tying them to \
+             it costs little (stage 2 vs stage 1). p_loss rests on three pressures spanning 10–15 psi and is the least \
+             determined parameter.\n",
+            v[0],
+            v[1],
+            v[2],
+            ll / 1e3,
+            ll / PSI_PA,
+            res[0],
+            res[1],
+            res[2],
+            100.0 * res[0] / v[0],
+            100.0 * res[1] / v[1],
+            100.0 * res[2] / v[2],
+        );
+    }
+
+    // ---- Per sample ----
+    let _ = writeln!(
+        w,
+        "## Per sample\n\nErrors are (simulated − measured)/measured; pass = within 15 % (peak), 20 % (rise, \
+         duration). Overlays: validation/pulse/sample<N>.png (stress against time from each trace's 10 % rise; \
+         record dashed).\n\n\
+         | sample | material | psi | v (m/s) | peak meas. / sim. (MPa) | error | rise meas. / sim. (µs) | error | duration meas. / sim. (µs) | error | all pass | energy meas. / sim. (J) | error |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let mut shape_rows = String::new();
+    for r in &records {
+        let i = pressure_index(r.psi);
+        let s = &sims[i];
+        let sm = s.metrics.expect("simulated pulse");
+        let err = errors(&r.metrics, &sm);
+        let flag = |j: usize| {
+            if err[j].abs() <= TOL[j] {
+                format!("{:+.1} %", 100.0 * err[j])
+            } else {
+                format!("**{:+.1} % FAIL**", 100.0 * err[j])
+            }
+        };
+        let pass = (0..3).all(|j| err[j].abs() <= TOL[j]);
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {:.2} | {} / {} | {} | {} / {} | {} | {} / {} | {} | {} | {:.2} / {:.2} | {:+.1} % |",
+            r.sample,
+            r.material,
+            r.psi,
+            m.velocity_m_s[i],
+            mpa(r.metrics.peak),
+            mpa(sm.peak),
+            flag(0),
+            us(r.metrics.rise_10_90_s),
+            us(sm.rise_10_90_s),
+            flag(1),
+            us(r.metrics.duration_10_s),
+            us(sm.duration_10_s),
+            flag(2),
+            if pass { "yes" } else { "**no**" },
+            r.energy_j,
+            s.energy_j,
+            100.0 * (s.energy_j / r.energy_j - 1.0)
+        );
+        let (pm, fm) = plateau_and_fall(&r.time_s, &r.stress_pa);
+        let (ps, fs) = plateau_and_fall(&s.time_s, &s.stress_pa);
+        let _ = writeln!(
+            shape_rows,
+            "| {} | {} | {} / {} | {} / {} | {:.1} % |",
+            r.sample,
+            r.psi,
+            us(pm),
+            us(ps),
+            us(fm),
+            us(fs),
+            100.0 * shape_rms(r, s)
+        );
+        let (tm, ym) = aligned(&r.time_s, &r.stress_pa, r.metrics.start_10_s);
+        let (ts, ys) = aligned(&s.time_s, &s.stress_pa, sm.start_10_s);
+        let title = format!(
+            "Sample {} ({}), {} psi: incident gauge, aligned at the 10 % rise",
+            r.sample, r.material, r.psi
+        );
+        xy_plot(
+            &out_dir.join(format!("sample{}.png", r.sample)),
+            true,
+            &Axes {
+                title: &title,
+                x_label: "time from the 10 % rise (µs)",
+                y_label: "bar stress, compression positive (MPa)",
+                x_scale: 1e6,
+                y_scale: 1e-6,
+            },
+            &[
+                Curve {
+                    label: format!("record, sample {}", r.sample),
+                    x: &tm,
+                    y: &ym,
+                    measured: true,
+                },
+                Curve {
+                    label: format!("simulated, v = {:.2} m/s", m.velocity_m_s[i]),
+                    x: &ts,
+                    y: &ys,
+                    measured: false,
+                },
+            ],
+        )
+        .expect("plot");
+    }
+    let _ = writeln!(
+        w,
+        "\nShape beyond the three metrics (on an 11-sample moving average of both traces): time spent above 90 % of \
+         the peak, fall from 90 % to 10 % after the peak, and the RMS difference of the traces aligned at the 10 % \
+         rise over the measured pulse, relative to the measured peak.\n\n\
+         | sample | psi | above 90 % meas. / sim. (µs) | fall 90→10 % meas. / sim. (µs) | shape RMS |\n|---|---|---|---|---|\n{shape_rows}"
+    );
+
+    // ---- Scatter ----
+    let _ = writeln!(
+        w,
+        "## Scatter between records at the same pressure\n\nMean and half-range (relative to the mean) of the measured \
+         metrics at each pressure, against the simulation. The scatter is the floor any one-parameter-set calibration \
+         faces: a simulation at the mean still errs by the half-range on the extreme records.\n\n\
+         | psi | samples | metric | measured | mean | ± half-range | simulated | sim. vs mean |\n|---|---|---|---|---|---|---|---|"
+    );
+    for (i, &psi) in PRESSURES_PSI.iter().enumerate() {
+        let group: Vec<&Record> = records.iter().filter(|r| r.psi == psi).collect();
+        let sm = sims[i].metrics.expect("simulated pulse");
+        let names: Vec<String> = group.iter().map(|r| r.sample.to_string()).collect();
+        for j in 0..4 {
+            let get_m = |p: &PulseMetrics| match j {
+                0 => p.peak / 1e6,
+                1 => p.rise_10_90_s * 1e6,
+                _ => p.duration_10_s * 1e6,
+            };
+            let vals: Vec<f64> = group
+                .iter()
+                .map(|r| {
+                    if j == 3 {
+                        r.energy_j
+                    } else {
+                        get_m(&r.metrics)
+                    }
+                })
+                .collect();
+            let simv = if j == 3 { sims[i].energy_j } else { get_m(&sm) };
+            let mean = vals.iter().sum::<f64>() / vals.len() as f64;
+            let (lo, hi) = vals
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            let name = match j {
+                0 => "peak (MPa)",
+                1 => "rise 10–90 % (µs)",
+                2 => "duration at 10 % (µs)",
+                _ => "pulse energy (J)",
+            };
+            let prec = if j == 3 { 2 } else { 1 };
+            let _ = writeln!(
+                w,
+                "| {psi} | {} | {name} | {} | {mean:.prec$} | {:.1} % | {simv:.prec$} | {:+.1} % |",
+                names.join(", "),
+                vals.iter()
+                    .map(|v| format!("{v:.prec$}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                50.0 * (hi - lo) / mean,
+                100.0 * (simv / mean - 1.0)
+            );
+        }
+    }
+
+    // ---- Energy and momentum ----
+    let _ = writeln!(
+        w,
+        "\n## Energy and momentum\n\nStriker kinetic energy; energy of the incident pulse A/(ρ c0) ∫σ² dt (simulated; \
+         mean of the records at that pressure); work left in the shaper at the end; striker velocity after the pulse \
+         (negative: it bounces back).\n\n\
+         | psi | v (m/s) | striker energy (J) | pulse energy sim. / records (J) | shaper work (J) | v after (m/s) |\n|---|---|---|---|---|---|"
+    );
+    for (i, &psi) in PRESSURES_PSI.iter().enumerate() {
+        let s = &sims[i];
+        let group: Vec<&Record> = records.iter().filter(|r| r.psi == psi).collect();
+        let meas = group.iter().map(|r| r.energy_j).sum::<f64>() / group.len() as f64;
+        let ke = 0.5 * a.striker_mass_kg() * m.velocity_m_s[i].powi(2);
+        let _ = writeln!(
+            w,
+            "| {psi} | {:.2} | {ke:.2} | {:.2} / {meas:.2} | {:.2} | {:+.2} |",
+            m.velocity_m_s[i], s.energy_j, s.shaper_work_j, s.striker_final_velocity_m_s
+        );
+    }
+
+    // ---- Numerical sensitivity ----
+    let _ = writeln!(
+        w,
+        "\n## Numerical sensitivity\n\nLargest change of any record's relative error (peak, rise, duration) when the \
+         calibrated model is run on a finer grid or read with a point gauge, in percentage points:\n\n\
+         | run | peak | rise | duration |\n|---|---|---|---|"
+    );
+    for (label, cell, gauge) in [
+        ("0.5 mm cells, 2 mm gauge", 0.5e-3, GAUGE_LENGTH_M),
+        ("1 mm cells, point gauge", CELL_M, 0.0),
+    ] {
+        let alt = run_model_with(&a, &m, cell, gauge);
+        let mut d = [0.0f64; 3];
+        for r in &records {
+            let i = pressure_index(r.psi);
+            let (Some(x), Some(y)) = (&sims[i].metrics, &alt[i].metrics) else {
+                continue;
+            };
+            let (e0, e1) = (errors(&r.metrics, x), errors(&r.metrics, y));
+            for j in 0..3 {
+                d[j] = d[j].max((e1[j] - e0[j]).abs());
+            }
+        }
+        let _ = writeln!(
+            w,
+            "| {label} | {:.2} | {:.2} | {:.2} |",
+            100.0 * d[0],
+            100.0 * d[1],
+            100.0 * d[2]
+        );
+    }
+
+    // ---- Scale invariance ----
+    let _ = writeln!(
+        w,
+        "\n## Scale invariance (the bridge question)\n\nThe shaper is a massless spring between linear bars, so scaling \
+         the striker velocity by s, the shaper area by s (diameter by √s) and its thickness by s, with σ0, n, m and E \
+         unchanged, scales every force, displacement and velocity by s and leaves the disc's strain history, hence the \
+         pulse shape, unchanged: the stress scales by exactly s (tests/pulse_calibration.rs checks it). Should the \
+         records be read at s times the reading used here, the calibration is k × s², the same p_loss, diameter × √s, \
+         thickness × s:\n\n\
+         | reading | s | k (m²/s²/Pa) | v at 10 / 15 psi (m/s) | diameter (mm) | thickness (mm) |\n|---|---|---|---|---|---|"
+    );
+    for (name, s) in [
+        (
+            "half the authors' formula (the gauge file's, used here)",
+            1.0,
+        ),
+        (
+            "the authors' formula literally (`amplifier_gain = 1.0`)",
+            2.0,
+        ),
+        (
+            "a half bridge, as the authors describe it (`half-poisson`, gain 1)",
+            4.0,
+        ),
+    ] {
+        let _ = writeln!(
+            w,
+            "| {name} | {s:.3} | {:.4e} | {:.2} / {:.2} | {:.3} | {:.3} |",
+            k * s * s,
+            m.velocity_m_s[0] * s,
+            m.velocity_m_s[2] * s,
+            m.shaper.diameter_m * 1e3 * s.sqrt(),
+            m.shaper.thickness_m * 1e3 * s
+        );
+    }
+    let _ = writeln!(w, "\n{}", NOTES.trim());
+    std::fs::write(out_dir.join("REPORT.md"), rep).expect("REPORT.md");
+    eprintln!(
+        "max |err|/tol {:.3}, max energy error {:.3}; wrote {}",
+        sc.worst,
+        sc.worst_energy,
+        out_dir.join("REPORT.md").display()
+    );
+}
+
+/// What the model misses: written from the overlays of the shipped calibration (the numbers are
+/// in the tables above; re-read them if the calibration changes).
+const NOTES: &str = "
+## What the model misses
+
+Written from the overlays (validation/pulse/sample<N>.png) of the shipped calibration.
+
+* **The flat top.** At 12.5 and 15 psi the records hold ≥ 90 % of their peak for 35–47 µs, often after a
+  shoulder near 90 % on the rise; the model's top is rounded (≈ 30 µs above 90 %) and overshoots the 15 psi
+  plateau by 6–8 %. A disc flowing plastically with little hardening would give such a plateau; the soft,
+  mostly elastic cushion the fit needs does not.
+* **The toe.** Most records step to ≈ 10–20 MPa within a few µs and then pause or rise more slowly
+  (clearest in samples 1, 6 and 8); the model rises steadily from the start. Where the pause is long the
+  simulated rise is short: sample 6 −15 %, sample 8 −7 %, and at 10 psi ≈ 11 % below the two records' mean.
+  The records' own rise times scatter by ± 5–9 % at one pressure.
+* **The slow tail.** Every record keeps a low tail, ≈ 3–10 MPa, for 40–60 µs after its main fall; the
+  simulated pulse ends abruptly when the striker leaves the shaper. The duration at 10 % of peak is matched
+  by a longer, smoother body instead; at 15 psi the records' main fall (46–59 µs from 90 % to 10 %) is
+  faster than the model's (≈ 64 µs).
+* **The energy budget.** The fitted cushion gives most of its energy back: the shaper keeps ≈ 10 % of the
+  striker's energy and the striker bounces back at ≈ 40 % of its impact speed. A real annealed copper disc
+  flattened to ε ≈ 0.6 would dissipate far more and stop the striker, so the real gun would have to give
+  more energy than k says. The gun calibration rests on the pulse energy the records carry plus a rebound
+  nobody measured; the striker's speed (light gates) or the shaper's final thickness would pin k and decide
+  between this cushion and a dissipative disc.
+* **Why not copper.** With E = 117 GPa the disc unloads at once, the pulse ends soon after the striker stops,
+  and the rise time grows with pressure where the records' falls (58.6 → 47.8 → 42.1 µs): fit *copper* above
+  fails (largest |error|/tolerance > 1) even with σ0, n, m and the thickness free. Reproducing the records
+  with a real copper disc needs a compliance in series with it (faces, contacts) that the shaper model does
+  not have: the fitted E stands for it.
+";
