@@ -193,9 +193,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             no_dispersion,
             force,
         } => {
-            if !bars.is_file() {
-                load_apparatus(&bars)?;
-            }
+            require_bars_file(&bars)?;
             crate::reduce::reduce_command(
                 &record,
                 &bars,
@@ -229,6 +227,12 @@ fn say(line: &str) -> Result<()> {
 
 /// Reads a bar set-up file named on the command line.
 fn load_apparatus(bars: &Path) -> Result<crate::apparatus::Apparatus> {
+    require_bars_file(bars)?;
+    crate::apparatus::Apparatus::from_file(bars)
+}
+
+/// Names `--bars` and what is allowed when the set-up file named on the command line is missing.
+fn require_bars_file(bars: &Path) -> Result<()> {
     if !bars.is_file() {
         return Err(Error::Input {
             file: "command line".into(),
@@ -237,7 +241,7 @@ fn load_apparatus(bars: &Path) -> Result<crate::apparatus::Apparatus> {
             allowed: "a bar set-up .toml file such as bars/authors.toml".into(),
         });
     }
-    crate::apparatus::Apparatus::from_file(bars)
+    Ok(())
 }
 
 fn gun(pressure: &str, bars: &Path) -> Result<()> {
