@@ -57,7 +57,8 @@ build: deps
 demo: build
 	@$(BIN) run $(DEMO_SCENE) -o $(DEMO_H5) --plot $(DEMO_PNG) --force > demo-summary.txt
 	@echo "demo: SS440c spheres, 10 psi ($(DEMO_SCENE))"
-	@grep -E "peak_contact_force|displacement_at_peak_contact_force|equilibrium_ratio|peak_back_force|displacement_at_peak_back_force" demo-summary.txt || true
+	@grep -E "^result: " demo-summary.txt | sed 's/^result: /  /'
+	@grep -E "^ +energy_balance_max_relative_error " demo-summary.txt
 	@rm -f demo-summary.txt
 	@echo "  HDF5: $(abspath $(DEMO_H5))"
 	@echo "  plot: $(abspath $(DEMO_PNG))"

@@ -303,6 +303,8 @@ fn strain(
         energy: Vec::new(),
         bars: Vec::new(),
         summary: Vec::new(),
+        reduction: None,
+        warnings: Vec::new(),
     };
     let text = format!(
         "record = \"{}\"\nbars = \"{}\"\n",
@@ -340,10 +342,11 @@ fn run(
         check_output(p, force)?;
     }
     let params = Params::from_file(scene)?;
-    for w in params.warnings() {
+    let mut out = params.run()?;
+    out.warnings.splice(0..0, params.warnings());
+    for w in &out.warnings {
         eprintln!("shpb: warning: {w}");
     }
-    let out = params.run()?;
     print_summary(&params, &out)?;
     if let Some(p) = output {
         write_hdf5(p, force, &params.text, &out)?;
@@ -379,6 +382,18 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
         text.push_str(&format!(
             "  {:<40} {:>14.6e} {}\n",
             it.key, it.value, it.unit
+        ));
+    }
+    if let (Some(c), Some(r)) = (&out.contact, &out.reduction) {
+        let k = c.peak_index();
+        text.push_str(&format!(
+            "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
+             displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
+            c.force_n[k] * 1e-3,
+            r.peak_back_force_n * 1e-3,
+            c.displacement_m[k] * 1e6,
+            r.displacement_at_peak_force_m * 1e6,
+            r.equilibrium_ratio_at_peak
         ));
     }
     match w.write_all(text.as_bytes()).and_then(|_| w.flush()) {
@@ -489,12 +504,20 @@ fn plot_test(
         x_scale: 1e6,
         y_scale: 1e-6,
     };
-    let fd_curves = vec![Curve {
+    let mut fd_curves = vec![Curve {
         label: "true contact (simulation)".into(),
         x: &contact.displacement_m,
         y: &contact.force_n,
         measured: false,
     }];
+    if let Some(r) = &out.reduction {
+        fd_curves.push(Curve {
+            label: "reduced from the gauges (back force)".into(),
+            x: &r.displacement_m,
+            y: &r.force_back_n,
+            measured: true,
+        });
+    }
     let fd_axes = Axes {
         title: "force against sphere approach",
         x_label: "sphere approach δ (mm)",

@@ -224,6 +224,10 @@ pub struct RunOutput {
     pub bars: Vec<crate::solver::pulse::BarSnapshots>,
     /// Scalar results (attributes of `/summary`).
     pub summary: Vec<SummaryItem>,
+    /// The lab's reduction of the simulated gauge records (`/reduction/*`), full SHPB tests only.
+    pub reduction: Option<crate::reduce::Reduction>,
+    /// Things the user should know about the run (`/summary` attribute `warnings`, one per line).
+    pub warnings: Vec<String>,
 }
 
 /// One recorded gauge channel: bar strain and the digitised voltage on the `/time` axis.
@@ -247,6 +251,8 @@ impl RunOutput {
             energy: Vec::new(),
             bars: Vec::new(),
             summary,
+            reduction: None,
+            warnings: Vec::new(),
         }
     }
 }
@@ -355,6 +361,12 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
                 )?;
             }
         }
+        if let Some(r) = &out.reduction {
+            let g = f.create_group("reduction").map_err(h5err(path))?;
+            for (name, data, units, _) in crate::reduce::reduction_columns(r) {
+                write_dataset(&g, name, data, units, path)?;
+            }
+        }
         if !out.energy.is_empty() {
             let g = f.create_group("energy").map_err(h5err(path))?;
             for (name, data) in &out.energy {
@@ -380,6 +392,7 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
                 .join(", "),
             path,
         )?;
+        string_attr(&s, "warnings", &out.warnings.join("\n"), path)?;
         f.close().map_err(h5err(path))
     })
 }

@@ -846,6 +846,21 @@ fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) ->
         energy.push(("contact".into(), contact_work));
     }
     energy.push(("total".into(), total));
+    let mut warnings = Vec::new();
+    let reduction = match &options.specimen {
+        Some(spec) => match reduce_simulated_records(apparatus, options, spec, &t, &gauges) {
+            Ok(red) => {
+                summary.extend(reduced_summary(&red));
+                warnings.extend(red.warnings.iter().map(|w| format!("reduction: {w}")));
+                Some(red)
+            }
+            Err(e) => {
+                warnings.push(format!("reduction of the simulated records failed: {e}"));
+                None
+            }
+        },
+        None => None,
+    };
     Ok(RunOutput {
         contact: r.contact,
         time_s: Some(t),
@@ -853,7 +868,80 @@ fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) ->
         energy,
         bars: r.snapshots,
         summary,
+        reduction,
+        warnings,
     })
+}
+
+/// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
+/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
+/// < 0.02 % of its peak.
+pub const SIMULATED_RECORD_SMOOTHING_S: f64 = 2e-6;
+
+/// The lab's reduction of a simulated test: the digitised voltages read back through each
+/// channel's bridge (as the lab gets them), dispersion correction only when the bars disperse.
+fn reduce_simulated_records(
+    apparatus: &Apparatus,
+    options: &PulseOptions,
+    spec: &crate::apparatus::SpecimenSetup,
+    time_s: &[f64],
+    gauges: &[crate::io::GaugeTrace],
+) -> Result<crate::reduce::Reduction> {
+    let strain = |name: &str| -> Result<Vec<f64>> {
+        let trace = gauges.iter().find(|g| g.name == name);
+        let channel = apparatus.gauges.channel(name);
+        match (trace, channel) {
+            (Some(g), Some(ch)) => Ok(ch.strains_from_voltages(&g.voltage_v)),
+            _ => Err(Error::Input {
+                file: apparatus.source.clone(),
+                key: "gauges".into(),
+                problem: format!("no `{name}` gauge channel to reduce"),
+                allowed: "channels named incident and transmission".into(),
+            }),
+        }
+    };
+    let input = crate::reduce::ReductionInput {
+        time_s: time_s.to_vec(),
+        incident_strain: strain("incident")?,
+        transmission_strain: strain("transmission")?,
+    };
+    let reduction_options = crate::reduce::ReductionOptions {
+        dispersion_correction: options.dispersion != Dispersion::None,
+        specimen_radii_m: Some((spec.pair.sphere1.radius_m, spec.pair.sphere2.radius_m)),
+        smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
+        ..Default::default()
+    };
+    crate::reduce::reduce(
+        &input,
+        &crate::reduce::ReductionSetup::from_apparatus(apparatus)?,
+        &reduction_options,
+    )
+}
+
+/// Summary items of the reduction of a simulated test (`reduced_*`).
+fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
+    let mut v = vec![
+        item("reduced_peak_back_force", r.peak_back_force_n, "N"),
+        item("reduced_peak_front_force", r.peak_front_force_n, "N"),
+        item(
+            "reduced_displacement_at_peak_force",
+            r.displacement_at_peak_force_m,
+            "m",
+        ),
+        item(
+            "reduced_equilibrium_ratio_at_peak",
+            r.equilibrium_ratio_at_peak,
+            "1",
+        ),
+    ];
+    if let Some(rate) = &r.strain_rate_per_s {
+        v.push(item(
+            "reduced_peak_strain_rate",
+            rate.iter().copied().fold(0.0, f64::max),
+            "1/s",
+        ));
+    }
+    v
 }
 
 /// Linear interpolation of (t, y) at the times `at` (end values held outside).

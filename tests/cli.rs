@@ -640,3 +640,98 @@ fn curve_prints_header_and_101_rows() {
     );
     assert!(rows[100].1 > 0.0);
 }
+
+/// Every dataset under `group`, recursively, as (path, dataset).
+fn datasets(group: &hdf5::Group, prefix: &str, out: &mut Vec<(String, hdf5::Dataset)>) {
+    for name in group.member_names().unwrap() {
+        let path = format!("{prefix}/{name}");
+        if let Ok(ds) = group.dataset(&name) {
+            out.push((path, ds));
+        } else if let Ok(g) = group.group(&name) {
+            datasets(&g, &path, out);
+        }
+    }
+}
+
+/// The full SS440c test writes the documented HDF5 layout (README, "HDF5 layout"): every
+/// dataset with a `units` attribute, the reduction of the simulated records beside the true
+/// contact (round trip through bridge, amplifier, noise and digitiser within 2 %), the energy
+/// ledger and the x–t snapshots; `/summary` carries `warnings`.
+#[test]
+fn full_test_writes_the_documented_hdf5_layout() {
+    let dir = TempDir::new().unwrap();
+    let scene = format!(
+        "{}/scenes/shpb-ss440c-10psi.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = shpb(
+        dir.path(),
+        &["run", &scene, "-o", "out.h5", "--plot", "out.png"],
+    );
+    assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+    assert!(dir.path().join("out.png").is_file());
+    let f = hdf5::File::open(dir.path().join("out.h5")).expect("open output");
+    assert_eq!(string_attr(&f, "shpb_version"), env!("CARGO_PKG_VERSION"));
+    assert_eq!(
+        string_attr(&f, "scene"),
+        std::fs::read_to_string(&scene).unwrap()
+    );
+    let mut all = Vec::new();
+    datasets(&f.group("/").unwrap(), "", &mut all);
+    let names: Vec<&str> = all.iter().map(|(p, _)| p.as_str()).collect();
+    for required in [
+        "/time",
+        "/gauges/incident/strain",
+        "/gauges/incident/voltage",
+        "/gauges/transmission/strain",
+        "/gauges/transmission/voltage",
+        "/contact/time",
+        "/contact/displacement",
+        "/contact/force",
+        "/reduction/time",
+        "/reduction/displacement",
+        "/reduction/force_front",
+        "/reduction/force_back",
+        "/reduction/strain_rate",
+        "/energy/striker",
+        "/energy/bars",
+        "/energy/shaper",
+        "/energy/contact",
+        "/energy/total",
+        "/bars/incident/snapshots",
+        "/bars/transmission/snapshots",
+    ] {
+        assert!(
+            names.contains(&required),
+            "{required} missing from {names:?}"
+        );
+    }
+    for (path, ds) in &all {
+        let units = string_attr(ds, "units");
+        assert!(!units.is_empty(), "{path} has empty units");
+        let v: Vec<f64> = ds.read_raw().unwrap();
+        assert!(!v.is_empty() && v.iter().all(|x| x.is_finite()), "{path}");
+    }
+    let n_time = f.dataset("time").unwrap().size();
+    for g in ["incident", "transmission"] {
+        assert_eq!(
+            f.dataset(&format!("gauges/{g}/voltage")).unwrap().size(),
+            n_time
+        );
+    }
+    let snap = f.dataset("bars/incident/snapshots").unwrap();
+    assert_eq!(snap.ndim(), 2, "snapshots are a time × x field");
+    let summary = f.group("summary").unwrap();
+    let _ = string_attr(&summary, "warnings");
+    let attr = |k: &str| -> f64 { summary.attr(k).unwrap().read_scalar().unwrap() };
+    let (f_true, d_true) = (
+        attr("peak_contact_force"),
+        attr("displacement_at_peak_contact_force"),
+    );
+    let (f_red, d_red) = (
+        attr("reduced_peak_back_force"),
+        attr("reduced_displacement_at_peak_force"),
+    );
+    assert!((f_red / f_true - 1.0).abs() < 0.02, "{f_red} vs {f_true}");
+    assert!((d_red / d_true - 1.0).abs() < 0.02, "{d_red} vs {d_true}");
+}

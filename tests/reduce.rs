@@ -808,6 +808,8 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
         energy: Vec::new(),
         bars: Vec::new(),
         summary: Vec::new(),
+        reduction: None,
+        warnings: Vec::new(),
     };
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run.h5");
