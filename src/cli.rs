@@ -76,6 +76,41 @@ pub enum Command {
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
+        /// Fidelity preset (wins over the scene's `fidelity`; explicit knobs in the scene win
+        /// over both).
+        #[arg(long, value_enum)]
+        fidelity: Option<crate::fidelity::Fidelity>,
+    },
+    /// Run a scene on a ladder of resolutions: error of each level against the finest, run
+    /// time, observed order of convergence and Richardson extrapolation.
+    Convergence {
+        /// The scene TOML file (collision, force-driven, pulse or shpb).
+        scene: PathBuf,
+        /// CSV table output.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// PNG of error against run time.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Time the fidelity presets of a full test against `reference`, price the physics knobs,
+    /// and measure memory against bar length: the table to pick a preset with.
+    Bench {
+        /// A `shpb` scene file.
+        #[arg(default_value = "scenes/shpb-ss440c-10psi.toml")]
+        scene: PathBuf,
+        /// Runs per timing (median reported; `reference` runs once).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Also write the tables as markdown to this file.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// Overwrite an existing report.
+        #[arg(long)]
+        force: bool,
     },
     /// Print the loading curve F(δ) of a specimen as CSV on stdout.
     Curve {
@@ -147,6 +182,19 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Run the validation cases (paper Figs. 2–4, gauge records, Hertz, restitution): prints
+    /// case, metric, value, threshold and pass/fail; exits non-zero if a check fails.
+    Validate {
+        /// Cases to run (default: all): fig2-quasistatic, fig3-rate, fig4-force-driven,
+        /// fig4-virtual-shpb, gauge-records, hertz-analytic, restitution.
+        cases: Vec<String>,
+        /// Also write DIR/REPORT.md and one PNG per case.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Overwrite existing report files.
+        #[arg(long)]
+        force: bool,
+    },
 }
 
 /// Parses the command line, runs it, prints errors; returns the process exit code.
@@ -170,13 +218,41 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             csv,
             plot,
             force,
+            fidelity,
         } => run(
             &scene,
             output.as_deref(),
             csv.as_deref(),
             plot.as_deref(),
             force,
+            fidelity,
         ),
+        Command::Bench {
+            scene,
+            repeats,
+            report,
+            force,
+        } => {
+            if let Some(p) = &report {
+                check_output(p, force)?;
+            }
+            let b = crate::bench::bench(&scene, repeats, |s| eprintln!("shpb: bench: {s}"))?;
+            let md = crate::bench::markdown(&b);
+            say(&md)?;
+            if let Some(p) = &report {
+                crate::io::write_atomically(p, force, |tmp| {
+                    std::fs::write(tmp, &md).map_err(|e| Error::io(p, e))
+                })?;
+                eprintln!("wrote {}", p.display());
+            }
+            Ok(())
+        }
+        Command::Convergence {
+            scene,
+            output,
+            plot,
+            force,
+        } => convergence(&scene, output.as_deref(), plot.as_deref(), force),
         Command::Curve {
             specimen,
             rate,
@@ -210,6 +286,11 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             csv,
             force,
         } => strain(&record, &bars, output.as_deref(), csv.as_deref(), force),
+        Command::Validate {
+            cases,
+            report,
+            force,
+        } => validate(&cases, report.as_deref(), force),
     }
 }
 
@@ -337,11 +418,12 @@ fn run(
     csv: Option<&Path>,
     plot: Option<&Path>,
     force: bool,
+    fidelity: Option<crate::fidelity::Fidelity>,
 ) -> Result<()> {
     for p in [output, csv, plot].into_iter().flatten() {
         check_output(p, force)?;
     }
-    let params = Params::from_file(scene)?;
+    let params = Params::from_file_with(scene, fidelity)?;
     let mut out = params.run()?;
     out.warnings.splice(0..0, params.warnings());
     for w in &out.warnings {
@@ -593,4 +675,36 @@ fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Res
         }
         _ => Ok(()),
     }
+}
+
+/// `shpb convergence`: runs the ladder with a progress line per level, prints the table, writes
+/// the CSV and the error-against-run-time plot.
+fn convergence(
+    scene: &Path,
+    output: Option<&Path>,
+    plot: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    for p in [output, plot].into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    let study = crate::convergence::study(scene, |i, value| {
+        eprintln!("shpb: convergence level {} ({value:e})", i + 1);
+    })?;
+    let table = crate::convergence::table_text(&study);
+    say(&table)?;
+    if let Some(p) = output {
+        crate::convergence::write_csv(p, force, &study)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = plot {
+        crate::convergence::plot(p, force, &study)?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// `shpb validate [CASE…] [--report DIR] [--force]` (issue 7): see [`crate::validate::command`].
+fn validate(cases: &[String], report: Option<&Path>, force: bool) -> Result<()> {
+    crate::validate::command(cases, report, force)
 }

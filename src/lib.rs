@@ -9,9 +9,12 @@
 
 pub mod apparatus;
 pub mod bar;
+pub mod bench;
 pub mod cli;
 pub mod contact;
+pub mod convergence;
 pub mod error;
+pub mod fidelity;
 pub mod gauge;
 pub mod io;
 pub mod material;
@@ -22,5 +25,6 @@ pub mod shaper;
 pub mod solver;
 pub mod specimen;
 pub mod striker;
+pub mod validate;
 
 pub use error::{Error, Result};

@@ -5,6 +5,7 @@ use crate::apparatus::{Apparatus, IncidentEnd, PulseOptions, ShaperOverride};
 use crate::bar::Dispersion;
 use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
 use crate::error::{Error, Result, Validator};
+use crate::fidelity::Fidelity;
 use crate::io::{CsvTable, RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
 use crate::specimen::{SpecimenSpec, SpherePair};
@@ -42,6 +43,8 @@ pub const SCENE_KINDS: &[(&str, &str)] = &[
 struct QuasistaticFile {
     #[allow(dead_code)]
     kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
@@ -59,6 +62,8 @@ struct QuasistaticFile {
 struct ConstantRateFile {
     #[allow(dead_code)]
     kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
@@ -75,6 +80,8 @@ struct ConstantRateFile {
 struct CollisionFile {
     #[allow(dead_code)]
     kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
@@ -84,8 +91,7 @@ struct CollisionFile {
     #[serde(default)]
     velocity2_m_s: f64,
     time_step_s: Option<f64>,
-    #[serde(default = "default_steps_per_contact")]
-    steps_per_contact: f64,
+    steps_per_contact: Option<f64>,
     #[serde(default = "one")]
     output_every: usize,
 }
@@ -95,6 +101,8 @@ struct CollisionFile {
 struct ForceDrivenFile {
     #[allow(dead_code)]
     kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
     specimen: SpecimenSpec,
     #[serde(default)]
     law: LawKind,
@@ -108,8 +116,7 @@ struct ForceDrivenFile {
     #[serde(default = "default_impedance")]
     medium_impedance_kg_s: f64,
     time_step_s: Option<f64>,
-    #[serde(default = "default_steps_per_period")]
-    steps_per_period: f64,
+    steps_per_period: Option<f64>,
     end_time_s: Option<f64>,
     #[serde(default = "one")]
     output_every: usize,
@@ -120,6 +127,8 @@ struct ForceDrivenFile {
 struct PulseFile {
     #[allow(dead_code)]
     kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
     specimen: Option<SpecimenSpec>,
     #[serde(default)]
     law: LawKind,
@@ -129,12 +138,10 @@ struct PulseFile {
     pressure: String,
     #[serde(default)]
     shaper: ShaperOverride,
-    #[serde(default = "default_cell_size")]
-    cell_size_m: f64,
+    cell_size_m: Option<f64>,
     #[serde(default = "default_incident_end")]
     incident_end: String,
-    #[serde(default = "default_dispersion")]
-    dispersion: String,
+    dispersion: Option<String>,
     end_time_s: Option<f64>,
     #[serde(default = "default_gauge_length")]
     gauge_length_m: f64,
@@ -144,24 +151,12 @@ fn default_gauge_length() -> f64 {
     2e-3
 }
 
-fn default_cell_size() -> f64 {
-    1e-3
-}
 fn default_incident_end() -> String {
     "transmission".into()
-}
-fn default_dispersion() -> String {
-    "none".into()
 }
 
 fn default_points() -> usize {
     1001
-}
-fn default_steps_per_contact() -> f64 {
-    2000.0
-}
-fn default_steps_per_period() -> f64 {
-    2000.0
 }
 fn one() -> usize {
     1
@@ -230,6 +225,8 @@ pub struct Params {
     pub pair: SpherePair,
     /// The contact law selected.
     pub law: LawKind,
+    /// The fidelity preset the numerical knobs were taken from (explicit keys win).
+    pub fidelity: Fidelity,
     /// Form of region II of the loading law (`smooth` C¹ default, or `published`).
     pub region2: Region2Form,
     /// Kind-specific parameters.
@@ -285,6 +282,19 @@ impl Params {
             Some(toml::Value::String(k)) => k.clone(),
             Some(_) => return Err(v.error("kind", "not a string", kinds)),
             None => return Err(v.error("kind", "missing", kinds)),
+        };
+        let fidelity = match table.get("fidelity") {
+            None => Fidelity::default(),
+            Some(toml::Value::String(name)) => Fidelity::parse(name).ok_or_else(|| {
+                v.error(
+                    "fidelity",
+                    format!("unknown preset `{name}`"),
+                    "fast, standard, reference",
+                )
+            })?,
+            Some(_) => {
+                return Err(v.error("fidelity", "not a string", "fast, standard, reference"));
+            }
         };
         let sv = v.table("specimen");
         let (pair, law, region2, params) = match kind.as_str() {
@@ -345,14 +355,20 @@ impl Params {
                     p.radius_m,
                     speed,
                 );
-                let n = v.in_range("steps_per_contact", f.steps_per_contact, 20.0, 1e8, "")?;
+                let n = v.in_range(
+                    "steps_per_contact",
+                    f.steps_per_contact.unwrap_or(fidelity.dem_steps()),
+                    20.0,
+                    1e8,
+                    "",
+                )?;
                 let limit = solver::stability_limit(&pair, solver::hertz_peak_force(&pair, speed));
                 let dt = match f.time_step_s {
                     Some(dt) => v.positive(
                         "time_step_s",
                         dt,
                         limit,
-                        "s (the explicit stability limit 2/ω of this contact)",
+                        "s (the stability limit 1/ω of this contact, solver::stability_limit)",
                     )?,
                     None => tc / n,
                 };
@@ -392,11 +408,17 @@ impl Params {
                     1e9,
                     "kg/s",
                 )?;
-                let n = v.in_range("steps_per_period", f.steps_per_period, 10.0, 1e8, "")?;
+                let n = v.in_range(
+                    "steps_per_period",
+                    f.steps_per_period.unwrap_or(fidelity.dem_steps()),
+                    10.0,
+                    1e8,
+                    "",
+                )?;
                 let peak = drive.peak_n().max(1e-3);
                 let limit = solver::stability_limit(&pair, peak);
                 let dt = match f.time_step_s {
-                    Some(dt) => v.positive("time_step_s", dt, limit, "s (the explicit stability limit 2/ω of this contact at the peak drive force)")?,
+                    Some(dt) => v.positive("time_step_s", dt, limit, "s (the stability limit 1/ω of this contact at the peak drive force, solver::stability_limit)")?,
                     None => solver::default_time_step(&pair, peak, z, n),
                 };
                 let last = *drive
@@ -477,10 +499,12 @@ impl Params {
                         ));
                     }
                 };
-                let dispersion = match f.dispersion.as_str() {
-                    "none" => Dispersion::None,
-                    "love-rod" => Dispersion::LoveRod,
-                    other => {
+                let knobs = fidelity.bar_knobs();
+                let dispersion = match f.dispersion.as_deref() {
+                    None => knobs.dispersion,
+                    Some("none") => Dispersion::None,
+                    Some("love-rod") => Dispersion::LoveRod,
+                    Some(other) => {
                         return Err(v.error(
                             "dispersion",
                             format!("unknown model `{other}`"),
@@ -488,7 +512,13 @@ impl Params {
                         ));
                     }
                 };
-                let cell = v.in_range("cell_size_m", f.cell_size_m, 1e-5, 0.05, "m")?;
+                let cell = v.in_range(
+                    "cell_size_m",
+                    f.cell_size_m.unwrap_or(knobs.cell_size_m),
+                    1e-5,
+                    0.05,
+                    "m",
+                )?;
                 let c0 = apparatus.material.wave_speed_m_s();
                 let gauge_d = apparatus
                     .gauges
@@ -515,7 +545,7 @@ impl Params {
                     dispersion,
                     end_time_s,
                     gauge_length_m,
-                    snapshot_interval_s: is_test.then_some(2e-6),
+                    snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
                 };
                 // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
                 for spec in &apparatus.pulse_chain(&options).bars {
@@ -548,8 +578,39 @@ impl Params {
             pair,
             law,
             region2,
+            fidelity,
             params,
         })
+    }
+
+    /// Reads a scene file with its `fidelity` replaced by `fidelity` (when given): what
+    /// `--fidelity` does. The stored scene text is the file's with the preset set.
+    pub fn from_file_with(path: &Path, fidelity: Option<Fidelity>) -> Result<Params> {
+        let overrides: Vec<(String, toml::Value)> = fidelity
+            .map(|f| ("fidelity".to_string(), toml::Value::String(f.name().into())))
+            .into_iter()
+            .collect();
+        Params::from_file_overridden(path, &overrides)
+    }
+
+    /// Reads a scene file with some keys replaced (dotted paths such as `shaper.thickness_m`
+    /// reach into tables); the stored scene text is the modified TOML.
+    pub fn from_file_overridden(
+        path: &Path,
+        overrides: &[(String, toml::Value)],
+    ) -> Result<Params> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let file = path.display().to_string();
+        let text = if overrides.is_empty() {
+            text
+        } else {
+            with_overrides(&text, &file, overrides)?
+        };
+        let base = path
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        Params::from_toml(&text, &file, &base)
     }
 
     /// The contact law of this scene.
@@ -942,6 +1003,43 @@ fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
         ));
     }
     v
+}
+
+/// Scene TOML `text` with `overrides` applied: each dotted key path (`pressure`,
+/// `shaper.thickness_m`) set to its value, creating tables on the way; an error names `file`
+/// when a path runs through a non-table value.
+pub fn with_overrides(
+    text: &str,
+    file: &str,
+    overrides: &[(String, toml::Value)],
+) -> Result<String> {
+    let v = Validator::new(file);
+    let mut table: toml::Table = parse_as(text, file)?;
+    for (path, value) in overrides {
+        let parts: Vec<&str> = path.split('.').collect();
+        let (last, tables) = parts.split_last().expect("split yields at least one part");
+        let mut t = &mut table;
+        for part in tables {
+            let entry = t
+                .entry(part.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            t = match entry {
+                toml::Value::Table(inner) => inner,
+                _ => {
+                    return Err(v.error(
+                        path,
+                        format!("`{part}` is not a table"),
+                        "a key path through tables, e.g. shaper.thickness_m",
+                    ));
+                }
+            };
+        }
+        t.insert(last.to_string(), value.clone());
+    }
+    toml::to_string(&table).map_err(|e| Error::Parse {
+        file: file.to_string(),
+        message: e.to_string(),
+    })
 }
 
 /// Linear interpolation of (t, y) at the times `at` (end values held outside).

@@ -316,6 +316,11 @@ pub fn simulate_chain(setup: &ChainSetup) -> Result<ChainResult> {
         .iter()
         .map(|s| Bar::new(s, setup.dt_s))
         .collect::<Result<Vec<_>>>()?;
+    // Each sphere's mass joins its bar's end node (the paper's DEM).
+    for &(k, right, mass_kg) in &setup.end_masses {
+        let node = if right { bars[k].node_count() - 1 } else { 0 };
+        bars[k].add_node_mass(node, mass_kg);
+    }
     bars[0].set_initial_velocity(setup.striker_velocity_m_s);
     let striker_energy_j = bars[0].kinetic_energy_j();
     let mut joints: Vec<JointState> = setup.joints.iter().map(|&j| JointState::new(j)).collect();
