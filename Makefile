@@ -21,7 +21,7 @@ DEMO_SCENE := scenes/shpb-ss440c-10psi.toml
 DEMO_H5 := demo.h5
 DEMO_PNG := demo.png
 
-.PHONY: all deps build demo test clean
+.PHONY: all deps build demo test clean perf-report
 
 all: build
 
@@ -67,6 +67,13 @@ test: deps
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --all-targets -- -D warnings
 	$(CARGO) test --release
+
+# Speed/accuracy measurements of validation/perf/REPORT.md (≈ 1 min; not part of `test`).
+perf-report: build
+	$(BIN) bench scenes/shpb-ss440c-10psi.toml --report validation/perf/BENCH.md --force
+	$(BIN) convergence scenes/shpb-ss440c-10psi.toml -o validation/perf/convergence-shpb-ss440c-10psi.csv --plot validation/perf/convergence-shpb-ss440c-10psi.png --force > validation/perf/convergence-shpb-ss440c-10psi.txt
+	$(BIN) convergence scenes/force-driven-ss440c-10psi.toml -o validation/perf/convergence-force-driven-ss440c-10psi.csv --plot validation/perf/convergence-force-driven-ss440c-10psi.png --force > validation/perf/convergence-force-driven-ss440c-10psi.txt
+	$(BIN) convergence scenes/collision-ss440c-5ms.toml -o validation/perf/convergence-collision-ss440c-5ms.csv --plot validation/perf/convergence-collision-ss440c-5ms.png --force > validation/perf/convergence-collision-ss440c-5ms.txt
 
 clean:
 	$(CARGO) clean

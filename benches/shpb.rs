@@ -1,10 +1,14 @@
-//! Criterion benches: a full default SS440c SHPB test (gun → shaper → bars → spheres → gauges),
-//! the bar pulse alone, the force-driven Fig. 4 DEM, and one contact-law evaluation.
+//! Criterion benches: a full SS440c SHPB test (gun → shaper → bars → spheres → gauges →
+//! reduction) at each fidelity preset, the bar pulse alone, the force-driven Fig. 4 DEM, the
+//! reduction of one real gauge record, and one contact-law evaluation.
 //! Run with `cargo bench`; report ratios, not absolute times (DEVELOPERS.md).
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use shpb::apparatus::Apparatus;
 use shpb::contact::{ContactHistory, LawKind};
+use shpb::fidelity::Fidelity;
 use shpb::material::Material;
+use shpb::reduce::{ReductionOptions, reduce_record_file};
 use shpb::scene::Params;
 use shpb::specimen::SpherePair;
 use std::hint::black_box;
@@ -15,10 +19,26 @@ fn scene(path: &str) -> Params {
 }
 
 fn benches(c: &mut Criterion) {
-    let test = scene("scenes/shpb-ss440c-10psi.toml");
-    c.bench_function("full SHPB test, SS440c 10 psi (default)", |b| {
-        b.iter(|| black_box(test.run().unwrap()))
-    });
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // The reference preset (Love rod, 0.125 mm cells) takes seconds per run: `shpb bench` times it.
+    for f in [Fidelity::Fast, Fidelity::Standard] {
+        let test = Params::from_file_with(&root.join("scenes/shpb-ss440c-10psi.toml"), Some(f))
+            .expect("shipped scene");
+        c.bench_function(
+            &format!("full SHPB test, SS440c 10 psi ({})", f.name()),
+            |b| b.iter(|| black_box(test.run().unwrap())),
+        );
+    }
+    let app = Apparatus::from_file(&root.join("bars/authors.toml")).expect("shipped set-up");
+    let record = root.join("validation/gauge-records/data/2013-05-22_sample2_ss440c.csv");
+    c.bench_function(
+        "reduction of a real record (sample 2, dispersion corrected)",
+        |b| {
+            b.iter(|| {
+                black_box(reduce_record_file(&record, &app, &ReductionOptions::default()).unwrap())
+            })
+        },
+    );
     let pulse = scene("scenes/pulse-10psi.toml");
     c.bench_function("pulse only, 10 psi", |b| {
         b.iter(|| black_box(pulse.run().unwrap()))
