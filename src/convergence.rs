@@ -92,6 +92,22 @@ pub struct Level {
     pub signal_rms_error: f64,
 }
 
+impl Level {
+    /// The level's table columns: value, run time, peak, its error, displacement at peak, its
+    /// error, signal RMS error.
+    pub fn columns(&self) -> [f64; 7] {
+        [
+            self.value,
+            self.runtime_s,
+            self.metrics.peak,
+            self.peak_error,
+            self.metrics.displacement_at_peak_m,
+            self.displacement_error,
+            self.signal_rms_error,
+        ]
+    }
+}
+
 /// Observed order of convergence of one quantity and its Richardson-extrapolated value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Order {
@@ -317,15 +333,9 @@ pub fn table_text(s: &Study) -> String {
         "signal_rms"
     ));
     for l in &s.levels {
+        let [value, runtime, peak, peak_err, disp, disp_err, rms] = l.columns();
         t.push_str(&format!(
-            "{:>14.4e} {:>11.4} {:>16.9e} {:>11.2e} {:>16.9e} {:>11.2e} {:>11.2e}\n",
-            l.value,
-            l.runtime_s,
-            l.metrics.peak,
-            l.peak_error,
-            l.metrics.displacement_at_peak_m,
-            l.displacement_error,
-            l.signal_rms_error
+            "{value:>14.4e} {runtime:>11.4} {peak:>16.9e} {peak_err:>11.2e} {disp:>16.9e} {disp_err:>11.2e} {rms:>11.2e}\n"
         ));
     }
     let ex = |o: &Order| {
@@ -375,16 +385,9 @@ pub fn write_csv(path: &Path, force: bool, s: &Study) -> Result<()> {
         s.knob.key()
     );
     for l in &s.levels {
-        text.push_str(&format!(
-            "{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
-            l.value,
-            l.runtime_s,
-            l.metrics.peak,
-            l.peak_error,
-            l.metrics.displacement_at_peak_m,
-            l.displacement_error,
-            l.signal_rms_error
-        ));
+        let row: Vec<String> = l.columns().iter().map(|v| format!("{v:e}")).collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
     }
     crate::io::write_atomically(path, force, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| Error::io(path, e))
