@@ -112,6 +112,32 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Run a scene over the Cartesian product of swept parameters, in parallel, and write a
+    /// summary table (peak force, displacement at peak, peak strain rate, equilibrium ratio,
+    /// time to equilibrium) per run.
+    Sweep {
+        /// The scene TOML file.
+        scene: PathBuf,
+        /// A swept key: KEY=V1,V2,… or KEY=START:STOP:COUNT (units as in scenes; lengths of
+        /// `_m` keys in mm/um/m), e.g. pressure=5psi:20psi:16. Repeat for a product.
+        #[arg(long = "set", required = true)]
+        set: Vec<String>,
+        /// Worker threads.
+        #[arg(short = 'j', long = "jobs", default_value_t = 1)]
+        jobs: usize,
+        /// Run only shard k of n (k/n): every n-th run from the k-th, deterministic.
+        #[arg(long)]
+        shard: Option<String>,
+        /// HDF5 output: /summary table and one /runs/<index> group per run.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// CSV of the summary table.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
     /// Print the loading curve F(δ) of a specimen as CSV on stdout.
     Curve {
         /// Built-in material (the paper's 6.35 mm pair of it) or a pair .toml file.
@@ -247,6 +273,23 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Sweep {
+            scene,
+            set,
+            jobs,
+            shard,
+            output,
+            csv,
+            force,
+        } => sweep(
+            &scene,
+            &set,
+            jobs,
+            shard.as_deref(),
+            output.as_deref(),
+            csv.as_deref(),
+            force,
+        ),
         Command::Convergence {
             scene,
             output,
@@ -707,4 +750,62 @@ fn convergence(
 /// `shpb validate [CASE…] [--report DIR] [--force]` (issue 7): see [`crate::validate::command`].
 fn validate(cases: &[String], report: Option<&Path>, force: bool) -> Result<()> {
     crate::validate::command(cases, report, force)
+}
+
+/// `shpb sweep`: validates every point first, runs them with a progress bar, prints and writes
+/// the summary table.
+fn sweep(
+    scene: &Path,
+    set: &[String],
+    jobs: usize,
+    shard: Option<&str>,
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    use crate::sweep::{check_points, parse_axis, parse_shard, product, run_points, summary_csv};
+    for p in [output, csv].into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    if !scene.is_file() {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "SCENE".into(),
+            problem: format!("cannot read {}: no such file", scene.display()),
+            allowed: "a scene .toml file".into(),
+        });
+    }
+    let axes = set
+        .iter()
+        .map(|s| parse_axis(s))
+        .collect::<Result<Vec<_>>>()?;
+    let mut points = product(&axes);
+    if let Some(s) = shard {
+        let (k, n) = parse_shard(s)?;
+        points = crate::sweep::shard(points, k, n);
+    }
+    check_points(scene, &axes, &points)?;
+    let bar = indicatif::ProgressBar::new(points.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let rows = run_points(scene, &axes, &points, jobs, || bar.inc(1))?;
+    bar.finish_and_clear();
+    let table = summary_csv(&axes, &rows);
+    say(table.trim_end())?;
+    if let Some(p) = csv {
+        crate::io::write_atomically(p, force, |tmp| {
+            std::fs::write(tmp, &table).map_err(|e| Error::io(p, e))
+        })?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = output {
+        crate::io::write_sweep_hdf5(p, force, scene, set, &axes, &rows)?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
 }

@@ -437,3 +437,57 @@ pub fn csv_name(name: &str, unit: &str) -> String {
     };
     format!("{name}_{u}")
 }
+
+/// Writes a sweep: root attributes `shpb_version`, `scene` (the scene text) and `sweep` (the
+/// `--set` specifications); `/summary/run` and `/summary/<column>` (with `units`) with one row
+/// per run, `/summary/inputs/<key>` (the swept values as written); and `/runs/<index>` groups
+/// whose attributes are that run's inputs and results.
+pub fn write_sweep_hdf5(
+    path: &Path,
+    force: bool,
+    scene: &Path,
+    set: &[String],
+    axes: &[crate::sweep::Axis],
+    rows: &[crate::sweep::RunSummary],
+) -> Result<()> {
+    let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
+    write_atomically(path, force, |tmp| {
+        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
+        string_attr(&f, "scene", &scene_text, path)?;
+        string_attr(&f, "sweep", &set.join("\n"), path)?;
+        let s = f.create_group("summary").map_err(h5err(path))?;
+        let run: Vec<f64> = rows.iter().map(|r| r.index as f64).collect();
+        write_dataset(&s, "run", &run, "1", path)?;
+        for (k, (name, units)) in crate::sweep::SUMMARY_COLUMNS.iter().enumerate() {
+            let col: Vec<f64> = rows.iter().map(|r| r.values()[k]).collect();
+            write_dataset(&s, name, &col, units, path)?;
+        }
+        let inputs = s.create_group("inputs").map_err(h5err(path))?;
+        for (k, a) in axes.iter().enumerate() {
+            let col: Vec<VarLenUnicode> = rows.iter().map(|r| vlu(&r.inputs[k])).collect();
+            inputs
+                .new_dataset_builder()
+                .with_data(&col)
+                .create(a.key.as_str())
+                .map_err(h5err(path))?;
+        }
+        let runs = f.create_group("runs").map_err(h5err(path))?;
+        for r in rows {
+            let g = runs
+                .create_group(&r.index.to_string())
+                .map_err(h5err(path))?;
+            for (a, v) in axes.iter().zip(&r.inputs) {
+                string_attr(&g, &a.key, v, path)?;
+            }
+            for ((name, _), v) in crate::sweep::SUMMARY_COLUMNS.iter().zip(r.values()) {
+                g.new_attr::<f64>()
+                    .shape(())
+                    .create(*name)
+                    .and_then(|at| at.write_scalar(&v))
+                    .map_err(h5err(path))?;
+            }
+        }
+        f.close().map_err(h5err(path))
+    })
+}

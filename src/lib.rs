@@ -25,6 +25,7 @@ pub mod shaper;
 pub mod solver;
 pub mod specimen;
 pub mod striker;
+pub mod sweep;
 pub mod validate;
 
 pub use error::{Error, Result};

@@ -106,9 +106,12 @@ fn check_range(
 pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
     let t = text.trim();
     // The unit is the trailing run of letters (so exponents such as 1e5Pa stay in the number).
+    // (Step over the whole character found: it may be several bytes long, e.g. `é`.)
     let unit_start = t
-        .rfind(|c: char| !c.is_ascii_alphabetic())
-        .map(|i| i + 1)
+        .char_indices()
+        .rev()
+        .find(|&(_, c)| !c.is_ascii_alphabetic())
+        .map(|(i, c)| i + c.len_utf8())
         .unwrap_or(0);
     let (num, unit) = t.split_at(unit_start);
     let value: f64 = num

@@ -53,10 +53,17 @@ fn check_error(e: &Error, label: &str, also: &[&str]) -> Result<(), TestCaseErro
         Error::Input { file, .. } | Error::Parse { file, .. } | Error::Io { file, .. } => {
             file.clone()
         }
-        other => return Err(TestCaseError::fail(format!("unexpected error kind: {other}"))),
+        other => {
+            return Err(TestCaseError::fail(format!(
+                "unexpected error kind: {other}"
+            )));
+        }
     };
     prop_assert!(!file.is_empty(), "error names no file: {shown}");
-    prop_assert!(shown.contains(&file), "message does not show the file: {shown}");
+    prop_assert!(
+        shown.contains(&file),
+        "message does not show the file: {shown}"
+    );
     let file_path = file.rsplit_once(':').map_or(file.as_str(), |(f, line)| {
         if line.chars().all(|c| c.is_ascii_digit()) {
             f
@@ -78,10 +85,36 @@ fn check_error(e: &Error, label: &str, also: &[&str]) -> Result<(), TestCaseErro
 fn odd_value() -> impl Strategy<Value = String> {
     prop_oneof![
         prop::sample::select(vec![
-            "nan", "+nan", "-nan", "inf", "+inf", "-inf", "0", "0.0", "-0.0", "-1", "-1.0e3",
-            "1e308", "-1e308", "1e400", "1e-400", "5e-324", "9223372036854775807",
-            "-9223372036854775808", "18446744073709551616", "1e9", "1e10", "3", "\"\"",
-            "\"10\"", "true", "[1.0, 2.0]", "{ a = 1 }", "1979-05-27", "0x10", "1_000",
+            "nan",
+            "+nan",
+            "-nan",
+            "inf",
+            "+inf",
+            "-inf",
+            "0",
+            "0.0",
+            "-0.0",
+            "-1",
+            "-1.0e3",
+            "1e308",
+            "-1e308",
+            "1e400",
+            "1e-400",
+            "5e-324",
+            "9223372036854775807",
+            "-9223372036854775808",
+            "18446744073709551616",
+            "1e9",
+            "1e10",
+            "3",
+            "\"\"",
+            "\"10\"",
+            "true",
+            "[1.0, 2.0]",
+            "{ a = 1 }",
+            "1979-05-27",
+            "0x10",
+            "1_000",
         ])
         .prop_map(str::to_string),
         any::<f64>().prop_map(|x| format!("{x:e}")),
@@ -94,15 +127,56 @@ fn odd_value() -> impl Strategy<Value = String> {
 fn odd_string() -> impl Strategy<Value = String> {
     prop_oneof![
         prop::sample::select(vec![
-            "NaNpsi", "nanpsi", "infpsi", "-infbar", "-5bar", "1e400kPa", "1e-400Pa", "10 psi",
-            "10PSI", "psi", "", " ", "10", "0psi", "-0psi", "1e308MPa", "10psipsi", "10 kPa ",
-            "ss440c", "al2017", "ss302", "unobtainium", "fast", "standard", "reference",
-            "burgoyne-daraio", "hertz", "collision", "quasistatic", "pulse", "shpb",
-            "force-driven", "constant-rate", "free", "absorbing", "transmission", "none",
-            "love-rod", "../bars/authors.toml", "../bars/gauges-authors.toml", "/", ".",
-            "../specimens/ss440c.toml", "../specimens/pair-6.35mm-al2017.toml", "nope.toml",
-            "../validation/fig4-force-driven/data/ss440c_10psi_force10.csv", "x.csv",
-            "\u{0}", "é", "\u{1F600}psi",
+            "NaNpsi",
+            "nanpsi",
+            "infpsi",
+            "-infbar",
+            "-5bar",
+            "1e400kPa",
+            "1e-400Pa",
+            "10 psi",
+            "10PSI",
+            "psi",
+            "",
+            " ",
+            "10",
+            "0psi",
+            "-0psi",
+            "1e308MPa",
+            "10psipsi",
+            "10 kPa ",
+            "ss440c",
+            "al2017",
+            "ss302",
+            "unobtainium",
+            "fast",
+            "standard",
+            "reference",
+            "burgoyne-daraio",
+            "hertz",
+            "collision",
+            "quasistatic",
+            "pulse",
+            "shpb",
+            "force-driven",
+            "constant-rate",
+            "free",
+            "absorbing",
+            "transmission",
+            "none",
+            "love-rod",
+            "../bars/authors.toml",
+            "../bars/gauges-authors.toml",
+            "/",
+            ".",
+            "../specimens/ss440c.toml",
+            "../specimens/pair-6.35mm-al2017.toml",
+            "nope.toml",
+            "../validation/fig4-force-driven/data/ss440c_10psi_force10.csv",
+            "x.csv",
+            "\u{0}",
+            "é",
+            "\u{1F600}psi",
         ])
         .prop_map(str::to_string),
         "[-+]?[0-9]{0,3}(\\.[0-9]{0,3})?([eE][-+]?[0-9]{1,3})? ?(psi|bar|kPa|MPa|GPa|Pa|atm|NaN|)",
@@ -114,12 +188,37 @@ fn odd_string() -> impl Strategy<Value = String> {
 fn some_key() -> impl Strategy<Value = String> {
     prop_oneof![
         prop::sample::select(vec![
-            "kind", "fidelity", "law", "region2", "points", "max_displacement_m",
-            "strain_rate_per_s", "velocity1_m_s", "velocity2_m_s", "time_step_s",
-            "steps_per_contact", "output_every", "force_csv", "time_column", "force_column",
-            "medium_impedance_kg_s", "steps_per_period", "end_time_s", "bars", "pressure",
-            "incident_end", "dispersion", "cell_size_m", "gauge_length_m", "pair", "material",
-            "diameter_m", "radius_m", "mass_kg", "specimen", "shaper",
+            "kind",
+            "fidelity",
+            "law",
+            "region2",
+            "points",
+            "max_displacement_m",
+            "strain_rate_per_s",
+            "velocity1_m_s",
+            "velocity2_m_s",
+            "time_step_s",
+            "steps_per_contact",
+            "output_every",
+            "force_csv",
+            "time_column",
+            "force_column",
+            "medium_impedance_kg_s",
+            "steps_per_period",
+            "end_time_s",
+            "bars",
+            "pressure",
+            "incident_end",
+            "dispersion",
+            "cell_size_m",
+            "gauge_length_m",
+            "pair",
+            "material",
+            "diameter_m",
+            "radius_m",
+            "mass_kg",
+            "specimen",
+            "shaper",
         ])
         .prop_map(str::to_string),
         "[a-z_][a-z0-9_]{0,10}",
@@ -270,8 +369,7 @@ fn check_scene(text: &str) -> Result<(), TestCaseError> {
 fn mutated_scene() -> impl Strategy<Value = String> {
     let scenes = shipped_scenes();
     let n = scenes.len();
-    (0..n, prop::collection::vec(mutation(), 1..5))
-        .prop_map(move |(k, ms)| mutate(&scenes[k], &ms))
+    (0..n, prop::collection::vec(mutation(), 1..5)).prop_map(move |(k, ms)| mutate(&scenes[k], &ms))
 }
 
 // ---------------------------------------------------------------- CSV generators
@@ -540,10 +638,28 @@ fn non_utf8_csv_names_the_file() {
 fn odd_pressures_are_refused_naming_the_file() {
     let label = scene_label();
     let text = std::fs::read_to_string(scenes_dir().join("pulse-10psi.toml")).unwrap();
-    for p in ["NaNpsi", "-5bar", "1e400kPa", "infpsi", "", "psi", "10", "1e308MPa"] {
+    for p in [
+        "NaNpsi", "-5bar", "1e400kPa", "infpsi", "", "psi", "10", "1e308MPa",
+    ] {
         let t = text.replace("\"10psi\"", &quote(p));
         let e = Params::from_toml(&t, &label, &scenes_dir()).unwrap_err();
         let s = e.to_string();
         assert!(s.contains(&label) && s.contains("pressure"), "{p}: {s}");
     }
+}
+
+/// Regression (found by `pulse_pressures_never_panic`): a pressure whose last non-letter is a
+/// multi-byte character (`é`, `10µpsi`) made `parse_pressure` slice inside the character and panic.
+#[test]
+fn non_ascii_pressure_is_an_error_not_a_panic() {
+    for p in ["é", "10é", "10µpsi", "10\u{1F600}", "\u{1F600}psi", "½bar"] {
+        assert!(shpb::striker::parse_pressure(p).is_err(), "{p}");
+        let e = shpb::striker::cli_pressure(p).unwrap_err();
+        assert!(e.to_string().contains("--pressure"), "{e}");
+    }
+    let label = scene_label();
+    let text = std::fs::read_to_string(scenes_dir().join("pulse-10psi.toml")).unwrap();
+    let e = Params::from_toml(&text.replace("\"10psi\"", "\"é\""), &label, &scenes_dir())
+        .unwrap_err();
+    assert!(e.to_string().contains(&label), "{e}");
 }
