@@ -134,6 +134,25 @@ pub enum Command {
         /// CSV of the summary table.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Continue an interrupted sweep from its checkpoint (`<output>.partial.csv`) without
+        /// redoing finished runs.
+        #[arg(long)]
+        resume: bool,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Join the HDF5 files of the shards of one sweep into one file.
+    Merge {
+        /// The shards' HDF5 files (written by `shpb sweep --shard k/n -o …`).
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// The merged HDF5 file.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also write the merged summary as CSV.
+        #[arg(long)]
+        csv: Option<PathBuf>,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -280,16 +299,23 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             shard,
             output,
             csv,
+            resume,
             force,
         } => sweep(
             &scene,
             &set,
             jobs,
             shard.as_deref(),
-            output.as_deref(),
-            csv.as_deref(),
+            (output.as_deref(), csv.as_deref()),
+            resume,
             force,
         ),
+        Command::Merge {
+            inputs,
+            output,
+            csv,
+            force,
+        } => merge(&inputs, &output, csv.as_deref(), force),
         Command::Convergence {
             scene,
             output,
@@ -752,20 +778,22 @@ fn validate(cases: &[String], report: Option<&Path>, force: bool) -> Result<()> 
     crate::validate::command(cases, report, force)
 }
 
-/// `shpb sweep`: validates every point first, runs them with a progress bar, prints and writes
-/// the summary table.
+/// `shpb sweep`: validates every point first, runs the unfinished ones with a progress bar and a
+/// checkpoint, prints and writes the summary table.
 fn sweep(
     scene: &Path,
     set: &[String],
     jobs: usize,
     shard: Option<&str>,
-    output: Option<&Path>,
-    csv: Option<&Path>,
+    (output, csv): (Option<&Path>, Option<&Path>),
+    resume: bool,
     force: bool,
 ) -> Result<()> {
-    use crate::sweep::{check_points, parse_axis, parse_shard, product, run_points, summary_csv};
-    for p in [output, csv].into_iter().flatten() {
-        check_output(p, force)?;
+    use crate::sweep::{Checkpoint, check_points, parse_axis, parse_shard, product, run_points};
+    if !resume {
+        for p in [output, csv].into_iter().flatten() {
+            check_output(p, force)?;
+        }
     }
     if !scene.is_file() {
         return Err(Error::Input {
@@ -780,12 +808,47 @@ fn sweep(
         .map(|s| parse_axis(s))
         .collect::<Result<Vec<_>>>()?;
     let mut points = product(&axes);
+    let mut spec = set.to_vec();
     if let Some(s) = shard {
         let (k, n) = parse_shard(s)?;
         points = crate::sweep::shard(points, k, n);
+        spec.push(format!("shard {k}/{n}"));
     }
     check_points(scene, &axes, &points)?;
-    let bar = indicatif::ProgressBar::new(points.len() as u64);
+    let anchor = output.or(csv);
+    if resume && anchor.is_none() {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "--resume".into(),
+            problem: "no output to resume".into(),
+            allowed: "the same -o/--csv as the interrupted sweep".into(),
+        });
+    }
+    let checkpoint = match anchor {
+        Some(a) => Some(Checkpoint::open(
+            a,
+            scene,
+            &spec,
+            axes.len(),
+            resume,
+            force,
+        )?),
+        None => None,
+    };
+    let mut rows = checkpoint.as_ref().map(|c| c.1.clone()).unwrap_or_default();
+    let finished: std::collections::HashSet<usize> = rows.iter().map(|r| r.index).collect();
+    let todo: Vec<_> = points
+        .into_iter()
+        .filter(|p| !finished.contains(&p.index))
+        .collect();
+    if resume {
+        eprintln!(
+            "shpb: resuming: {} runs done, {} to go",
+            rows.len(),
+            todo.len()
+        );
+    }
+    let bar = indicatif::ProgressBar::new(todo.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta}",
@@ -793,19 +856,94 @@ fn sweep(
         .expect("valid template")
         .progress_chars("=> "),
     );
-    let rows = run_points(scene, &axes, &points, jobs, || bar.inc(1))?;
+    let failed = std::sync::Mutex::new(None);
+    let new_rows = run_points(scene, &axes, &todo, jobs, |row| {
+        if let Some((c, _)) = &checkpoint
+            && let Err(e) = c.record(row)
+        {
+            *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+        }
+        bar.inc(1);
+    })?;
     bar.finish_and_clear();
-    let table = summary_csv(&axes, &rows);
+    if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    rows.extend(new_rows);
+    rows.sort_by_key(|r| r.index);
+    let table = crate::sweep::summary_csv(&axes, &rows);
     say(table.trim_end())?;
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    write_study(scene, &spec, &keys, &rows, output, csv)?;
+    if let Some((c, _)) = checkpoint {
+        c.finish()?;
+    }
+    Ok(())
+}
+
+/// Writes a study's HDF5 and CSV (atomically; outputs were checked before the runs).
+fn write_study(
+    scene: &Path,
+    spec: &[String],
+    keys: &[String],
+    rows: &[crate::sweep::RunSummary],
+    output: Option<&Path>,
+    csv: Option<&Path>,
+) -> Result<()> {
     if let Some(p) = csv {
-        crate::io::write_atomically(p, force, |tmp| {
+        let table = crate::sweep::summary_csv_keys(keys, rows);
+        crate::io::write_atomically(p, true, |tmp| {
             std::fs::write(tmp, &table).map_err(|e| Error::io(p, e))
         })?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = output {
-        crate::io::write_sweep_hdf5(p, force, scene, set, &axes, &rows)?;
+        let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
+        crate::io::write_sweep_hdf5(p, true, &scene_text, spec, keys, rows)?;
         eprintln!("wrote {}", p.display());
     }
+    Ok(())
+}
+
+/// `shpb merge`: joins shard files of one sweep (same scene and `--set`), sorted by run index.
+fn merge(inputs: &[PathBuf], output: &Path, csv: Option<&Path>, force: bool) -> Result<()> {
+    for p in [Some(output), csv].into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    let mut merged: Option<crate::io::SweepFile> = None;
+    for p in inputs {
+        let part = crate::io::read_sweep_hdf5(p)?;
+        merged = Some(match merged {
+            None => part,
+            Some(mut m) => {
+                if m.scene != part.scene
+                    || m.sweep_without_shard() != part.sweep_without_shard()
+                    || m.keys != part.keys
+                {
+                    return Err(Error::Input {
+                        file: p.display().to_string(),
+                        key: "sweep".into(),
+                        problem: "not a shard of the same sweep as the first file (scene or --set differ)".into(),
+                        allowed: "shards of one `shpb sweep` (same scene and --set, different --shard)".into(),
+                    });
+                }
+                m.rows.extend(part.rows);
+                m
+            }
+        });
+    }
+    let mut m = merged.expect("clap requires at least one input");
+    m.rows.sort_by_key(|r| r.index);
+    m.rows.dedup_by_key(|r| r.index);
+    let spec = m.sweep_without_shard();
+    if let Some(p) = csv {
+        let table = crate::sweep::summary_csv_keys(&m.keys, &m.rows);
+        crate::io::write_atomically(p, force, |tmp| {
+            std::fs::write(tmp, &table).map_err(|e| Error::io(p, e))
+        })?;
+        eprintln!("wrote {}", p.display());
+    }
+    crate::io::write_sweep_hdf5(output, force, &m.scene, &spec, &m.keys, &m.rows)?;
+    eprintln!("wrote {} ({} runs)", output.display(), m.rows.len());
     Ok(())
 }

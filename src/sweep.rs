@@ -279,14 +279,15 @@ pub fn overrides(axes: &[Axis], p: &Point) -> Vec<(String, toml::Value)> {
         .collect()
 }
 
-/// Runs `points` of the sweep on `threads` threads (rayon), calling `done` after each run;
-/// the summaries come back in point order whatever the order of completion.
+/// Runs `points` of the sweep on `threads` threads (rayon), calling `done` with each finished
+/// run's summary (from the worker thread); the summaries come back in point order whatever the
+/// order of completion.
 pub fn run_points(
     scene: &Path,
     axes: &[Axis],
     points: &[Point],
     threads: usize,
-    done: impl Fn() + Sync,
+    done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Vec<RunSummary>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.max(1))
@@ -308,8 +309,9 @@ pub fn run_points(
                     .zip(&p.coords)
                     .map(|(a, &c)| a.labels[c].clone())
                     .collect();
-                done();
-                Ok(summarise(p.index, inputs, &out))
+                let row = summarise(p.index, inputs, &out);
+                done(&row);
+                Ok(row)
             })
             .collect::<Result<Vec<_>>>()
     })
@@ -317,8 +319,14 @@ pub fn run_points(
 
 /// The summary table as CSV: `run`, one column per axis key, then the summary columns with units.
 pub fn summary_csv(axes: &[Axis], rows: &[RunSummary]) -> String {
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    summary_csv_keys(&keys, rows)
+}
+
+/// [`summary_csv`] given the swept keys.
+pub fn summary_csv_keys(keys: &[String], rows: &[RunSummary]) -> String {
     let mut head = vec!["run".to_string()];
-    head.extend(axes.iter().map(|a| a.key.clone()));
+    head.extend(keys.iter().cloned());
     head.extend(
         SUMMARY_COLUMNS
             .iter()
@@ -327,11 +335,136 @@ pub fn summary_csv(axes: &[Axis], rows: &[RunSummary]) -> String {
     let mut text = head.join(",");
     text.push('\n');
     for r in rows {
-        let mut cells = vec![r.index.to_string()];
-        cells.extend(r.inputs.iter().cloned());
-        cells.extend(r.values().iter().map(|v| format!("{v:e}")));
-        text.push_str(&cells.join(","));
-        text.push('\n');
+        text.push_str(&row_line(r));
     }
     text
+}
+
+/// The checkpoint of a sweep: finished runs, one CSV line each, appended and flushed as they
+/// finish, so an interrupted sweep (Ctrl-C, a killed job) loses only the runs in flight.
+/// Its first line identifies the sweep (scene and `--set` specifications); `--resume` refuses a
+/// checkpoint of another sweep. Values are written in Rust's shortest round-trip form, so a
+/// resumed sweep reproduces the uninterrupted one bit for bit.
+pub struct Checkpoint {
+    /// The checkpoint file.
+    pub path: std::path::PathBuf,
+    file: std::sync::Mutex<std::fs::File>,
+}
+
+/// The identifying first line of a checkpoint.
+fn checkpoint_header(scene: &Path, set: &[String]) -> String {
+    format!(
+        "# shpb sweep checkpoint; scene={}; set={}",
+        scene.display(),
+        set.join(" ; ")
+    )
+}
+
+/// The checkpoint path of a sweep writing `output`: `<output>.partial.csv`.
+pub fn checkpoint_path(output: &Path) -> std::path::PathBuf {
+    let mut name = output.as_os_str().to_owned();
+    name.push(".partial.csv");
+    std::path::PathBuf::from(name)
+}
+
+fn row_line(r: &RunSummary) -> String {
+    let mut cells = vec![r.index.to_string()];
+    cells.extend(r.inputs.iter().cloned());
+    cells.extend(r.values().iter().map(|v| format!("{v:e}")));
+    cells.join(",") + "\n"
+}
+
+fn parse_row(line: &str, n_inputs: usize) -> Option<RunSummary> {
+    let cells: Vec<&str> = line.split(',').collect();
+    if cells.len() != 1 + n_inputs + SUMMARY_COLUMNS.len() {
+        return None;
+    }
+    let index = cells[0].parse().ok()?;
+    let inputs = cells[1..=n_inputs].iter().map(|c| c.to_string()).collect();
+    let v: Vec<f64> = cells[1 + n_inputs..]
+        .iter()
+        .map(|c| c.parse().ok())
+        .collect::<Option<_>>()?;
+    Some(RunSummary {
+        index,
+        inputs,
+        peak_force_n: v[0],
+        displacement_at_peak_m: v[1],
+        peak_strain_rate_per_s: v[2],
+        equilibrium_ratio_at_peak: v[3],
+        time_to_equilibrium_s: v[4],
+    })
+}
+
+impl Checkpoint {
+    /// Opens the checkpoint of `output`: with `resume`, reads the finished runs of an existing
+    /// one (it must belong to the same sweep; a torn last line is dropped); without, refuses an
+    /// existing one unless `force` (then starts afresh).
+    pub fn open(
+        output: &Path,
+        scene: &Path,
+        set: &[String],
+        n_inputs: usize,
+        resume: bool,
+        force: bool,
+    ) -> Result<(Checkpoint, Vec<RunSummary>)> {
+        use std::io::Write;
+        let path = checkpoint_path(output);
+        let header = checkpoint_header(scene, set);
+        let mut finished = Vec::new();
+        let exists = path.is_file();
+        if exists && resume {
+            let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+            let mut lines = text.lines();
+            if lines.next() != Some(header.as_str()) {
+                return Err(Error::Input {
+                    file: path.display().to_string(),
+                    key: "--resume".into(),
+                    problem: "the checkpoint belongs to another sweep (scene or --set differ)".into(),
+                    allowed: "the same scene and --set values as the interrupted sweep, or --force to start afresh".into(),
+                });
+            }
+            finished = lines.filter_map(|l| parse_row(l, n_inputs)).collect();
+        } else if exists && !force {
+            return Err(Error::Input {
+                file: path.display().to_string(),
+                key: "output".into(),
+                problem: "an interrupted sweep left this checkpoint".into(),
+                allowed: "--resume to continue it, or --force to start afresh".into(),
+            });
+        }
+        // Rewrite the checkpoint with the header and the complete rows (drops a torn line).
+        let mut text = header + "\n";
+        for r in &finished {
+            text.push_str(&row_line(r));
+        }
+        std::fs::write(&path, &text).map_err(|e| Error::io(&path, e))?;
+        let mut file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(|e| Error::io(&path, e))?;
+        file.flush().map_err(|e| Error::io(&path, e))?;
+        Ok((
+            Checkpoint {
+                path,
+                file: std::sync::Mutex::new(file),
+            },
+            finished,
+        ))
+    }
+
+    /// Appends one finished run (one write of a whole line, then flush).
+    pub fn record(&self, r: &RunSummary) -> Result<()> {
+        use std::io::Write;
+        let mut f = self.file.lock().unwrap_or_else(|e| e.into_inner());
+        f.write_all(row_line(r).as_bytes())
+            .and_then(|_| f.flush())
+            .map_err(|e| Error::io(&self.path, e))
+    }
+
+    /// Removes the checkpoint once the outputs are written.
+    pub fn finish(self) -> Result<()> {
+        drop(self.file);
+        std::fs::remove_file(&self.path).map_err(|e| Error::io(&self.path, e))
+    }
 }
