@@ -134,6 +134,10 @@ pub enum Command {
         /// CSV of the summary table.
         #[arg(long)]
         csv: Option<PathBuf>,
+        /// Summary PNG: peak force and strain rate against the swept parameter (one) or as
+        /// heat maps (two).
+        #[arg(long)]
+        plot: Option<PathBuf>,
         /// Continue an interrupted sweep from its checkpoint (`<output>.partial.csv`) without
         /// redoing finished runs.
         #[arg(long)]
@@ -299,6 +303,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             shard,
             output,
             csv,
+            plot,
             resume,
             force,
         } => sweep(
@@ -306,7 +311,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             &set,
             jobs,
             shard.as_deref(),
-            (output.as_deref(), csv.as_deref()),
+            (output.as_deref(), csv.as_deref(), plot.as_deref()),
             resume,
             force,
         ),
@@ -785,13 +790,13 @@ fn sweep(
     set: &[String],
     jobs: usize,
     shard: Option<&str>,
-    (output, csv): (Option<&Path>, Option<&Path>),
+    (output, csv, plot): (Option<&Path>, Option<&Path>, Option<&Path>),
     resume: bool,
     force: bool,
 ) -> Result<()> {
     use crate::sweep::{Checkpoint, check_points, parse_axis, parse_shard, product, run_points};
     if !resume {
-        for p in [output, csv].into_iter().flatten() {
+        for p in [output, csv, plot].into_iter().flatten() {
             check_output(p, force)?;
         }
     }
@@ -807,6 +812,14 @@ fn sweep(
         .iter()
         .map(|s| parse_axis(s))
         .collect::<Result<Vec<_>>>()?;
+    if plot.is_some() && axes.len() > 2 {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "--plot".into(),
+            problem: format!("{} swept parameters", axes.len()),
+            allowed: "one (line plot) or two (heat map) --set parameters".into(),
+        });
+    }
     let mut points = product(&axes);
     let mut spec = set.to_vec();
     if let Some(s) = shard {
@@ -875,6 +888,10 @@ fn sweep(
     say(table.trim_end())?;
     let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
     write_study(scene, &spec, &keys, &rows, output, csv)?;
+    if let Some(p) = plot {
+        sweep_plot(p, resume || force, &axes, &rows)?;
+        eprintln!("wrote {}", p.display());
+    }
     if let Some((c, _)) = checkpoint {
         c.finish()?;
     }
@@ -946,4 +963,60 @@ fn merge(inputs: &[PathBuf], output: &Path, csv: Option<&Path>, force: bool) -> 
     crate::io::write_sweep_hdf5(output, force, &m.scene, &spec, &m.keys, &m.rows)?;
     eprintln!("wrote {} ({} runs)", output.display(), m.rows.len());
     Ok(())
+}
+
+/// The summary plot of a finished sweep (rows of a sharded sweep that are missing stay blank).
+fn sweep_plot(
+    path: &Path,
+    force: bool,
+    axes: &[crate::sweep::Axis],
+    rows: &[crate::sweep::RunSummary],
+) -> Result<()> {
+    let numeric = |a: &crate::sweep::Axis| -> Result<Vec<f64>> {
+        a.labels
+            .iter()
+            .map(|l| {
+                crate::sweep::number_and_unit(l)
+                    .map(|(v, _)| v)
+                    .ok_or_else(|| Error::Input {
+                        file: "command line".into(),
+                        key: "--plot".into(),
+                        problem: format!("`{l}` of {} is not a number", a.key),
+                        allowed: "numeric swept values".into(),
+                    })
+            })
+            .collect()
+    };
+    let label = |a: &crate::sweep::Axis| {
+        let unit = a
+            .labels
+            .first()
+            .and_then(|l| crate::sweep::number_and_unit(l))
+            .map(|(_, u)| u)
+            .unwrap_or_default();
+        if unit.is_empty() {
+            a.key.clone()
+        } else {
+            format!("{} ({unit})", a.key)
+        }
+    };
+    let nx = axes[0].labels.len();
+    let ny = axes.get(1).map(|a| a.labels.len()).unwrap_or(1);
+    let mut f = vec![vec![f64::NAN; ny]; nx];
+    let mut r = vec![vec![f64::NAN; ny]; nx];
+    for row in rows {
+        let (i, j) = (row.index / ny, row.index % ny);
+        f[i][j] = row.peak_force_n;
+        r[i][j] = row.peak_strain_rate_per_s;
+    }
+    let xv = numeric(&axes[0])?;
+    let xl = label(&axes[0]);
+    match axes.get(1) {
+        None => crate::plot::sweep_figure(path, force, (&xl, &xv), None, &f, &r),
+        Some(a) => {
+            let yv = numeric(a)?;
+            let yl = label(a);
+            crate::plot::sweep_figure(path, force, (&xl, &xv), Some((&yl, &yv)), &f, &r)
+        }
+    }
 }

@@ -236,3 +236,169 @@ pub fn test_figure(
         root.present().map_err(perr(path))
     })
 }
+
+/// Sequential colour (white → dark blue) of `v` within [lo, hi].
+fn level_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
+    let a = if hi > lo {
+        ((v - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    RGBColor(
+        (255.0 - 225.0 * a) as u8,
+        (255.0 - 165.0 * a) as u8,
+        (255.0 - 55.0 * a) as u8,
+    )
+}
+
+/// One quantity of a two-parameter study as a heat map: cell (i, j) at (x_i, y_j), value
+/// `z[i][j]` (NaN cells left blank); the caption gives the colour range.
+fn draw_heat_map(
+    area: &Area,
+    path: &Path,
+    labels: (&str, &str, &str),
+    x: &[f64],
+    y: &[f64],
+    z: &[Vec<f64>],
+) -> Result<()> {
+    let edges = |v: &[f64]| -> Vec<f64> {
+        let n = v.len();
+        let step = |i: usize| {
+            if n > 1 {
+                (v[i.min(n - 1)] - v[i.saturating_sub(1).min(n - 2)]).abs()
+            } else {
+                1.0
+            }
+        };
+        let mut e = vec![v[0] - 0.5 * step(1)];
+        for i in 1..n {
+            e.push(0.5 * (v[i - 1] + v[i]));
+        }
+        e.push(v[n - 1] + 0.5 * step(n - 1));
+        e
+    };
+    let (xe, ye) = (edges(x), edges(y));
+    let finite: Vec<f64> = z
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (x0, x1) = (xe[0].min(xe[xe.len() - 1]), xe[0].max(xe[xe.len() - 1]));
+    let (y0, y1) = (ye[0].min(ye[ye.len() - 1]), ye[0].max(ye[ye.len() - 1]));
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!("{} (white {:.4e} → blue {:.4e})", labels.2, lo, hi),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style(("sans-serif", 16))
+        .draw()
+        .map_err(perr(path))?;
+    for i in 0..x.len() {
+        for j in 0..y.len() {
+            let v = z[i][j];
+            if !v.is_finite() {
+                continue;
+            }
+            let rect = Rectangle::new(
+                [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                level_colour(v, lo, hi).filled(),
+            );
+            chart.plotting_area().draw(&rect).map_err(perr(path))?;
+            chart
+                .plotting_area()
+                .draw(&Text::new(
+                    format!("{v:.3e}"),
+                    (0.5 * (xe[i] + xe[i + 1]), 0.5 * (ye[j] + ye[j + 1])),
+                    ("sans-serif", 12),
+                ))
+                .map_err(perr(path))?;
+        }
+    }
+    Ok(())
+}
+
+/// The summary plot of a study with one or two swept parameters: peak force and peak strain
+/// rate against the parameter (lines) or over the two parameters (heat maps). `x` and `y` hold
+/// the numeric values of the swept parameters with their axis labels; `force[i][j]` and
+/// `rate[i][j]` the results (j = 0 only for one parameter).
+pub fn sweep_figure(
+    path: &Path,
+    force: bool,
+    x: (&str, &[f64]),
+    y: Option<(&str, &[f64])>,
+    force_n: &[Vec<f64>],
+    rate_per_s: &[Vec<f64>],
+) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1600, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let (left, right) = root.split_horizontally(800);
+        match y {
+            None => {
+                let f: Vec<f64> = force_n.iter().map(|r| r[0]).collect();
+                let r: Vec<f64> = rate_per_s.iter().map(|r| r[0]).collect();
+                for (area, title, ylab, data, scale) in [
+                    (&left, "peak contact force", "force (kN)", &f, 1e-3),
+                    (
+                        &right,
+                        "peak strain rate (reduced)",
+                        "strain rate (1/s)",
+                        &r,
+                        1.0,
+                    ),
+                ] {
+                    let axes = Axes {
+                        title,
+                        x_label: x.0,
+                        y_label: ylab,
+                        x_scale: 1.0,
+                        y_scale: scale,
+                    };
+                    let curves = [Curve {
+                        label: title.to_string(),
+                        x: x.1,
+                        y: data,
+                        measured: false,
+                    }];
+                    draw_xy(area, path, &axes, &curves)?;
+                }
+            }
+            Some((ylab, yv)) => {
+                let kn: Vec<Vec<f64>> = force_n
+                    .iter()
+                    .map(|r| r.iter().map(|v| v * 1e-3).collect())
+                    .collect();
+                draw_heat_map(
+                    &left,
+                    path,
+                    (x.0, ylab, "peak contact force (kN)"),
+                    x.1,
+                    yv,
+                    &kn,
+                )?;
+                draw_heat_map(
+                    &right,
+                    path,
+                    (x.0, ylab, "peak strain rate (1/s)"),
+                    x.1,
+                    yv,
+                    rate_per_s,
+                )?;
+            }
+        }
+        root.present().map_err(perr(path))
+    })
+}

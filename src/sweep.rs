@@ -42,7 +42,7 @@ fn bad_set(spec: &str, problem: impl Into<String>) -> Error {
 }
 
 /// Splits `12.5psi` into (12.5, "psi"); None when it does not start with a number.
-fn number_and_unit(text: &str) -> Option<(f64, String)> {
+pub fn number_and_unit(text: &str) -> Option<(f64, String)> {
     let t = text.trim();
     let split = t
         .char_indices()

@@ -22,6 +22,34 @@ fn axes() -> Vec<shpb::sweep::Axis> {
     .collect()
 }
 
+/// `--plot` draws the one- and two-parameter summary figures.
+#[test]
+fn sweep_plots_one_and_two_parameters() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let scene = scene();
+    for (name, extra) in [
+        ("one.png", vec![]),
+        ("two.png", vec!["--set", "shaper.thickness=0.35mm,0.45mm"]),
+    ] {
+        let mut args = vec![
+            "sweep",
+            scene.to_str().unwrap(),
+            "--set",
+            "pressure=8psi:16psi:3",
+            "--plot",
+            name,
+        ];
+        args.extend(extra);
+        let out = shpb(dir.path(), &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(std::fs::metadata(dir.path().join(name)).unwrap().len() > 10_000);
+    }
+}
+
 #[test]
 fn set_specifications_parse_with_units_and_aliases() {
     let a = parse_axis("striker.pressure=5psi:20psi:16").unwrap();
