@@ -355,6 +355,14 @@ impl Params {
                     p.radius_m,
                     speed,
                 );
+                if !(tc.is_finite() && tc > 0.0) {
+                    // A closing speed so small (subnormal) that the Hertz contact time overflows.
+                    return Err(v.error(
+                        "velocity1_m_s",
+                        format!("closing speed {speed:e} m/s gives no finite contact time"),
+                        "velocity1_m_s - velocity2_m_s a normal (not subnormal) positive number of m/s",
+                    ));
+                }
                 let n = v.in_range(
                     "steps_per_contact",
                     f.steps_per_contact.unwrap_or(fidelity.dem_steps()),

@@ -3,8 +3,9 @@
 //! truncated, empty and non-UTF-8 files) are either accepted or refused with an error that names
 //! the file — never a panic.
 //!
-//! Case counts are bounded (64–128 per property) so the file runs in seconds in release; proptest
-//! turns any panic inside a property into a failure and shrinks it.
+//! Case counts are bounded (128 per property; `SHPB_PROPTEST_CASES=n` for a longer search) so the
+//! file runs in well under a second in release; proptest turns any panic inside a property into a
+//! failure and shrinks it.
 
 use proptest::prelude::*;
 use shpb::error::Error;
@@ -71,9 +72,7 @@ fn check_error(e: &Error, label: &str, also: &[&str]) -> Result<(), TestCaseErro
             file.as_str()
         }
     });
-    let named = file_path == label
-        || also.contains(&file_path)
-        || (file_path != label && Path::new(file_path).is_file());
+    let named = file_path == label || also.contains(&file_path) || Path::new(file_path).is_file();
     prop_assert!(
         named,
         "error does not name `{label}` or a referenced file: {shown}"
@@ -488,8 +487,16 @@ fn check_csv_error(e: &Error, label: &str) -> Result<(), TestCaseError> {
     check_error(e, label, &[])
 }
 
+/// Cases per property: 128 (bounded for `make test`), or `SHPB_PROPTEST_CASES` for a longer search.
+fn cases() -> u32 {
+    std::env::var("SHPB_PROPTEST_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(128)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), failure_persistence: None, ..ProptestConfig::default() })]
 
     /// Mutated shipped scenes: accepted (and, for the cheap kinds, run) or refused naming the file.
     #[test]
@@ -659,7 +666,22 @@ fn non_ascii_pressure_is_an_error_not_a_panic() {
     }
     let label = scene_label();
     let text = std::fs::read_to_string(scenes_dir().join("pulse-10psi.toml")).unwrap();
-    let e = Params::from_toml(&text.replace("\"10psi\"", "\"é\""), &label, &scenes_dir())
-        .unwrap_err();
+    let e =
+        Params::from_toml(&text.replace("\"10psi\"", "\"é\""), &label, &scenes_dir()).unwrap_err();
     assert!(e.to_string().contains(&label), "{e}");
+}
+
+/// Regression (found by `mutated_scenes_never_panic`): a subnormal closing speed made the Hertz
+/// contact time, and so the default time step, infinite, and the scene was accepted.
+#[test]
+fn subnormal_collision_speed_is_refused() {
+    let label = scene_label();
+    let text = std::fs::read_to_string(scenes_dir().join("collision-dissimilar.toml")).unwrap();
+    let text = text.replace(
+        "velocity1_m_s = 2.0",
+        "velocity1_m_s = 6.052751140807466e-309",
+    );
+    let e = Params::from_toml(&text, &label, &scenes_dir()).unwrap_err();
+    let s = e.to_string();
+    assert!(s.contains(&label) && s.contains("velocity1_m_s"), "{s}");
 }
