@@ -179,36 +179,45 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
         );
         let e_delay = delay(&s) - delay(&m);
         let tag = format!("sample {n} ({label})");
-        checks.push(Check::at_most(
-            format!("{tag}: |incident peak error|"),
-            e_inc.abs(),
-            Unit::Percent,
-            INCIDENT_PEAK_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{tag}: |reflected peak error|"),
-            e_ref.abs(),
-            Unit::Percent,
-            REFLECTED_PEAK_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{tag}: |transmitted peak error|"),
-            e_tra.abs(),
-            Unit::Percent,
-            TRANSMITTED_PEAK_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{tag}: |reflected return error|"),
-            e_reflected_delay.abs(),
-            Unit::Microseconds,
-            REFLECTED_DELAY_MAX_S,
-        ));
-        checks.push(Check::at_most(
-            format!("{tag}: |transmitted arrival error|"),
-            e_delay.abs(),
-            Unit::Microseconds,
-            TRANSMITTED_DELAY_MAX_S,
-        ));
+        for (what, value, unit, limit) in [
+            (
+                "incident peak error",
+                e_inc,
+                Unit::Percent,
+                INCIDENT_PEAK_MAX,
+            ),
+            (
+                "reflected peak error",
+                e_ref,
+                Unit::Percent,
+                REFLECTED_PEAK_MAX,
+            ),
+            (
+                "transmitted peak error",
+                e_tra,
+                Unit::Percent,
+                TRANSMITTED_PEAK_MAX,
+            ),
+            (
+                "reflected return error",
+                e_reflected_delay,
+                Unit::Microseconds,
+                REFLECTED_DELAY_MAX_S,
+            ),
+            (
+                "transmitted arrival error",
+                e_delay,
+                Unit::Microseconds,
+                TRANSMITTED_DELAY_MAX_S,
+            ),
+        ] {
+            checks.push(Check::at_most(
+                format!("{tag}: |{what}|"),
+                value.abs(),
+                unit,
+                limit,
+            ));
+        }
         rows.push(format!(
             "| {n} | {label} | {:.1} / {:.1} | {} | {:.1} / {:.1} | {} | {:.1} / {:.1} | {} | {:.1} / {:.1} | {:+.1} | {:.1} / {:.1} | {:+.1} | {:+.1} | {:.1} / {:.1} |",
             m.incident.peak / 1e6,

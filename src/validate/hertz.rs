@@ -94,30 +94,19 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
             r.peak_force_n / f_star - 1.0,
             r.restitution - 1.0,
         );
-        checks.push(Check::at_most(
-            format!("{label}: |max approach error|"),
-            e_d.abs(),
-            Unit::Scientific,
-            APPROACH_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{label}: |contact time error|"),
-            e_t.abs(),
-            Unit::Scientific,
-            APPROACH_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{label}: |peak force error|"),
-            e_f.abs(),
-            Unit::Scientific,
-            APPROACH_MAX,
-        ));
-        checks.push(Check::at_most(
-            format!("{label}: |e − 1|"),
-            e_e.abs(),
-            Unit::Scientific,
-            RESTITUTION_MAX,
-        ));
+        for (what, value, limit) in [
+            ("max approach error", e_d, APPROACH_MAX),
+            ("contact time error", e_t, APPROACH_MAX),
+            ("peak force error", e_f, APPROACH_MAX),
+            ("e − 1", e_e, RESTITUTION_MAX),
+        ] {
+            checks.push(Check::at_most(
+                format!("{label}: |{what}|"),
+                value.abs(),
+                Unit::Scientific,
+                limit,
+            ));
+        }
         let ratio = if params.law == crate::contact::LawKind::Hertz {
             "—".to_string()
         } else {
