@@ -1,7 +1,7 @@
 //! `shpb bench`: the speed/accuracy table a user needs to pick a fidelity preset, the measured
 //! price of the physics knobs, and memory against bar length.
 
-use crate::convergence::interpolated_peak;
+use crate::convergence::{metrics, rms_difference, signal};
 use crate::error::{Error, Result};
 use crate::fidelity::Fidelity;
 use crate::io::RunOutput;
@@ -73,39 +73,20 @@ fn timed(params: &Params, repeats: usize) -> Result<(f64, RunOutput)> {
     Ok((times[times.len() / 2], last.expect("at least one run")))
 }
 
-fn transmission(out: &RunOutput) -> (Vec<f64>, Vec<f64>) {
-    match (
-        &out.time_s,
-        out.gauges.iter().find(|g| g.name == "transmission"),
-    ) {
-        (Some(t), Some(g)) => (t.clone(), g.strain.clone()),
-        _ => (Vec::new(), Vec::new()),
-    }
-}
-
-fn row(label: &str, runtime_s: f64, out: &RunOutput, reference: &RunOutput) -> Result<Row> {
-    let peak = |o: &RunOutput| -> Result<(f64, f64)> {
-        let c = o.contact.as_ref().ok_or_else(|| Error::Input {
-            file: "shpb bench".into(),
-            key: "kind".into(),
-            problem: "the scene has no spheres".into(),
-            allowed: "a `shpb` scene".into(),
-        })?;
-        Ok(interpolated_peak(&c.force_n, &c.displacement_m))
-    };
-    let (f, d) = peak(out)?;
-    let (fr, dr) = peak(reference)?;
-    let (t, y) = transmission(out);
-    let (tr, yr) = transmission(reference);
-    Ok(Row {
+/// A row comparing `out` with `reference` (both full tests: the scene was checked to have spheres).
+fn row(label: &str, runtime_s: f64, out: &RunOutput, reference: &RunOutput) -> Row {
+    let (m, r) = (metrics(out), metrics(reference));
+    let ((t, y), (tr, yr)) = (signal(out), signal(reference));
+    Row {
         label: label.to_string(),
         runtime_s,
-        peak_force_n: f,
-        displacement_at_peak_m: d,
-        peak_error: (f - fr).abs() / fr,
-        displacement_error: (d - dr).abs() / dr,
-        signal_rms_error: crate::convergence::rms_difference(&t, &y, &tr, &yr),
-    })
+        peak_force_n: m.peak,
+        displacement_at_peak_m: m.displacement_at_peak_m,
+        peak_error: (m.peak - r.peak).abs() / r.peak,
+        displacement_error: (m.displacement_at_peak_m - r.displacement_at_peak_m).abs()
+            / r.displacement_at_peak_m,
+        signal_rms_error: rms_difference(&t, &y, &tr, &yr),
+    }
 }
 
 /// Runs the presets, the physics knobs and the memory ladder of a `shpb` scene; `repeats` runs
@@ -160,13 +141,13 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
     for f in [Fidelity::Fast, Fidelity::Standard] {
         progress(&format!("{} preset", f.name()));
         let (t, out) = timed(&load(f, &[])?, repeats)?;
-        presets.push(row(f.name(), t, &out, &reference)?);
+        presets.push(row(f.name(), t, &out, &reference));
     }
-    presets.push(row("reference", t_ref, &reference, &reference)?);
+    presets.push(row("reference", t_ref, &reference, &reference));
 
     progress("physics knobs");
     let (t_std, standard) = timed(&base, repeats)?;
-    let mut knobs = vec![row("standard", t_std, &standard, &standard)?];
+    let mut knobs = vec![row("standard", t_std, &standard, &standard)];
     let s = |x: &str| toml::Value::String(x.into());
     for (label, extra) in [
         ("dispersion = love-rod", vec![("dispersion", s("love-rod"))]),
@@ -182,7 +163,7 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
     ] {
         progress(label);
         let (t, out) = timed(&load(Fidelity::Standard, &extra)?, repeats)?;
-        knobs.push(row(label, t, &out, &standard)?);
+        knobs.push(row(label, t, &out, &standard));
     }
 
     Ok(Bench {

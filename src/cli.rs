@@ -289,9 +289,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             let md = crate::bench::markdown(&b);
             say(&md)?;
             if let Some(p) = &report {
-                crate::io::write_atomically(p, force, |tmp| {
-                    std::fs::write(tmp, &md).map_err(|e| Error::io(p, e))
-                })?;
+                crate::io::write_text_atomically(p, force, &md)?;
                 eprintln!("wrote {}", p.display());
             }
             Ok(())
@@ -884,10 +882,11 @@ fn sweep(
     }
     rows.extend(new_rows);
     rows.sort_by_key(|r| r.index);
-    let table = crate::sweep::summary_csv(&axes, &rows);
-    say(table.trim_end())?;
     let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
-    write_study(scene, &spec, &keys, &rows, output, csv)?;
+    let table = crate::sweep::summary_csv_keys(&keys, &rows);
+    say(table.trim_end())?;
+    let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
+    write_study(&scene_text, &spec, &keys, &rows, &table, (output, csv))?;
     if let Some(p) = plot {
         sweep_plot(p, resume || force, &axes, &rows)?;
         eprintln!("wrote {}", p.display());
@@ -898,25 +897,22 @@ fn sweep(
     Ok(())
 }
 
-/// Writes a study's HDF5 and CSV (atomically; outputs were checked before the runs).
+/// Writes a study's summary `table` as CSV and its HDF5 (atomically; the outputs were checked
+/// before the runs, so they are replaced here).
 fn write_study(
-    scene: &Path,
+    scene_text: &str,
     spec: &[String],
     keys: &[String],
     rows: &[crate::sweep::RunSummary],
-    output: Option<&Path>,
-    csv: Option<&Path>,
+    table: &str,
+    (output, csv): (Option<&Path>, Option<&Path>),
 ) -> Result<()> {
     if let Some(p) = csv {
-        let table = crate::sweep::summary_csv_keys(keys, rows);
-        crate::io::write_atomically(p, true, |tmp| {
-            std::fs::write(tmp, &table).map_err(|e| Error::io(p, e))
-        })?;
+        crate::io::write_text_atomically(p, true, table)?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = output {
-        let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
-        crate::io::write_sweep_hdf5(p, true, &scene_text, spec, keys, rows)?;
+        crate::io::write_sweep_hdf5(p, true, scene_text, spec, keys, rows)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())
@@ -952,16 +948,17 @@ fn merge(inputs: &[PathBuf], output: &Path, csv: Option<&Path>, force: bool) -> 
     let mut m = merged.expect("clap requires at least one input");
     m.rows.sort_by_key(|r| r.index);
     m.rows.dedup_by_key(|r| r.index);
+    let table = crate::sweep::summary_csv_keys(&m.keys, &m.rows);
     let spec = m.sweep_without_shard();
-    if let Some(p) = csv {
-        let table = crate::sweep::summary_csv_keys(&m.keys, &m.rows);
-        crate::io::write_atomically(p, force, |tmp| {
-            std::fs::write(tmp, &table).map_err(|e| Error::io(p, e))
-        })?;
-        eprintln!("wrote {}", p.display());
-    }
-    crate::io::write_sweep_hdf5(output, force, &m.scene, &spec, &m.keys, &m.rows)?;
-    eprintln!("wrote {} ({} runs)", output.display(), m.rows.len());
+    write_study(
+        &m.scene,
+        &spec,
+        &m.keys,
+        &m.rows,
+        &table,
+        (Some(output), csv),
+    )?;
+    eprintln!("merged {} runs", m.rows.len());
     Ok(())
 }
 

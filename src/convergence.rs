@@ -158,7 +158,8 @@ pub fn richardson(medium: f64, fine: f64, ratio: f64, p: f64) -> f64 {
     fine + (fine - medium) / (ratio.powf(p) - 1.0)
 }
 
-fn metrics(out: &RunOutput) -> Metrics {
+/// Peak and displacement at peak of a run (sub-sample, [`interpolated_peak`]).
+pub(crate) fn metrics(out: &RunOutput) -> Metrics {
     match &out.contact {
         Some(c) => {
             let (peak, displacement_at_peak_m) = interpolated_peak(&c.force_n, &c.displacement_m);
@@ -198,8 +199,9 @@ pub fn interpolated_peak(f: &[f64], g: &[f64]) -> (f64, f64) {
     (quad(fm, f0, fp), quad(g[k - 1], g[k], g[k + 1]))
 }
 
-/// The compared signal of a run: (time, values).
-fn signal(out: &RunOutput) -> (Vec<f64>, Vec<f64>) {
+/// The compared signal of a run (transmission-gauge strain, else the last gauge, else the
+/// contact force): (time, values).
+pub(crate) fn signal(out: &RunOutput) -> (Vec<f64>, Vec<f64>) {
     if let (Some(t), Some(g)) = (
         &out.time_s,
         out.gauges.iter().find(|g| g.name == "transmission"),
@@ -389,9 +391,7 @@ pub fn write_csv(path: &Path, force: bool, s: &Study) -> Result<()> {
         text.push_str(&row.join(","));
         text.push('\n');
     }
-    crate::io::write_atomically(path, force, |tmp| {
-        std::fs::write(tmp, &text).map_err(|e| Error::io(path, e))
-    })
+    crate::io::write_text_atomically(path, force, &text)
 }
 
 /// Draws relative error against run time on log–log axes (levels with zero error left out).

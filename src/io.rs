@@ -257,7 +257,8 @@ impl RunOutput {
     }
 }
 
-fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
+/// Converts an HDF5 error into the crate's error naming `file`.
+pub(crate) fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
     move |e| Error::Hdf5 {
         file: file.display().to_string(),
         message: e.to_string(),
@@ -270,7 +271,12 @@ fn vlu(s: &str) -> VarLenUnicode {
 }
 
 /// Writes a string attribute.
-fn string_attr(loc: &hdf5::Location, name: &str, value: &str, file: &Path) -> Result<()> {
+pub(crate) fn string_attr(
+    loc: &hdf5::Location,
+    name: &str,
+    value: &str,
+    file: &Path,
+) -> Result<()> {
     loc.new_attr::<VarLenUnicode>()
         .shape(())
         .create(name)
@@ -397,6 +403,13 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
     })
 }
 
+/// Writes `text` to `path` atomically (refusing to overwrite without `force`).
+pub fn write_text_atomically(path: &Path, force: bool, text: &str) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        std::fs::write(tmp, text).map_err(|e| Error::io(path, e))
+    })
+}
+
 /// Writes a run as CSV with one header line (units in the column names): the contact series,
 /// or for bar scenes the time axis with each gauge's strain and voltage.
 pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
@@ -424,9 +437,7 @@ pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
         text.push_str(&row.join(","));
         text.push('\n');
     }
-    write_atomically(path, force, |tmp| {
-        std::fs::write(tmp, &text).map_err(|e| Error::io(path, e))
-    })
+    write_text_atomically(path, force, &text)
 }
 
 /// CSV column name with unit, e.g. `force_N`, `strain_rate_per_s`.

@@ -73,12 +73,11 @@
 use crate::apparatus::Apparatus;
 use crate::error::{Error, Result};
 use crate::gauge::{GaugeChannel, RawRecord};
-use hdf5::types::VarLenUnicode;
+use crate::io::{h5err, string_attr};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
 use std::io::Write;
 use std::path::Path;
-use std::str::FromStr;
 
 /// Bancroft first-mode fit for ν = 0.31 (physics.md §7): A, B, C, D, E, F of
 /// `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`.
@@ -926,13 +925,6 @@ pub fn reduce_record_file(
     )
 }
 
-fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
-    move |e| Error::Hdf5 {
-        file: file.display().to_string(),
-        message: e.to_string(),
-    }
-}
-
 /// Reads `/time` and `/gauges/{incident,transmission}/strain` of an HDF5 file written by
 /// `shpb run`.
 pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
@@ -1040,21 +1032,6 @@ fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
     v
 }
 
-/// Writes a string attribute.
-fn string_attr(loc: &hdf5::Location, name: &str, value: &str, file: &Path) -> Result<()> {
-    let s = VarLenUnicode::from_str(value)
-        .or_else(|_| VarLenUnicode::from_str(""))
-        .map_err(|e| Error::Hdf5 {
-            file: file.display().to_string(),
-            message: e.to_string(),
-        })?;
-    loc.new_attr::<VarLenUnicode>()
-        .shape(())
-        .create(name)
-        .and_then(|a| a.write_scalar(&s))
-        .map_err(h5err(file))
-}
-
 /// Writes a reduction to HDF5 atomically: root attributes `shpb_version` and `scene` (the
 /// command line), `/reduction/<series>` with `units` attributes, `/summary` scalar attributes
 /// with a `units` list.
@@ -1097,9 +1074,7 @@ pub fn write_reduction_csv(path: &Path, force: bool, r: &Reduction) -> Result<()
         text.push_str(&row.join(","));
         text.push('\n');
     }
-    crate::io::write_atomically(path, force, |tmp| {
-        std::fs::write(tmp, &text).map_err(|e| Error::io(path, e))
-    })
+    crate::io::write_text_atomically(path, force, &text)
 }
 
 /// Prints a line on stdout; a closed pipe is not an error.

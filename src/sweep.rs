@@ -317,13 +317,8 @@ pub fn run_points(
     })
 }
 
-/// The summary table as CSV: `run`, one column per axis key, then the summary columns with units.
-pub fn summary_csv(axes: &[Axis], rows: &[RunSummary]) -> String {
-    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
-    summary_csv_keys(&keys, rows)
-}
-
-/// [`summary_csv`] given the swept keys.
+/// The summary table as CSV: `run`, one column per swept key, then the summary columns with
+/// units; one row per run.
 pub fn summary_csv_keys(keys: &[String], rows: &[RunSummary]) -> String {
     let mut head = vec!["run".to_string()];
     head.extend(keys.iter().cloned());

@@ -18,7 +18,7 @@ mod restitution;
 
 use crate::error::{Error, Result};
 use crate::io::RunOutput;
-use crate::io::{check_output, write_atomically};
+use crate::io::check_output;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -505,9 +505,7 @@ pub fn write_report(dir: &Path, force: bool, results: &[CaseResult], ctx: &Conte
     }
     let md = report_markdown(results, ctx)?;
     let path = dir.join("REPORT.md");
-    write_atomically(&path, force, |tmp| {
-        std::fs::write(tmp, md.as_bytes()).map_err(|e| Error::io(tmp, e))
-    })
+    crate::io::write_text_atomically(&path, force, &md)
 }
 
 /// `shpb validate [CASE…] [--report DIR] [--force]`: runs the cases, prints the table, writes
