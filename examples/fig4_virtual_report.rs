@@ -10,20 +10,9 @@ use shpb::apparatus::Apparatus;
 use shpb::io::CsvTable;
 use shpb::reduce::{ReductionOptions, reduce_record_file};
 use shpb::scene::Params;
+use shpb::validate::gauge_records::SAMPLES;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The 2013-05-22 records: (sample, material, pressure tag).
-const RECORDS: [(u32, &str, &str); 8] = [
-    (1, "ss440c", "10"),
-    (2, "ss440c", "12p5"),
-    (3, "ss440c", "15"),
-    (4, "al2017", "12p5"),
-    (5, "al2017", "15"),
-    (6, "ss302", "10"),
-    (7, "ss302", "15"),
-    (8, "ss302", "12p5"),
-];
 
 /// A peak force (N) and the displacement at it (m).
 type Peak = (f64, f64);
@@ -56,17 +45,17 @@ fn fig4_record(root: &Path, m: &str, p: &str) -> Option<(f64, f64)> {
 
 /// Our reduction (peak back force, δ at peak) of the 2013-05-22 record of `m` at `p`, and the
 /// authors' reduction of it (sample 1: the literal formula, see the gauge-records report).
-fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(u32, Peak, Peak)> {
-    let (s, _, _) = RECORDS.iter().find(|(_, rm, rp)| *rm == m && *rp == p)?;
+fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(usize, Peak, Peak)> {
+    let scene = format!("{m}-{p}psi");
+    let (s, _, _, stem) = SAMPLES.iter().find(|r| r.2 == scene)?;
     let dir = root.join("validation/gauge-records/data");
-    let rec = dir.join(format!("2013-05-22_sample{s}_{m}.csv"));
+    let rec = dir.join(format!("2013-05-22_{stem}.csv"));
     let options = ReductionOptions {
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
         ..Default::default()
     };
     let r = reduce_record_file(&rec, app, &options).unwrap();
-    let authors =
-        measured_peak(&dir.join(format!("2013-05-22_sample{s}_{m}_authors_reduction.csv")));
+    let authors = measured_peak(&dir.join(format!("2013-05-22_{stem}_authors_reduction.csv")));
     Some((
         *s,
         (r.peak_back_force_n, r.displacement_at_peak_force_m),

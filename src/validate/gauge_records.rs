@@ -10,8 +10,9 @@ use crate::gauge::{PulseMetrics, RawRecord, pulse_metrics};
 use crate::reduce::record_strains;
 use std::fmt::Write as _;
 
-/// (sample, label, virtual scene stem, record file stem) of the eight 2013-05-22 records.
-const SAMPLES: [(usize, &str, &str, &str); 8] = [
+/// (sample, label, virtual scene stem in validation/fig4-virtual-shpb, record file stem in
+/// validation/gauge-records/data) of the eight 2013-05-22 records.
+pub const SAMPLES: [(usize, &str, &str, &str); 8] = [
     (1, "SS440c 10 psi", "ss440c-10psi", "sample1_ss440c"),
     (2, "SS440c 12.5 psi", "ss440c-12p5psi", "sample2_ss440c"),
     (3, "SS440c 15 psi", "ss440c-15psi", "sample3_ss440c"),

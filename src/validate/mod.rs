@@ -11,7 +11,7 @@ mod fig3;
 mod fig4_force;
 mod fig4_virtual;
 pub mod figure;
-mod gauge_records;
+pub mod gauge_records;
 mod hertz;
 mod inputs;
 mod restitution;
