@@ -261,12 +261,7 @@ fn check_every(v: &Validator, n: usize) -> Result<usize> {
 impl Params {
     /// Reads and validates a scene file.
     pub fn from_file(path: &Path) -> Result<Params> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let base = path
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from("."));
-        Params::from_toml(&text, &path.display().to_string(), &base)
+        Params::from_file_overridden(path, &[])
     }
 
     /// Validates scene TOML text; relative paths inside it are resolved against `base_dir`.
