@@ -361,6 +361,110 @@ fn moving_average(v: &[f64], half: usize) -> Vec<f64> {
         .collect()
 }
 
+/// The incident pulse a measured specimen history implies (what the incident gauge saw, moved to
+/// the specimen face), from force F(t) and sphere approach δ(t) alone: see [`implied_incident`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpliedIncident {
+    /// Sample times (those of the history), s.
+    pub time_s: Vec<f64>,
+    /// Incident stress at the face, compression positive, Pa.
+    pub stress_pa: Vec<f64>,
+    /// Largest incident stress, Pa.
+    pub peak_pa: f64,
+    /// Time of the largest incident stress, s.
+    pub peak_time_s: f64,
+    /// Full width of the pulse at half its peak, s (for an unshaped pulse: 2 L_striker / c0).
+    pub duration_half_s: f64,
+    /// Mean stress over that width, Pa (the plateau of an unshaped pulse, which its peak is not:
+    /// the spheres' inertia adds a spike at the start).
+    pub mean_over_half_pa: f64,
+    /// Impulse A ∫σ dt over the pulse (above 5 % of peak), N s: a stopped striker's momentum.
+    pub impulse_n_s: f64,
+    /// Energy the pulse carries, A c0 / E ∫σ² dt over the pulse (above 5 % of peak), J.
+    pub energy_j: f64,
+}
+
+/// Incident stress at the specimen face implied by force F and approach δ (physics.md §7 run
+/// backwards): with the front force equal to the back force F (equilibrium), the transmission
+/// face moving at F/(ρ c0 A) and the incident face at that plus δ̇, the one-wave relations
+/// F = A(σI + σR), v = (σI − σR)/(ρ c0) give σI = F/A + ρ c0 δ̇ / 2. δ̇ is a central difference over
+/// `smoothing_s` and F is averaged over the same span (the records are noisy). None if the
+/// history has fewer than 3 samples or no compressive pulse.
+pub fn implied_incident(
+    time_s: &[f64],
+    displacement_m: &[f64],
+    force_n: &[f64],
+    bar: &BarProperties,
+    smoothing_s: f64,
+) -> Option<ImpliedIncident> {
+    let n = time_s.len();
+    if n < 3 || displacement_m.len() != n || force_n.len() != n {
+        return None;
+    }
+    let dt = (time_s[n - 1] - time_s[0]) / (n - 1) as f64;
+    let half = ((smoothing_s / (2.0 * dt)).round() as usize).max(1);
+    let rho_c = bar.youngs_modulus_pa / bar.wave_speed_m_s;
+    let force = moving_average(force_n, half);
+    let stress_pa: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(half), (i + half).min(n - 1));
+            let rate = (displacement_m[b] - displacement_m[a]) / (time_s[b] - time_s[a]);
+            force[i] / bar.area_m2 + 0.5 * rho_c * rate
+        })
+        .collect();
+    let (k, &peak_pa) = stress_pa
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    if peak_pa <= 0.0 {
+        return None;
+    }
+    let (h0, h1) = interval_above(time_s, &stress_pa, k, 0.5 * peak_pa);
+    let (lo, hi) = index_interval_above(&stress_pa, k, 0.05 * peak_pa);
+    let integral = |f: &dyn Fn(f64) -> f64| -> f64 {
+        (lo..hi)
+            .map(|i| 0.5 * (f(stress_pa[i]) + f(stress_pa[i + 1])) * (time_s[i + 1] - time_s[i]))
+            .sum()
+    };
+    let impulse_n_s = bar.area_m2 * integral(&|s| s);
+    let (m0, m1) = index_interval_above(&stress_pa, k, 0.5 * peak_pa);
+    let mean_over_half_pa = stress_pa[m0..=m1].iter().sum::<f64>() / (m1 - m0 + 1) as f64;
+    let energy_j = bar.area_m2 / rho_c * integral(&|s| s * s);
+    Some(ImpliedIncident {
+        time_s: time_s.to_vec(),
+        peak_time_s: time_s[k],
+        duration_half_s: h1 - h0,
+        mean_over_half_pa,
+        impulse_n_s,
+        energy_j,
+        peak_pa,
+        stress_pa,
+    })
+}
+
+/// Sample indices (first, last) of the contiguous run around `k` where `y` ≥ `level`.
+fn index_interval_above(y: &[f64], k: usize, level: f64) -> (usize, usize) {
+    let lo = (0..k).rev().find(|&i| y[i] < level).map_or(0, |i| i + 1);
+    let hi = (k + 1..y.len())
+        .find(|&j| y[j] < level)
+        .map_or(y.len() - 1, |j| j - 1);
+    (lo, hi)
+}
+
+/// Times where `y` crosses `level` on either side of sample `k` (linear between samples; the
+/// record's ends if it never drops below).
+fn interval_above(t: &[f64], y: &[f64], k: usize, level: f64) -> (f64, f64) {
+    let cross = |i: usize| t[i] + (level - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i]);
+    let (lo, hi) = index_interval_above(y, k, level);
+    let start = if lo > 0 { cross(lo - 1) } else { t[0] };
+    let end = if hi + 1 < y.len() {
+        cross(hi)
+    } else {
+        t[y.len() - 1]
+    };
+    (start, end)
+}
+
 /// Subtracts the mean of the first `n` samples (none if `n` is 0).
 fn debias(v: &[f64], n: usize) -> Vec<f64> {
     crate::gauge::remove_baseline(v, n)

@@ -1,6 +1,7 @@
 //! Case `fig4-virtual-shpb`: the full virtual SHPB test (calibrated gas gun and copper shaper,
 //! the authors' bars, two spheres with the paper's law, gauges, the lab's reduction of the
-//! simulated records) for the nine scenes of `validation/fig4-virtual-shpb/`, against the eight
+//! simulated records) for the nine scenes of `validation/fig4-virtual-shpb/`, and the SS440c 10
+//! and 12.5 psi tests as the Fig. 4 records were shot (20 cm striker, no shaper), against the eight
 //! measured Fig. 4 records: peak force and displacement at peak force.
 
 use super::figure::{Figure, Legend, Panel, Series, Style};
@@ -11,34 +12,53 @@ use crate::solver;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-/// (label, scene stem) of the nine virtual tests; the stem also names the Fig. 4 record of the
-/// same material and pressure in `validation/fig4-force-driven/` when there is one.
-pub(crate) const SCENES: [(&str, &str); 9] = [
-    ("SS440c 10 psi", "ss440c-10psi"),
-    ("SS440c 12.5 psi", "ss440c-12p5psi"),
-    ("SS440c 15 psi", "ss440c-15psi"),
-    ("SS302 10 psi", "ss302-10psi"),
-    ("SS302 12.5 psi", "ss302-12p5psi"),
-    ("SS302 15 psi", "ss302-15psi"),
-    ("Al2017 10 psi", "al2017-10psi"),
-    ("Al2017 12.5 psi", "al2017-12p5psi"),
-    ("Al2017 15 psi", "al2017-15psi"),
+/// (label, scene stem, stem of the Fig. 4 record of the same material and pressure in
+/// `validation/fig4-force-driven/`, if there is one) of the virtual tests: the nine with the
+/// 2013-05-22 set-up (10 cm striker, copper shaper) and the two SS440c tests the Fig. 4 records
+/// show were shot with a 20 cm striker and no shaper (validation/fig4-virtual-shpb/REPORT.md).
+pub(crate) const SCENES: [(&str, &str, &str); 11] = [
+    ("SS440c 10 psi", "ss440c-10psi", "ss440c-10psi"),
+    ("SS440c 12.5 psi", "ss440c-12p5psi", "ss440c-12p5psi"),
+    ("SS440c 15 psi", "ss440c-15psi", "ss440c-15psi"),
+    ("SS302 10 psi", "ss302-10psi", "ss302-10psi"),
+    ("SS302 12.5 psi", "ss302-12p5psi", "ss302-12p5psi"),
+    ("SS302 15 psi", "ss302-15psi", "ss302-15psi"),
+    ("Al2017 10 psi", "al2017-10psi", "al2017-10psi"),
+    ("Al2017 12.5 psi", "al2017-12p5psi", "al2017-12p5psi"),
+    ("Al2017 15 psi", "al2017-15psi", "al2017-15psi"),
+    (
+        "SS440c 10 psi, 20 cm striker (as shot)",
+        "ss440c-10psi-20cm-striker",
+        "ss440c-10psi",
+    ),
+    (
+        "SS440c 12.5 psi, 20 cm striker (as shot)",
+        "ss440c-12p5psi-20cm-striker",
+        "ss440c-12p5psi",
+    ),
 ];
 
-/// Accepted band of (reduced peak force) / (measured peak force): ±20 %. Achieved 0.82–1.00;
-/// the real gun's shot-to-shot scatter at one nominal pressure is 10–16 % (two real SS440c tests
-/// at 10 psi differ by 16 % in peak force), which no deterministic model can follow.
+/// Accepted band of reduced / measured peak force and δ at peak for the tests run as the Fig. 4
+/// records were shot: ±10 %, the accuracy of the paper's law on the same records in the
+/// force-driven DEM (fig4-force-driven: SS440c δ at peak within 2–4 %, RMS over loading 5–11 %).
+/// Achieved 0.99–1.07.
+const AS_SHOT_RATIO: (f64, f64) = (0.90, 1.10);
+
+/// Accepted band of (reduced peak force) / (measured peak force) for the 2013-05-22 set-up: ±20 %.
+/// Achieved 0.82–1.01; the low end is SS440c at 10 and 12.5 psi, whose Fig. 4 records were shot
+/// with a 20 cm striker and no shaper (a different test: see the as-shot rows), and the real
+/// 2013-05-22 tests at one nominal pressure scatter by up to 16 % from the Fig. 4 ones.
 const FORCE_RATIO: (f64, f64) = (0.80, 1.20);
 
 /// Accepted band of (reduced δ at peak force) / (measured δ at peak force): ±15 %. Achieved
 /// 0.86–1.13 (Al2017 high, as in the force-driven DEM: the law, not the apparatus).
 const DELTA_RATIO: (f64, f64) = (0.85, 1.15);
 
-/// Runs the nine scenes (in parallel).
+/// Runs the scenes (in parallel).
 pub(crate) fn run_scenes(ctx: &Context) -> Result<Vec<VirtualRun>> {
     SCENES
         .par_iter()
-        .map(|&(_, stem)| {
+        .map(|&(_, stem, _)| {
             let path = ctx.path(&format!("validation/fig4-virtual-shpb/{stem}.toml"));
             let output = Params::from_file(&path)?.run()?;
             Ok(VirtualRun { stem, output })
@@ -85,7 +105,9 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
          contact history; *reduced*: what the reduction of the simulated records gives (peak back \
          force, δ at peak force) — what a lab would report, and what the checks use. *Measured*: \
          the Fig. 4 record of the same material and pressure (its δ counted from δ(0)). There is no \
-         Fig. 4 record for Al2017 at 10 psi.\n"
+         Fig. 4 record for Al2017 at 10 psi. The last two rows run SS440c at 10 and 12.5 psi as \
+         those Fig. 4 records were shot (`<material>-<psi>-20cm-striker.toml`: 20 cm striker, no \
+         shaper, Love-rod bars, the reduction dispersion-corrected).\n"
     );
     let _ = writeln!(
         md,
@@ -93,7 +115,13 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
     let mut panels = Vec::new();
-    for &(label, stem) in &SCENES {
+    for &(label, stem, record) in &SCENES {
+        let as_shot = stem.ends_with("-20cm-striker");
+        let (force_band, delta_band) = if as_shot {
+            (AS_SHOT_RATIO, AS_SHOT_RATIO)
+        } else {
+            (FORCE_RATIO, DELTA_RATIO)
+        };
         let run = runs
             .iter()
             .find(|r| r.stem == stem)
@@ -115,7 +143,7 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
                 )
             })
             .unwrap_or((f64::NAN, f64::NAN, f64::NAN));
-        let meas = measured(ctx, stem)?;
+        let meas = measured(ctx, record)?;
         let mut series = Vec::new();
         match &meas {
             Some((d, f)) => {
@@ -125,15 +153,15 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
                     format!("{label}: peak force, reduced / measured"),
                     f_red / fm,
                     Unit::Ratio,
-                    FORCE_RATIO.0,
-                    FORCE_RATIO.1,
+                    force_band.0,
+                    force_band.1,
                 ));
                 checks.push(Check::between(
                     format!("{label}: δ at peak force, reduced / measured"),
                     d_red / dm,
                     Unit::Ratio,
-                    DELTA_RATIO.0,
-                    DELTA_RATIO.1,
+                    delta_band.0,
+                    delta_band.1,
                 ));
                 let _ = writeln!(
                     md,
@@ -192,24 +220,31 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
     }
     let _ = writeln!(
         md,
-        "\n**Thresholds.** Reduced / measured peak force within {:.2}–{:.2} and δ at peak force \
-         within {:.2}–{:.2}. They are set from what the virtual test achieves (force 0.82–1.00, δ \
-         0.86–1.13 at the time of writing) and from the scatter of the real tests, which bounds \
-         what any deterministic model can reach: the two real SS440c tests at 10 psi (Fig. 4 and \
-         2013-05-22 sample 1) differ by 16 % in peak force, and the Fig. 4 records are not \
-         monotonic in pressure (δ at peak 271 µm at 12.5 psi, 260 µm at 15 psi). **SS440c at \
-         10 psi is the weakest point (force ≈ 0.82)**: the virtual test agrees with the other real \
-         10 psi test (sample 1: 10.6 kN reduced with the same bridge reading, virtual 10.1 kN), and \
-         the gun and shaper were calibrated on that day's records; no honest input moves the 10 psi \
-         test alone (validation/fig4-virtual-shpb/REPORT.md). The band is symmetric and no wider \
-         than the scatter of the real tests.\n",
-        FORCE_RATIO.0, FORCE_RATIO.1, DELTA_RATIO.0, DELTA_RATIO.1
+        "\n**Thresholds.** With the 2013-05-22 set-up (10 cm striker, copper shaper): reduced / \
+         measured peak force within {:.2}–{:.2} and δ at peak force within {:.2}–{:.2}, set from \
+         what the test achieves (force 0.82–1.01, δ 0.86–1.13) and from the scatter of the real \
+         tests. The SS440c 10 and 12.5 psi rows of that set-up are low (force 0.82 and 0.88) \
+         because those two Fig. 4 records were not shot with it: the incident pulse they imply \
+         (`shpb::reduce::implied_incident`) is the flat 82 µs pulse of a 20 cm striker without a \
+         shaper, with that striker's momentum and kinetic energy at the calibrated gun's velocity \
+         (validation/fig4-virtual-shpb/REPORT.md); with the shaped set-up the virtual 10 psi test \
+         agrees instead with the shaped real 10 psi test (2013-05-22 sample 1: 10.6 kN, virtual \
+         10.1 kN). **As shot** (`*-20cm-striker.toml`: `bars/authors-20cm-striker.toml`, the same \
+         gun doing the same work on the heavier striker, Love-rod bars, nothing fitted to Fig. 4): \
+         both within {:.2}–{:.2}, the accuracy of the paper's law on these records in the \
+         force-driven DEM above.\n",
+        FORCE_RATIO.0,
+        FORCE_RATIO.1,
+        DELTA_RATIO.0,
+        DELTA_RATIO.1,
+        AS_SHOT_RATIO.0,
+        AS_SHOT_RATIO.1
     );
     let _ = writeln!(
         md,
         "*Not modelled*: shot-to-shot variation of the gun and of the shaper (a fresh disc per \
-         test), the spheres' end inserts and alignment, bar dispersion (the simulated bars run \
-         without it, the reduction of the simulated records does not correct for it).\n"
+         test), the spheres' end inserts and alignment; bar dispersion only in the as-shot \
+         (unshaped) tests, where it matters (the shaped 15 psi test moves by 0.1 % with it).\n"
     );
     Ok(CaseResult {
         name: "fig4-virtual-shpb",

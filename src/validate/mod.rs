@@ -267,7 +267,7 @@ impl Context {
         self.root.join(relative)
     }
 
-    /// The nine virtual SHPB tests of `validation/fig4-virtual-shpb/` (run once, in parallel).
+    /// The virtual SHPB tests of `validation/fig4-virtual-shpb/` (run once, in parallel).
     pub fn virtual_runs(&self) -> Result<Arc<Vec<VirtualRun>>> {
         let mut guard = self
             .virtual_runs
