@@ -39,16 +39,7 @@ fn measured_peak(path: &Path) -> (f64, f64) {
 
 /// The Fig. 4 record of `m` at pressure tag `p`, if the paper has one.
 fn fig4_record(root: &Path, m: &str, p: &str) -> Option<(f64, f64)> {
-    std::fs::read_dir(root.join("validation/fig4-force-driven/data"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|q| {
-            q.file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with(&format!("{m}_{p}psi"))
-        })
-        .map(|q| measured_peak(&q))
+    fig4_path(root, m, p).map(|q| measured_peak(&q))
 }
 
 /// Our reduction (peak back force, δ at peak) of the 2013-05-22 record of `m` at `p`, and the

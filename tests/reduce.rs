@@ -550,6 +550,19 @@ fn virtual_shpb_test_reduces_to_its_own_contact_history() {
     );
 }
 
+/// The incident pulse implied by a run's true contact history (δ̇ over 4 µs).
+fn implied_from_contact(out: &RunOutput, bar: &BarProperties) -> shpb::reduce::ImpliedIncident {
+    let c = out.contact.as_ref().unwrap();
+    implied_incident(
+        c.time_s.as_ref().unwrap(),
+        &c.displacement_m,
+        &c.force_n,
+        bar,
+        4e-6,
+    )
+    .unwrap()
+}
+
 #[test]
 fn implied_incident_pulse_of_an_unshaped_test_is_the_strikers_square_pulse() {
     // A 20 cm striker straight on the incident bar (same material and diameter, non-dispersive
@@ -571,15 +584,7 @@ fn implied_incident_pulse_of_an_unshaped_test_is_the_strikers_square_pulse() {
     let bar = ReductionSetup::from_apparatus(&app).unwrap().incident_bar;
     let c0 = bar.wave_speed_m_s;
     let rho_c = bar.youngs_modulus_pa / c0;
-    let c = out.contact.as_ref().unwrap();
-    let pulse = implied_incident(
-        c.time_s.as_ref().unwrap(),
-        &c.displacement_m,
-        &c.force_n,
-        &bar,
-        4e-6,
-    )
-    .unwrap();
+    let pulse = implied_from_contact(&out, &bar);
     let checks = [
         ("plateau", pulse.mean_over_half_pa, 0.5 * rho_c * vel, 0.02),
         (
@@ -613,15 +618,7 @@ fn implied_incident_pulse_of_a_shaped_test_matches_the_incident_gauge() {
     let bar = ReductionSetup::from_apparatus(&authors())
         .unwrap()
         .incident_bar;
-    let c = out.contact.as_ref().unwrap();
-    let implied = implied_incident(
-        c.time_s.as_ref().unwrap(),
-        &c.displacement_m,
-        &c.force_n,
-        &bar,
-        4e-6,
-    )
-    .unwrap();
+    let implied = implied_from_contact(&out, &bar);
     let t = out.time_s.as_ref().unwrap();
     let strain = &out
         .gauges
