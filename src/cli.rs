@@ -189,6 +189,26 @@ pub enum Command {
         #[arg(long, default_value = "bars/authors.toml")]
         bars: PathBuf,
     },
+    /// Work out the incident pulse that loaded the spheres from a force–approach record.
+    ///
+    /// Reads a CSV with time_s, displacement_m and force_N (a Fig. 4 record, or `shpb run --csv`
+    /// of a test) and prints the incident stress pulse at the specimen face it implies,
+    /// σI = F/A + ρ c0 δ̇/2 (equal forces on both faces): peak, plateau, width, impulse, energy,
+    /// and the unshaped striker that would give it. With --pressure, also whether the set-up's
+    /// striker at the gun's velocity can deliver that impulse and energy at all.
+    Incident {
+        /// The force–approach CSV.
+        record: PathBuf,
+        /// Bar set-up file (bar material and diameter; striker and gun for --pressure).
+        #[arg(long, default_value = "bars/authors.toml")]
+        bars: PathBuf,
+        /// Gas-gun pressure of the test, with unit (e.g. 10psi), to test the set-up's striker.
+        #[arg(long, allow_hyphen_values = true)]
+        pressure: Option<String>,
+        /// Time span of the central difference for δ̇ and of the force average, µs.
+        #[arg(long, default_value_t = 4.0, allow_hyphen_values = true)]
+        smoothing_us: f64,
+    },
     /// Reduce a gauge record like the lab: forces at both faces, sphere approach, strain rate.
     ///
     /// Accepts the authors' raw CSV (time_s, incident_V, transmission_V) or an HDF5 file written by
@@ -333,6 +353,12 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             law,
         } => curve(&specimen, rate, to, points, law.into()),
         Command::Gun { pressure, bars } => gun(&pressure, &bars),
+        Command::Incident {
+            record,
+            bars,
+            pressure,
+            smoothing_us,
+        } => incident(&record, &bars, pressure.as_deref(), smoothing_us),
         Command::Reduce {
             record,
             bars,
@@ -417,6 +443,101 @@ fn gun(pressure: &str, bars: &Path) -> Result<()> {
         "elastic bar stress  {:.2} MPa (ρ c0 v / 2, without shaper)",
         0.5 * z * v / 1e6
     ))?;
+    Ok(())
+}
+
+/// `shpb incident`: the incident pulse a force–approach record implies (reduce::implied_incident).
+fn incident(record: &Path, bars: &Path, pressure: Option<&str>, smoothing_us: f64) -> Result<()> {
+    let apparatus = load_apparatus(bars)?;
+    let smoothing_s = Validator::new("command line").in_range(
+        "--smoothing-us",
+        smoothing_us,
+        0.0,
+        1000.0,
+        "µs",
+    )? * 1e-6;
+    // Every input is checked before anything is printed.
+    let gun_velocity = match pressure {
+        Some(text) => {
+            let p = crate::striker::cli_pressure(text)?;
+            let v = Validator::new("command line");
+            Some(apparatus.striker_velocity_m_s(p, &v, "--pressure")?)
+        }
+        None => None,
+    };
+    let table = crate::io::CsvTable::read(record)?;
+    let time = table.time_column("time_s")?;
+    let bar = crate::reduce::ReductionSetup::from_apparatus(&apparatus)?.incident_bar;
+    let pulse = crate::reduce::implied_incident(
+        time,
+        table.column("displacement_m")?,
+        table.column("force_N")?,
+        &bar,
+        smoothing_s,
+    )
+    .ok_or_else(|| Error::Input {
+        file: table.file.clone(),
+        key: "force_N".into(),
+        problem: "the record implies no compressive incident pulse".into(),
+        allowed: "a loading record: force and approach growing from the start".into(),
+    })?;
+    let c0 = bar.wave_speed_m_s;
+    let rho_c = bar.youngs_modulus_pa / c0;
+    say(&format!(
+        "record              {} ({} samples, {:.3} µs apart)",
+        record.display(),
+        time.len(),
+        (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64 * 1e6
+    ))?;
+    say(&format!(
+        "incident peak       {:.1} MPa at {:.1} µs",
+        pulse.peak_pa / 1e6,
+        pulse.peak_time_s * 1e6
+    ))?;
+    say(&format!(
+        "plateau             {:.1} MPa (mean over the width at half peak)",
+        pulse.mean_over_half_pa / 1e6
+    ))?;
+    say(&format!(
+        "width at half peak  {:.1} µs",
+        pulse.duration_half_s * 1e6
+    ))?;
+    say(&format!("impulse             {:.4} N s", pulse.impulse_n_s))?;
+    say(&format!("energy              {:.3} J", pulse.energy_j))?;
+    // An unshaped striker of the bar's impedance gives a square pulse: ρ c0 v / 2 for 2 L / c0.
+    let length_m = 0.5 * c0 * pulse.duration_half_s;
+    let velocity = 2.0 * pulse.mean_over_half_pa / rho_c;
+    let mass = apparatus.material.density_kg_m3 * bar.area_m2 * length_m;
+    say(&format!(
+        "unshaped striker    {:.3} m at {:.2} m/s would give that plateau and width \
+         (momentum {:.3} N s, energy {:.2} J)",
+        length_m,
+        velocity,
+        mass * velocity,
+        0.5 * mass * velocity * velocity
+    ))?;
+    if let Some(v0) = gun_velocity {
+        let m = apparatus.striker_mass_kg();
+        // Giving impulse I, the striker leaves at v0 − I/m: the pulse can carry at most the
+        // kinetic energy it lost, whatever a shaper does.
+        let after = v0 - pulse.impulse_n_s / m;
+        let most = 0.5 * m * (v0 * v0 - after * after);
+        say(&format!(
+            "set-up's striker    {:.3} m, {:.4} kg at {v0:.3} m/s: momentum {:.3} N s, energy {:.2} J",
+            apparatus.striker.length_m,
+            m,
+            m * v0,
+            0.5 * m * v0 * v0
+        ))?;
+        say(&format!(
+            "  giving this impulse it can put at most {most:.2} J into the bar: {}",
+            if pulse.energy_j > most {
+                "the record's pulse is NOT possible with this striker at this pressure"
+            } else {
+                "possible"
+            }
+        ))?;
+    }
     Ok(())
 }
 

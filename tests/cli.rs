@@ -735,3 +735,86 @@ fn full_test_writes_the_documented_hdf5_layout() {
     assert!((f_red / f_true - 1.0).abs() < 0.02, "{f_red} vs {f_true}");
     assert!((d_red / d_true - 1.0).abs() < 0.02, "{d_red} vs {d_true}");
 }
+
+#[test]
+fn incident_tells_which_striker_a_record_was_shot_with() {
+    // The Fig. 4 SS440c 10 psi record carries more energy, for its impulse, than the 10 cm striker
+    // at the calibrated gun's 10 psi velocity can give (momentum and energy conservation), and
+    // fits the 20 cm striker of bars/authors-20cm-striker.toml (validation/fig4-virtual-shpb).
+    let tmp = TempDir::new().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let record = measured_force_csv();
+    let run = |bars: &str| {
+        let out = shpb(
+            tmp.path(),
+            &[
+                "incident",
+                &record,
+                "--bars",
+                &format!("{root}/bars/{bars}"),
+                "--pressure",
+                "10psi",
+            ],
+        );
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    let short = run("authors.toml");
+    assert!(short.contains("NOT possible"), "{short}");
+    // The width of the flat pulse is 2 L / c0 of a 20 cm striker, within 2 %.
+    let line = short
+        .lines()
+        .find(|l| l.starts_with("unshaped striker"))
+        .unwrap();
+    let length: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!((length / 0.20 - 1.0).abs() < 0.02, "{line}");
+    let long = run("authors-20cm-striker.toml");
+    assert!(long.contains(": possible"), "{long}");
+}
+
+#[test]
+fn incident_refuses_bad_input_naming_file_and_key() {
+    let tmp = TempDir::new().unwrap();
+    let bars = format!("{}/bars/authors.toml", env!("CARGO_MANIFEST_DIR"));
+    let csv = write(tmp.path(), "f.csv", "time_s,force_N\n0,1\n1e-6,2\n");
+    let run = |args: &[&str]| {
+        let mut all = vec!["incident"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["--bars", &bars]);
+        shpb(tmp.path(), &all)
+    };
+    let out = run(&[csv.to_str().unwrap()]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["f.csv", "displacement_m"],
+    );
+    let record = measured_force_csv();
+    let out = run(&[&record, "--smoothing-us", "-1"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--smoothing-us", "allowed"],
+    );
+    let out = run(&[&record, "--pressure", "90psi"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--pressure", "allowed"],
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "printed before refusing: {}",
+        text(&out.stdout)
+    );
+    let out = shpb(tmp.path(), &["incident", &record, "--bars", "nothere.toml"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--bars", "nothere.toml"],
+    );
+}

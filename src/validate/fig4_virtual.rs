@@ -225,7 +225,7 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
          what the test achieves (force 0.82–1.01, δ 0.86–1.13) and from the scatter of the real \
          tests. The SS440c 10 and 12.5 psi rows of that set-up are low (force 0.82 and 0.88) \
          because those two Fig. 4 records were not shot with it: the incident pulse they imply \
-         (`shpb::reduce::implied_incident`) is the flat 82 µs pulse of a 20 cm striker without a \
+         (`shpb::reduce::implied_incident`) is the flat 81 µs pulse of a 20 cm striker without a \
          shaper, with that striker's momentum and kinetic energy at the calibrated gun's velocity \
          (validation/fig4-virtual-shpb/REPORT.md); with the shaped set-up the virtual 10 psi test \
          agrees instead with the shaped real 10 psi test (2013-05-22 sample 1: 10.6 kN, virtual \
