@@ -527,10 +527,11 @@ const ANALYSIS: &str = "
     (energy within 0.3–8 % of the simulated one at the same pressure);
   - the SS440c 10 and 12.5 psi records (also the only ones sampled at 20 MHz, where the others
     are at 10 MHz) imply a flat pulse rising within a few µs and 81 µs wide at half height,
-    2 L/c0 of a 20 cm striker; its plateau (79 and 94 MPa) is ρ c0 v/2, its impulse (1.92 and
-    2.27 N s) is within 1–2 % of m v of a 20 cm striker fired by the calibrated gun (4.11 and
-    4.80 m/s: the same work on twice the mass; 1.90 and 2.22 N s), and its energy (3.79 and
-    5.33 J) is within 3 % of that striker's kinetic energy (3.91 and 5.33 J). The shaped set-up at these pressures puts only 2.6 and 3.8 J into the bar;
+    2 L/c0 of a 20 cm striker; its plateau (79 and 94 MPa) is within 2 % of ρ c0 v/2 (81 and
+    95 MPa) and its impulse (1.92 and 2.27 N s) within 2.5 % of m v (1.90 and 2.22 N s) of a
+    20 cm striker fired by the calibrated gun (4.11 and 4.80 m/s: the same work on twice the
+    mass), and its energy (3.79 and 5.33 J) within 3 % of that striker's kinetic energy (3.91
+    and 5.33 J). The shaped set-up at these pressures puts only 2.6 and 3.8 J into the bar;
     a 10 cm striker at the calibrated velocity cannot deliver that impulse and energy together:
     giving that impulse it leaves at a speed that takes with it all but 3.20 and 4.28 J (last
     columns of the first table), whatever the shaper does.
