@@ -19,28 +19,18 @@
 use rayon::prelude::*;
 use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb::bar::Dispersion;
-use shpb::gauge::{
-    PulseMetrics, RawRecord, authors_stress_from_voltage, pulse_metrics, remove_baseline,
-};
+use shpb::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
 use shpb::plot::{Axes, Curve, xy_plot};
 use shpb::scene::resample;
 use shpb::shaper::PulseShaper;
 use shpb::solver::pulse::simulate_chain;
 use shpb::striker::{Gun, PSI_PA};
+use shpb::validate::gauge_records::{
+    BASELINE_SAMPLES, INCIDENT_WINDOW_S as WINDOW_S, SAMPLES, incident_pulse,
+};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// The records: sample number, material, gun pressure (psi).
-const SAMPLES: [(usize, &str, f64); 8] = [
-    (1, "ss440c", 10.0),
-    (2, "ss440c", 12.5),
-    (3, "ss440c", 15.0),
-    (4, "al2017", 12.5),
-    (5, "al2017", 15.0),
-    (6, "ss302", 10.0),
-    (7, "ss302", 15.0),
-    (8, "ss302", 12.5),
-];
 /// The three gun pressures, psi.
 const PRESSURES_PSI: [f64; 3] = [10.0, 12.5, 15.0];
 /// Tolerances of the issue: peak, rise 10–90 %, duration at 10 %.
@@ -48,10 +38,6 @@ const TOL: [f64; 3] = [0.15, 0.20, 0.20];
 const METRIC_NAMES: [&str; 3] = ["peak", "rise 10–90 %", "duration at 10 %"];
 /// Tolerance (weight) of the pulse energy in the objective: that of the issue's shape metrics.
 const ENERGY_TOL: f64 = 0.20;
-/// Pre-trigger samples averaged for the baseline.
-const BASELINE_SAMPLES: usize = 900;
-/// Window of the incident pulse in a record, s after the trigger.
-const WINDOW_S: (f64, f64) = (-10e-6, 250e-6);
 /// Cell size and gauge grid of the calibration runs (the `pulse` scene's defaults), m.
 const CELL_M: f64 = 1e-3;
 const GAUGE_LENGTH_M: f64 = 2e-3;
@@ -73,29 +59,16 @@ struct Record {
 }
 
 fn read_records(a: &Apparatus) -> Vec<Record> {
-    let e = a.material.youngs_modulus_pa;
-    let ch = a.gauges.channel("incident").expect("incident channel");
     SAMPLES
         .iter()
-        .map(|&(sample, material, psi)| {
-            let path = root().join(format!(
-                "validation/gauge-records/data/2013-05-22_sample{sample}_{material}.csv"
-            ));
-            let r = RawRecord::read(&path).expect("record");
-            let v = remove_baseline(&r.incident_v, BASELINE_SAMPLES);
-            let (time_s, stress_pa): (Vec<f64>, Vec<f64>) = r
-                .time_s
-                .iter()
-                .zip(&v)
-                .filter(|(t, _)| (WINDOW_S.0..=WINDOW_S.1).contains(*t))
-                .map(|(&t, &v)| (t, -e * ch.strain_from_voltage(v)))
-                .unzip();
+        .map(|s| {
+            let (time_s, stress_pa) = incident_pulse(a, &s.record_path(&root())).expect("record");
             let metrics = pulse_metrics(&time_s, &stress_pa, false).expect("incident pulse");
             let energy_j = pulse_energy_j(a, &time_s, &stress_pa);
             Record {
-                sample,
-                material,
-                psi,
+                sample: s.number,
+                material: s.material,
+                psi: s.psi,
                 time_s,
                 stress_pa,
                 metrics,

@@ -46,17 +46,15 @@ fn fig4_record(root: &Path, m: &str, p: &str) -> Option<(f64, f64)> {
 /// authors' reduction of it (sample 1: the literal formula, see the gauge-records report).
 fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(usize, Peak, Peak)> {
     let scene = format!("{m}-{p}psi");
-    let (s, _, _, stem) = SAMPLES.iter().find(|r| r.2 == scene)?;
-    let dir = root.join("validation/gauge-records/data");
-    let rec = dir.join(format!("2013-05-22_{stem}.csv"));
+    let s = SAMPLES.iter().find(|r| r.scene == scene)?;
     let options = ReductionOptions {
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
         ..Default::default()
     };
-    let r = reduce_record_file(&rec, app, &options).unwrap();
-    let authors = measured_peak(&dir.join(format!("2013-05-22_{stem}_authors_reduction.csv")));
+    let r = reduce_record_file(&s.record_path(root), app, &options).unwrap();
+    let authors = measured_peak(&s.authors_reduction_path(root));
     Some((
-        *s,
+        s.number,
         (r.peak_back_force_n, r.displacement_at_peak_force_m),
         authors,
     ))

@@ -12,20 +12,9 @@ use shpb::reduce::{
     Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
     reduce_record_file,
 };
+use shpb::validate::gauge_records::SAMPLES;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// One record: sample number, material, gun pressure (psi), file stem.
-const SAMPLES: [(usize, &str, &str, &str); 8] = [
-    (1, "SS440c", "10", "sample1_ss440c"),
-    (2, "SS440c", "12.5", "sample2_ss440c"),
-    (3, "SS440c", "15", "sample3_ss440c"),
-    (4, "Al2017", "12.5", "sample4_al2017"),
-    (5, "Al2017", "15", "sample5_al2017"),
-    (6, "SS302", "10", "sample6_ss302"),
-    (7, "SS302", "15", "sample7_ss302"),
-    (8, "SS302", "12.5", "sample8_ss302"),
-];
 
 /// The acceptance tolerance on the peak back force.
 const TOLERANCE: f64 = 0.15;
@@ -193,7 +182,7 @@ fn literal(a: &Apparatus) -> Apparatus {
 struct Row {
     n: usize,
     material: &'static str,
-    psi: &'static str,
+    psi: f64,
     ours: Reduction,
     ours_nodisp: Reduction,
     literal_peak: f64,
@@ -219,7 +208,6 @@ struct Row {
 fn main() -> shpb::Result<()> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let out_dir = root.join("validation/gauge-records");
-    let data = out_dir.join("data");
     let bars = root.join("bars/authors.toml");
     let app = Apparatus::from_file(&bars)?;
     let lit = literal(&app);
@@ -229,9 +217,11 @@ fn main() -> shpb::Result<()> {
     let ea = setup.transmission_bar.youngs_modulus_pa * setup.transmission_bar.area_m2;
     let default = ReductionOptions::default();
     let mut rows = Vec::new();
-    for (n, material, psi, stem) in SAMPLES {
-        let rec_path = data.join(format!("2013-05-22_{stem}.csv"));
-        let auth_path = data.join(format!("2013-05-22_{stem}_authors_reduction.csv"));
+    for sample in SAMPLES {
+        let (n, psi) = (sample.number, sample.psi);
+        let material = sample.label.split(' ').next().unwrap_or(sample.material);
+        let rec_path = sample.record_path(&root);
+        let auth_path = sample.authors_reduction_path(&root);
         let ours = reduce_record_file(&rec_path, &app, &default)?;
         let ours_nodisp = reduce_record_file(
             &rec_path,

@@ -205,6 +205,24 @@ pub struct ReductionInput {
     pub transmission_strain: Vec<f64>,
 }
 
+impl ReductionInput {
+    /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`
+    /// of `shpb run`), if it recorded both channels.
+    pub fn from_noise_free_gauges(out: &crate::io::RunOutput) -> Option<ReductionInput> {
+        let strain = |name: &str| {
+            out.gauges
+                .iter()
+                .find(|g| g.name == name)
+                .map(|g| g.strain.clone())
+        };
+        Some(ReductionInput {
+            time_s: out.time_s.clone()?,
+            incident_strain: strain("incident")?,
+            transmission_strain: strain("transmission")?,
+        })
+    }
+}
+
 /// Manual window settings; each `None` keeps the automatic rule (module docs, "Windows").
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct WindowOverride {

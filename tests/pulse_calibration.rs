@@ -7,24 +7,14 @@
 use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb::bar::Dispersion;
 use shpb::error::Validator;
-use shpb::gauge::{PulseMetrics, RawRecord, pulse_metrics, remove_baseline};
+use shpb::gauge::{PulseMetrics, pulse_metrics};
 use shpb::scene::resample;
 use shpb::shaper::PulseShaper;
 use shpb::solver::pulse::simulate_chain;
 use shpb::striker::PSI_PA;
+use shpb::validate::gauge_records::{SAMPLES, Sample, incident_pulse};
 use std::path::PathBuf;
 
-/// Sample number, material, gun pressure (psi).
-const SAMPLES: [(usize, &str, f64); 8] = [
-    (1, "ss440c", 10.0),
-    (2, "ss440c", 12.5),
-    (3, "ss440c", 15.0),
-    (4, "al2017", 12.5),
-    (5, "al2017", 15.0),
-    (6, "ss302", 10.0),
-    (7, "ss302", 15.0),
-    (8, "ss302", 12.5),
-];
 const PRESSURES_PSI: [f64; 3] = [10.0, 12.5, 15.0];
 /// The tolerances: peak, rise 10–90 %, duration at 10 % of peak. Never loosen them.
 const TOL_PEAK: f64 = 0.15;
@@ -35,23 +25,10 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Metrics of the incident pulse of a record: baseline over the first 900 samples, stress
-/// (compression positive) from the shipped channel, −10 to 250 µs after the trigger.
-fn record_metrics(a: &Apparatus, sample: usize, material: &str) -> PulseMetrics {
-    let e = a.material.youngs_modulus_pa;
-    let ch = a.gauges.channel("incident").expect("incident channel");
-    let path = root().join(format!(
-        "validation/gauge-records/data/2013-05-22_sample{sample}_{material}.csv"
-    ));
-    let r = RawRecord::read(&path).unwrap();
-    let v = remove_baseline(&r.incident_v, 900);
-    let (t, s): (Vec<f64>, Vec<f64>) = r
-        .time_s
-        .iter()
-        .zip(&v)
-        .filter(|(t, _)| (-10e-6..=250e-6).contains(*t))
-        .map(|(&t, &v)| (t, -e * ch.strain_from_voltage(v)))
-        .unzip();
+/// Metrics of the incident pulse of a record, read as the calibration reads it
+/// (`validate::gauge_records::incident_pulse`).
+fn record_metrics(a: &Apparatus, sample: &Sample) -> PulseMetrics {
+    let (t, s) = incident_pulse(a, &sample.record_path(&root())).unwrap();
     pulse_metrics(&t, &s, false).expect("incident pulse")
 }
 
@@ -107,8 +84,9 @@ fn shipped_gun_and_shaper_match_every_incident_record() {
         })
         .collect();
     let mut failures = Vec::new();
-    for &(sample, material, psi) in &SAMPLES {
-        let m = record_metrics(&a, sample, material);
+    for rec in &SAMPLES {
+        let (sample, material, psi) = (rec.number, rec.material, rec.psi);
+        let m = record_metrics(&a, rec);
         let s = sims[PRESSURES_PSI.iter().position(|&p| p == psi).unwrap()];
         let checks = [
             ("peak", s.peak / m.peak - 1.0, TOL_PEAK),

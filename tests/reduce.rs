@@ -505,19 +505,7 @@ fn virtual_shpb_test_reduces_to_its_own_contact_history() {
     let params =
         shpb::scene::Params::from_file(&root().join("scenes/shpb-ss440c-10psi.toml")).unwrap();
     let out = params.run().unwrap();
-    let strain = |name: &str| {
-        out.gauges
-            .iter()
-            .find(|g| g.name == name)
-            .unwrap()
-            .strain
-            .clone()
-    };
-    let input = ReductionInput {
-        time_s: out.time_s.clone().unwrap(),
-        incident_strain: strain("incident"),
-        transmission_strain: strain("transmission"),
-    };
+    let input = ReductionInput::from_noise_free_gauges(&out).unwrap();
     let s = ReductionSetup::from_apparatus(&authors()).unwrap();
     let r = reduce(
         &input,

@@ -16,19 +16,7 @@ fn reduction_of_simulated_records_recovers_the_true_contact() {
             unreachable!()
         };
         let out = params.run().unwrap();
-        let g = |name: &str| {
-            out.gauges
-                .iter()
-                .find(|g| g.name == name)
-                .unwrap()
-                .strain
-                .clone()
-        };
-        let input = ReductionInput {
-            time_s: out.time_s.clone().unwrap(),
-            incident_strain: g("incident"),
-            transmission_strain: g("transmission"),
-        };
+        let input = ReductionInput::from_noise_free_gauges(&out).unwrap();
         let options = ReductionOptions {
             dispersion_correction: false,
             specimen_radii_m: Some((params.pair.sphere1.radius_m, params.pair.sphere2.radius_m)),

@@ -9,22 +9,109 @@ use crate::error::{Error, Result};
 use crate::gauge::{PulseMetrics, RawRecord, pulse_metrics};
 use crate::reduce::record_strains;
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
-/// (sample, label, virtual scene stem in validation/fig4-virtual-shpb, record file stem in
-/// validation/gauge-records/data) of the eight 2013-05-22 records.
-pub const SAMPLES: [(usize, &str, &str, &str); 8] = [
-    (1, "SS440c 10 psi", "ss440c-10psi", "sample1_ss440c"),
-    (2, "SS440c 12.5 psi", "ss440c-12p5psi", "sample2_ss440c"),
-    (3, "SS440c 15 psi", "ss440c-15psi", "sample3_ss440c"),
-    (4, "Al2017 12.5 psi", "al2017-12p5psi", "sample4_al2017"),
-    (5, "Al2017 15 psi", "al2017-15psi", "sample5_al2017"),
-    (6, "SS302 10 psi", "ss302-10psi", "sample6_ss302"),
-    (7, "SS302 15 psi", "ss302-15psi", "sample7_ss302"),
-    (8, "SS302 12.5 psi", "ss302-12p5psi", "sample8_ss302"),
+/// One real SHPB record of 2013-05-22 (`validation/gauge-records/data`, CC-BY 4.0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Sample number of the record.
+    pub number: usize,
+    /// Specimen material, as in `specimens/` (e.g. `ss440c`).
+    pub material: &'static str,
+    /// Gas-gun pressure, psi.
+    pub psi: f64,
+    /// Label for tables, e.g. `SS440c 10 psi`.
+    pub label: &'static str,
+    /// Stem of the virtual test of the same material and pressure in
+    /// `validation/fig4-virtual-shpb/`.
+    pub scene: &'static str,
+    /// Stem of the record file `2013-05-22_<stem>.csv` (and `…_authors_reduction.csv`).
+    pub stem: &'static str,
+}
+
+/// The eight records of 2013-05-22.
+pub const SAMPLES: [Sample; 8] = [
+    sample(1, "ss440c", 10.0, "SS440c 10 psi", "ss440c-10psi"),
+    sample(2, "ss440c", 12.5, "SS440c 12.5 psi", "ss440c-12p5psi"),
+    sample(3, "ss440c", 15.0, "SS440c 15 psi", "ss440c-15psi"),
+    sample(4, "al2017", 12.5, "Al2017 12.5 psi", "al2017-12p5psi"),
+    sample(5, "al2017", 15.0, "Al2017 15 psi", "al2017-15psi"),
+    sample(6, "ss302", 10.0, "SS302 10 psi", "ss302-10psi"),
+    sample(7, "ss302", 15.0, "SS302 15 psi", "ss302-15psi"),
+    sample(8, "ss302", 12.5, "SS302 12.5 psi", "ss302-12p5psi"),
 ];
 
+const fn sample(
+    number: usize,
+    material: &'static str,
+    psi: f64,
+    label: &'static str,
+    scene: &'static str,
+) -> Sample {
+    const STEMS: [&str; 8] = [
+        "sample1_ss440c",
+        "sample2_ss440c",
+        "sample3_ss440c",
+        "sample4_al2017",
+        "sample5_al2017",
+        "sample6_ss302",
+        "sample7_ss302",
+        "sample8_ss302",
+    ];
+    Sample {
+        number,
+        material,
+        psi,
+        label,
+        scene,
+        stem: STEMS[number - 1],
+    }
+}
+
+impl Sample {
+    /// Path of the raw record below the repository root `root`.
+    pub fn record_path(&self, root: &Path) -> PathBuf {
+        root.join(format!(
+            "validation/gauge-records/data/2013-05-22_{}.csv",
+            self.stem
+        ))
+    }
+
+    /// Path of the authors' reduction of the record below `root`.
+    pub fn authors_reduction_path(&self, root: &Path) -> PathBuf {
+        root.join(format!(
+            "validation/gauge-records/data/2013-05-22_{}_authors_reduction.csv",
+            self.stem
+        ))
+    }
+}
+
+/// Window of the incident pulse in a record, s after the trigger.
+pub const INCIDENT_WINDOW_S: (f64, f64) = (-10e-6, 250e-6);
+
+/// The incident pulse of a record as the calibration reads it: baseline = mean of the first
+/// [`BASELINE_SAMPLES`] samples, bar stress (compression positive) through the set-up's `incident` channel,
+/// [`INCIDENT_WINDOW_S`] after the trigger. Returns (time s, stress Pa).
+pub fn incident_pulse(a: &Apparatus, record: &Path) -> Result<(Vec<f64>, Vec<f64>)> {
+    let e = a.material.youngs_modulus_pa;
+    let ch = a.gauges.channel("incident").ok_or_else(|| Error::Input {
+        file: a.source.clone(),
+        key: "gauges".into(),
+        problem: "no `incident` channel in the gauge set-up".into(),
+        allowed: "a channel named incident".into(),
+    })?;
+    let r = RawRecord::read(record)?;
+    let v = crate::gauge::remove_baseline(&r.incident_v, BASELINE_SAMPLES);
+    Ok(r.time_s
+        .iter()
+        .zip(&v)
+        .filter(|(t, _)| (INCIDENT_WINDOW_S.0..=INCIDENT_WINDOW_S.1).contains(*t))
+        .map(|(&t, &v)| (t, -e * ch.strain_from_voltage(v)))
+        .unzip())
+}
+
 /// Pre-trigger samples whose mean is each record channel's baseline (90 µs at 10 MHz).
-const BASELINE_SAMPLES: usize = 900;
+pub const BASELINE_SAMPLES: usize = 900;
 
 /// Width of the centred moving average applied to the records before their pulse metrics, s
 /// (2 µs: the records' 0.16 mV noise would otherwise add ≈ 2σ to a peak; the simulated signals
@@ -124,10 +211,9 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
     let mut checks = Vec::new();
     let mut rows = Vec::new();
     let mut panels = Vec::new();
-    for (n, label, stem, file) in SAMPLES {
-        let path = ctx.path(&format!(
-            "validation/gauge-records/data/2013-05-22_{file}.csv"
-        ));
+    for sample in SAMPLES {
+        let (n, label, stem) = (sample.number, sample.label, sample.scene);
+        let path = sample.record_path(&ctx.path(""));
         let rec = RawRecord::read(&path)?;
         let strains = record_strains(&rec, &apparatus, BASELINE_SAMPLES)?;
         let half = (RECORD_SMOOTHING_S / rec.sample_interval_s() / 2.0).round() as usize;
