@@ -8,6 +8,7 @@ use shpb::gauge::{
     Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup, RawRecord,
     authors_stress_from_voltage, pulse_metrics, remove_baseline,
 };
+use shpb::validate::gauge_records::SAMPLES;
 use std::path::{Path, PathBuf};
 
 /// The authors' bar constants (shared/reference/README.md).
@@ -28,21 +29,9 @@ fn root() -> PathBuf {
 
 /// The eight raw records of 2013-05-22 (fixtures copied with credit), sample number and path.
 fn records() -> Vec<(usize, PathBuf)> {
-    let dir = root().join("validation/gauge-records/data");
-    let names = [
-        "sample1_ss440c",
-        "sample2_ss440c",
-        "sample3_ss440c",
-        "sample4_al2017",
-        "sample5_al2017",
-        "sample6_ss302",
-        "sample7_ss302",
-        "sample8_ss302",
-    ];
-    names
+    SAMPLES
         .iter()
-        .enumerate()
-        .map(|(i, n)| (i + 1, dir.join(format!("2013-05-22_{n}.csv"))))
+        .map(|s| (s.number, s.record_path(&root())))
         .collect()
 }
 

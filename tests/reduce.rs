@@ -14,6 +14,7 @@ use shpb::reduce::{
     bancroft_phase_velocity_m_s, bancroft_velocity_ratio, dispersion_delay_s, dispersion_shift,
     implied_incident, reduce, reduce_command, reduce_record_file,
 };
+use shpb::validate::gauge_records::SAMPLES;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -27,27 +28,16 @@ fn authors() -> Apparatus {
 
 /// The eight records: (sample, raw record, authors' reduction).
 fn records() -> Vec<(usize, PathBuf, PathBuf)> {
-    let dir = root().join("validation/gauge-records/data");
-    [
-        "sample1_ss440c",
-        "sample2_ss440c",
-        "sample3_ss440c",
-        "sample4_al2017",
-        "sample5_al2017",
-        "sample6_ss302",
-        "sample7_ss302",
-        "sample8_ss302",
-    ]
-    .iter()
-    .enumerate()
-    .map(|(i, n)| {
-        (
-            i + 1,
-            dir.join(format!("2013-05-22_{n}.csv")),
-            dir.join(format!("2013-05-22_{n}_authors_reduction.csv")),
-        )
-    })
-    .collect()
+    SAMPLES
+        .iter()
+        .map(|s| {
+            (
+                s.number,
+                s.record_path(&root()),
+                s.authors_reduction_path(&root()),
+            )
+        })
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------------
