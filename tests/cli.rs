@@ -91,6 +91,17 @@ fn assert_refused(dir: &Path, out: &Output, code: Option<i32>, needles: &[&str])
     err
 }
 
+/// Writes `text` as `scene.toml` in a fresh directory, runs it, and checks that it is refused as
+/// bad input with a message naming the scene file and containing every needle.
+fn assert_scene_refused(text: &str, needles: &[&str]) {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", text);
+    let out = run_scene(dir.path(), &scene);
+    let mut all = vec![scene.to_str().unwrap()];
+    all.extend_from_slice(needles);
+    assert_refused(dir.path(), &out, Some(BAD_INPUT), &all);
+}
+
 const QUASISTATIC: &str = r#"
 kind = "quasistatic"
 max_displacement_m = 200e-6
@@ -134,20 +145,10 @@ pair = "ss440c"
 
 #[test]
 fn unknown_key_in_scene_names_file_key_and_allowed_keys() {
-    let dir = TempDir::new().unwrap();
     // A typo in a top-level key (it must sit before the [specimen] table).
-    let scene = write(
-        dir.path(),
-        "scene.toml",
+    assert_scene_refused(
         &QUASISTATIC.replace("points = 51", "points = 51\nmax_displacment_m = 1e-4"),
-    );
-    let out = run_scene(dir.path(), &scene);
-    assert_refused(
-        dir.path(),
-        &out,
-        Some(BAD_INPUT),
         &[
-            scene.to_str().unwrap(),
             "max_displacment_m",
             "unknown field",
             // the allowed keys are listed
@@ -207,10 +208,7 @@ fn missing_force_csv_names_scene_and_key() {
 
 #[test]
 fn negative_radius_names_key_and_range() {
-    let dir = TempDir::new().unwrap();
-    let scene = write(
-        dir.path(),
-        "scene.toml",
+    assert_scene_refused(
         r#"
 kind = "quasistatic"
 max_displacement_m = 100e-6
@@ -223,14 +221,7 @@ radius_m = -1e-3
 material = "ss440c"
 radius_m = 3e-3
 "#,
-    );
-    let out = run_scene(dir.path(), &scene);
-    assert_refused(
-        dir.path(),
-        &out,
-        Some(BAD_INPUT),
         &[
-            scene.to_str().unwrap(),
             "`specimen.sphere1.radius_m`",
             "-1e-3 m is out of range",
             "allowed: greater than 0 and at most 5e0 m",
@@ -240,19 +231,9 @@ radius_m = 3e-3
 
 #[test]
 fn nan_velocity_names_key_and_range() {
-    let dir = TempDir::new().unwrap();
-    let scene = write(
-        dir.path(),
-        "scene.toml",
+    assert_scene_refused(
         &COLLISION.replace("velocity1_m_s = 2.0", "velocity1_m_s = nan"),
-    );
-    let out = run_scene(dir.path(), &scene);
-    assert_refused(
-        dir.path(),
-        &out,
-        Some(BAD_INPUT),
         &[
-            scene.to_str().unwrap(),
             "`velocity1_m_s`",
             "NaN is not a finite number",
             "allowed: -1e4 to 1e4 m/s",
@@ -291,10 +272,7 @@ fn non_monotonic_force_time_names_csv_column_and_row() {
 
 #[test]
 fn unknown_material_names_key_and_builtin_materials() {
-    let dir = TempDir::new().unwrap();
-    let scene = write(
-        dir.path(),
-        "scene.toml",
+    assert_scene_refused(
         r#"
 kind = "quasistatic"
 max_displacement_m = 100e-6
@@ -307,14 +285,7 @@ diameter_m = 6.35e-3
 material = "ss440c"
 diameter_m = 6.35e-3
 "#,
-    );
-    let out = run_scene(dir.path(), &scene);
-    assert_refused(
-        dir.path(),
-        &out,
-        Some(BAD_INPUT),
         &[
-            scene.to_str().unwrap(),
             "`specimen.sphere1.material`",
             "unknown material `unobtainium`",
             "allowed: ss440c, ss302, al2017 or a path to a material .toml file",
@@ -324,19 +295,9 @@ diameter_m = 6.35e-3
 
 #[test]
 fn unknown_kind_names_key_and_all_kinds() {
-    let dir = TempDir::new().unwrap();
-    let scene = write(
-        dir.path(),
-        "scene.toml",
+    assert_scene_refused(
         &QUASISTATIC.replace("\"quasistatic\"", "\"teleport\""),
-    );
-    let out = run_scene(dir.path(), &scene);
-    assert_refused(
-        dir.path(),
-        &out,
-        Some(BAD_INPUT),
         &[
-            scene.to_str().unwrap(),
             "`kind`",
             "unknown scene kind `teleport`",
             "allowed: quasistatic, constant-rate, collision, force-driven",
