@@ -731,6 +731,37 @@ fn incident_tells_which_striker_a_record_was_shot_with() {
     assert!((length / 0.20 - 1.0).abs() < 0.02, "{line}");
     let long = run("authors-20cm-striker.toml");
     assert!(long.contains(": possible"), "{long}");
+    // Energy conservation: a simulated shaped test's own pulse is always possible for its striker.
+    let out = shpb(
+        tmp.path(),
+        &[
+            "run",
+            &format!("{root}/scenes/shpb-ss440c-10psi.toml"),
+            "-o",
+            "sim.h5",
+            "--csv",
+            "sim.csv",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let sim = tmp.path().join("sim.csv");
+    let out = shpb(
+        tmp.path(),
+        &[
+            "incident",
+            sim.to_str().unwrap(),
+            "--bars",
+            &format!("{root}/bars/authors.toml"),
+            "--pressure",
+            "10psi",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains(": possible"),
+        "{}",
+        text(&out.stdout)
+    );
 }
 
 #[test]
