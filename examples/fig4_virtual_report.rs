@@ -275,12 +275,9 @@ fn as_shot_sections(
         for (label, _, ftag) in SS440C {
             if let Some(path) = fig4_path(root, m, ftag) {
                 let (r, dt) = implied_record(&path, bar);
-                // A striker of mass ms at v0 that gives impulse I leaves at v0 − I/ms: the pulse
-                // can carry at most the kinetic energy it lost.
                 let vs = gun_velocity(short, label);
                 let ms = short.striker_mass_kg();
-                let after = vs - r.pulse.impulse_n_s / ms;
-                let most = 0.5 * ms * (vs * vs - after * after);
+                let most = shpb::striker::most_pulse_energy_j(ms, vs, r.pulse.impulse_n_s);
                 writeln!(
                     md,
                     "| Fig. 4 {m} {label} psi | {:.2} | {} | {most:.2} | {} |",

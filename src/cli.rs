@@ -518,10 +518,7 @@ fn incident(record: &Path, bars: &Path, pressure: Option<&str>, smoothing_us: f6
     ))?;
     if let Some(v0) = gun_velocity {
         let m = apparatus.striker_mass_kg();
-        // Giving impulse I, the striker leaves at v0 − I/m: the pulse can carry at most the
-        // kinetic energy it lost, whatever a shaper does.
-        let after = v0 - pulse.impulse_n_s / m;
-        let most = 0.5 * m * (v0 * v0 - after * after);
+        let most = crate::striker::most_pulse_energy_j(m, v0, pulse.impulse_n_s);
         say(&format!(
             "set-up's striker    {:.3} m, {:.4} kg at {v0:.3} m/s: momentum {:.3} N s, energy {:.2} J",
             apparatus.striker.length_m,

@@ -134,6 +134,15 @@ pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
     Ok(p)
 }
 
+/// Most energy a striker of mass `mass_kg` arriving at `velocity_m_s` can put into the bar while
+/// giving it impulse `impulse_n_s`: it leaves at v − I/m and keeps that kinetic energy, so the
+/// pulse carries at most m (v² − (v − I/m)²)/2, whatever a pulse shaper does (momentum and
+/// energy conservation), J.
+pub fn most_pulse_energy_j(mass_kg: f64, velocity_m_s: f64, impulse_n_s: f64) -> f64 {
+    let after = velocity_m_s - impulse_n_s / mass_kg;
+    0.5 * mass_kg * (velocity_m_s * velocity_m_s - after * after)
+}
+
 /// Allowed pressure syntax, for error messages.
 pub const PRESSURE_SYNTAX: &str =
     "a number with a unit: psi, Pa, kPa, MPa or bar (gauge), e.g. 10psi or 68.9kPa";

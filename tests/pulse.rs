@@ -333,3 +333,19 @@ fn bad_pulse_scenes_are_refused() {
         .to_string();
     assert!(e.contains("`bars`") && e.contains("nowhere.toml"), "{e}");
 }
+
+#[test]
+fn most_pulse_energy_follows_momentum_and_energy_conservation() {
+    use shpb::striker::most_pulse_energy_j;
+    let (m, v) = (0.2312, 5.8);
+    let ke = 0.5 * m * v * v;
+    // A striker that stops (impulse m v) can hand over all its kinetic energy …
+    assert!((most_pulse_energy_j(m, v, m * v) / ke - 1.0).abs() < 1e-12);
+    // … one that rebounds elastically (impulse 2 m v) none, and no impulse means no energy.
+    assert!(most_pulse_energy_j(m, v, 2.0 * m * v).abs() < 1e-12 * ke);
+    assert_eq!(most_pulse_energy_j(m, v, 0.0), 0.0);
+    // Stopping is the best case: more or less impulse leaves the striker some energy.
+    for f in [0.5, 0.9, 1.1, 1.5] {
+        assert!(most_pulse_energy_j(m, v, f * m * v) < ke);
+    }
+}

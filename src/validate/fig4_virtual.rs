@@ -160,8 +160,7 @@ fn which_striker(ctx: &Context, checks: &mut Vec<Check>, md: &mut String) -> Res
         };
         let psi = stem_psi(stem);
         let (v, mass) = (velocity(&short, psi)?, short.striker_mass_kg());
-        let after = v - pulse.impulse_n_s / mass;
-        let most = 0.5 * mass * (v * v - after * after);
+        let most = crate::striker::most_pulse_energy_j(mass, v, pulse.impulse_n_s);
         let metric = format!(
             "{label}: implied incident energy / most the 10 cm striker can give with its impulse"
         );
