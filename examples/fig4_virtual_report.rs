@@ -187,7 +187,6 @@ fn implied(time: &[f64], d: &[f64], f: &[f64], bar: &BarProperties) -> Implied {
     // Metrics over the whole history, the series (for the figure) from the start of loading.
     let mut pulse = implied_incident(time, d, f, bar, IMPLIED_SMOOTHING_S).unwrap();
     pulse.stress_pa.drain(..i0);
-    pulse.time_s.clone_from(&time_s);
     Implied {
         time_s,
         displacement_m,

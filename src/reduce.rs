@@ -383,9 +383,7 @@ fn moving_average(v: &[f64], half: usize) -> Vec<f64> {
 /// the specimen face), from force F(t) and sphere approach δ(t) alone: see [`implied_incident`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImpliedIncident {
-    /// Sample times (those of the history), s.
-    pub time_s: Vec<f64>,
-    /// Incident stress at the face, compression positive, Pa.
+    /// Incident stress at the face at the history's sample times, compression positive, Pa.
     pub stress_pa: Vec<f64>,
     /// Largest incident stress, Pa.
     pub peak_pa: f64,
@@ -437,7 +435,8 @@ pub fn implied_incident(
     if peak_pa <= 0.0 {
         return None;
     }
-    let (h0, h1) = interval_above(time_s, &stress_pa, k, 0.5 * peak_pa);
+    let half_peak = index_interval_above(&stress_pa, k, 0.5 * peak_pa);
+    let (h0, h1) = crossing_times(time_s, &stress_pa, half_peak, 0.5 * peak_pa);
     let (lo, hi) = index_interval_above(&stress_pa, k, 0.05 * peak_pa);
     let integral = |f: &dyn Fn(f64) -> f64| -> f64 {
         (lo..hi)
@@ -445,11 +444,10 @@ pub fn implied_incident(
             .sum()
     };
     let impulse_n_s = bar.area_m2 * integral(&|s| s);
-    let (m0, m1) = index_interval_above(&stress_pa, k, 0.5 * peak_pa);
+    let (m0, m1) = half_peak;
     let mean_over_half_pa = stress_pa[m0..=m1].iter().sum::<f64>() / (m1 - m0 + 1) as f64;
     let energy_j = bar.area_m2 / rho_c * integral(&|s| s * s);
     Some(ImpliedIncident {
-        time_s: time_s.to_vec(),
         peak_time_s: time_s[k],
         duration_half_s: h1 - h0,
         mean_over_half_pa,
@@ -469,11 +467,10 @@ fn index_interval_above(y: &[f64], k: usize, level: f64) -> (usize, usize) {
     (lo, hi)
 }
 
-/// Times where `y` crosses `level` on either side of sample `k` (linear between samples; the
-/// record's ends if it never drops below).
-fn interval_above(t: &[f64], y: &[f64], k: usize, level: f64) -> (f64, f64) {
+/// Times where `y` crosses `level` just outside the run of samples `(lo, hi)` at or above it
+/// (linear between samples; the record's ends if it never drops below).
+fn crossing_times(t: &[f64], y: &[f64], (lo, hi): (usize, usize), level: f64) -> (f64, f64) {
     let cross = |i: usize| t[i] + (level - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i]);
-    let (lo, hi) = index_interval_above(y, k, level);
     let start = if lo > 0 { cross(lo - 1) } else { t[0] };
     let end = if hi + 1 < y.len() {
         cross(hi)

@@ -25,8 +25,6 @@ pub struct Sample {
     /// Stem of the virtual test of the same material and pressure in
     /// `validation/fig4-virtual-shpb/`.
     pub scene: &'static str,
-    /// Stem of the record file `2013-05-22_<stem>.csv` (and `…_authors_reduction.csv`).
-    pub stem: &'static str,
 }
 
 /// The eight records of 2013-05-22.
@@ -48,40 +46,30 @@ const fn sample(
     label: &'static str,
     scene: &'static str,
 ) -> Sample {
-    const STEMS: [&str; 8] = [
-        "sample1_ss440c",
-        "sample2_ss440c",
-        "sample3_ss440c",
-        "sample4_al2017",
-        "sample5_al2017",
-        "sample6_ss302",
-        "sample7_ss302",
-        "sample8_ss302",
-    ];
     Sample {
         number,
         material,
         psi,
         label,
         scene,
-        stem: STEMS[number - 1],
     }
 }
 
 impl Sample {
-    /// Path of the raw record below the repository root `root`.
+    /// Path of the raw record `2013-05-22_sample<N>_<material>.csv` below the repository root.
     pub fn record_path(&self, root: &Path) -> PathBuf {
-        root.join(format!(
-            "validation/gauge-records/data/2013-05-22_{}.csv",
-            self.stem
-        ))
+        self.data_path(root, "")
     }
 
-    /// Path of the authors' reduction of the record below `root`.
+    /// Path of the authors' reduction of the record below the repository root.
     pub fn authors_reduction_path(&self, root: &Path) -> PathBuf {
+        self.data_path(root, "_authors_reduction")
+    }
+
+    fn data_path(&self, root: &Path, suffix: &str) -> PathBuf {
         root.join(format!(
-            "validation/gauge-records/data/2013-05-22_{}_authors_reduction.csv",
-            self.stem
+            "validation/gauge-records/data/2013-05-22_sample{}_{}{suffix}.csv",
+            self.number, self.material
         ))
     }
 }
