@@ -423,10 +423,17 @@ fn require_bars_file(bars: &Path) -> Result<()> {
     Ok(())
 }
 
-fn gun(pressure: &str, bars: &Path) -> Result<()> {
-    let apparatus = load_apparatus(bars)?;
+/// The `--pressure` option read and checked against the set-up's gun: (gauge pressure Pa,
+/// striker velocity m/s).
+fn gun_shot(apparatus: &crate::apparatus::Apparatus, pressure: &str) -> Result<(f64, f64)> {
     let p = crate::striker::cli_pressure(pressure)?;
     let v = apparatus.striker_velocity_m_s(p, &Validator::new("command line"), "--pressure")?;
+    Ok((p, v))
+}
+
+fn gun(pressure: &str, bars: &Path) -> Result<()> {
+    let apparatus = load_apparatus(bars)?;
+    let (p, v) = gun_shot(&apparatus, pressure)?;
     let e = 0.5 * apparatus.striker_mass_kg() * v * v;
     let z = apparatus.material.density_kg_m3 * apparatus.material.wave_speed_m_s();
     say(&format!(
@@ -458,11 +465,7 @@ fn incident(record: &Path, bars: &Path, pressure: Option<&str>, smoothing_us: f6
     )? * 1e-6;
     // Every input is checked before anything is printed.
     let gun_velocity = match pressure {
-        Some(text) => {
-            let p = crate::striker::cli_pressure(text)?;
-            let v = Validator::new("command line");
-            Some(apparatus.striker_velocity_m_s(p, &v, "--pressure")?)
-        }
+        Some(text) => Some(gun_shot(&apparatus, text)?.1),
         None => None,
     };
     let table = crate::io::CsvTable::read(record)?;
