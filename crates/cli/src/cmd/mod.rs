@@ -1,0 +1,3 @@
+//! The subcommands of `shpb`, one file each.
+
+pub mod reduce;

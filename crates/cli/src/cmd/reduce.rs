@@ -1,0 +1,147 @@
+//! `shpb reduce`: the lab's reduction of a raw record or of a run file.
+
+use shpb_core::apparatus::Apparatus;
+use shpb_core::reduce::{PAPER_SPHERE_RADII_M, ReductionOptions, ReductionSetup, reduce_named};
+use shpb_input::gauges::reduce_record_file;
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
+use shpb_output::reduction::{is_hdf5, read_hdf5_strains, write_reduction_csv, write_reduction_hdf5};
+use std::io::Write;
+use std::path::Path;
+
+fn input_err(
+    file: &str,
+    key: &str,
+    problem: impl Into<String>,
+    allowed: impl Into<String>,
+) -> Error {
+    Error::Input {
+        file: file.to_string(),
+        key: key.to_string(),
+        problem: problem.into(),
+        allowed: allowed.into(),
+    }
+}
+
+/// Prints a line on stdout; a closed pipe is not an error.
+fn say(line: &str) -> Result<()> {
+    let stdout = std::io::stdout();
+    let mut w = stdout.lock();
+    match writeln!(w, "{line}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::io(Path::new("stdout"), e))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `shpb reduce RECORD --bars BARS [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
+/// reduces a raw record (the authors' CSV) or an HDF5 file of `shpb run` (recognised by its
+/// signature) with the set-up's bars and gauges, writes `/reduction/*` (HDF5) and/or CSV, and
+/// prints a summary. The strain rate uses the paper's spheres (r1 + r2 = 6.35 mm).
+pub fn reduce_command(
+    record: &Path,
+    bars: &Path,
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    force: bool,
+    no_dispersion: bool,
+) -> Result<()> {
+    for p in [output, csv].into_iter().flatten() {
+        shpb_output::io::check_output(p, force)?;
+    }
+    if !bars.is_file() {
+        return Err(input_err(
+            "command line",
+            "--bars",
+            format!("cannot read {}: no such file", bars.display()),
+            "a bar set-up .toml file such as bars/authors.toml",
+        ));
+    }
+    if !record.is_file() {
+        return Err(input_err(
+            "command line",
+            "RECORD",
+            format!("cannot read {}: no such file", record.display()),
+            "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
+        ));
+    }
+    let apparatus = Apparatus::from_file(bars)?;
+    let options = ReductionOptions {
+        dispersion_correction: !no_dispersion,
+        specimen_radii_m: Some(PAPER_SPHERE_RADII_M),
+        ..ReductionOptions::default()
+    };
+    let hdf5_input = is_hdf5(record)?;
+    let r = if hdf5_input {
+        let input = read_hdf5_strains(record)?;
+        reduce_named(
+            &input,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &options,
+            &record.display().to_string(),
+        )?
+    } else {
+        reduce_record_file(record, &apparatus, &options)?
+    };
+    let mut scene = format!("shpb reduce {} --bars {}", record.display(), bars.display());
+    if let Some(o) = output {
+        scene.push_str(&format!(" -o {}", o.display()));
+    }
+    if let Some(c) = csv {
+        scene.push_str(&format!(" --csv {}", c.display()));
+    }
+    if no_dispersion {
+        scene.push_str(" --no-dispersion");
+    }
+    if force {
+        scene.push_str(" --force");
+    }
+    if let Some(o) = output {
+        write_reduction_hdf5(o, force, &scene, &r)?;
+    }
+    if let Some(c) = csv {
+        write_reduction_csv(c, force, &r)?;
+    }
+    let bridges: Vec<String> = ["incident", "transmission"]
+        .iter()
+        .filter_map(|n| apparatus.gauges.channel(n))
+        .map(|c| {
+            format!(
+                "{} {} gain {}",
+                c.name,
+                c.bridge.kind.name(),
+                c.amplifier_gain
+            )
+        })
+        .collect();
+    say(&format!(
+        "record: {} ({}); bridges: {}",
+        record.display(),
+        if hdf5_input {
+            "HDF5 gauge strains"
+        } else {
+            "raw gauge voltages"
+        },
+        bridges.join(", ")
+    ))?;
+    say(&format!(
+        "windows: incident from {:.2} µs, reflected +{:.2} µs, transmitted +{:.2} µs, {:.1} µs long; dispersion correction {}",
+        r.windows.incident_start_s * 1e6,
+        r.windows.reflected_delay_s * 1e6,
+        r.windows.transmitted_delay_s * 1e6,
+        r.windows.duration_s * 1e6,
+        if r.dispersion_corrected { "on" } else { "off" }
+    ))?;
+    say(&format!(
+        "peak back force {:.1} N at t = {:.2} µs; displacement at peak force {:.2} µm; equilibrium ratio at peak {:.3}",
+        r.peak_back_force_n,
+        r.peak_back_force_time_s * 1e6,
+        r.displacement_at_peak_force_m * 1e6,
+        r.equilibrium_ratio_at_peak
+    ))?;
+    for w in &r.warnings {
+        say(&format!("warning: {w}"))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,812 @@
+//! The `shpb` binary end to end: bad input is refused with a message naming the file, the key
+//! and what is allowed, and leaves no output (nor temporary file) behind; good input writes
+//! HDF5 with units and provenance, CSV with a header, and a `curve` table on stdout.
+
+use hdf5::types::VarLenUnicode;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use tempfile::TempDir;
+
+const BIN: &str = env!("CARGO_BIN_EXE_shpb");
+
+/// Exit code the CLI documents for bad input.
+const BAD_INPUT: i32 = 2;
+
+/// Outputs requested by every failing run; none of them may exist afterwards.
+const OUTPUTS: [&str; 3] = ["out.h5", "out.csv", "out.png"];
+
+/// The measured SS440c 10 psi force history shipped with the repository.
+fn measured_force_csv() -> String {
+    format!(
+        "{}/validation/fig4-force-driven/data/ss440c_10psi_force10.csv",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write test input");
+    p
+}
+
+fn shpb(dir: &Path, args: &[&str]) -> Output {
+    Command::new(BIN)
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("run the shpb binary")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Runs `shpb run <scene>` asking for HDF5, CSV and PNG output in `dir`.
+fn run_scene(dir: &Path, scene: &Path) -> Output {
+    let scene = scene.to_str().expect("UTF-8 temp path");
+    shpb(
+        dir,
+        &[
+            "run", scene, "-o", "out.h5", "--csv", "out.csv", "--plot", "out.png",
+        ],
+    )
+}
+
+/// Entries of `dir` whose names start with `.tmp-` (the atomic writer's temporary files).
+fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .expect("list temp dir")
+        .map(|e| {
+            e.expect("dir entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .filter(|n| n.starts_with(".tmp-"))
+        .collect()
+}
+
+/// Checks a refused run: non-zero exit (`code` if given), every `needle` in stderr, and no
+/// output or temporary file in `dir`. Returns stderr.
+fn assert_refused(dir: &Path, out: &Output, code: Option<i32>, needles: &[&str]) -> String {
+    let err = text(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "expected failure, got success; stderr:\n{err}"
+    );
+    if let Some(c) = code {
+        assert_eq!(out.status.code(), Some(c), "exit code; stderr:\n{err}");
+    }
+    for n in needles {
+        assert!(err.contains(n), "stderr lacks `{n}`:\n{err}");
+    }
+    for o in OUTPUTS {
+        assert!(!dir.join(o).exists(), "{o} was left behind; stderr:\n{err}");
+    }
+    assert_eq!(
+        temporaries(dir),
+        Vec::<String>::new(),
+        "temporary files left"
+    );
+    err
+}
+
+/// Writes `text` as `scene.toml` in a fresh directory, runs it, and checks that it is refused as
+/// bad input with a message naming the scene file and containing every needle.
+fn assert_scene_refused(text: &str, needles: &[&str]) {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", text);
+    let out = run_scene(dir.path(), &scene);
+    let mut all = vec![scene.to_str().unwrap()];
+    all.extend_from_slice(needles);
+    assert_refused(dir.path(), &out, Some(BAD_INPUT), &all);
+}
+
+const QUASISTATIC: &str = r#"
+kind = "quasistatic"
+max_displacement_m = 200e-6
+points = 51
+
+[specimen]
+pair = "ss440c"
+"#;
+
+const CONSTANT_RATE: &str = r#"
+kind = "constant-rate"
+strain_rate_per_s = 1e4
+max_displacement_m = 200e-6
+points = 51
+
+[specimen]
+pair = "ss440c"
+"#;
+
+const COLLISION: &str = r#"
+kind = "collision"
+velocity1_m_s = 2.0
+
+[specimen]
+pair = "ss440c"
+"#;
+
+fn force_driven(csv: &str) -> String {
+    format!(
+        r#"
+kind = "force-driven"
+force_csv = "{csv}"
+
+[specimen]
+pair = "ss440c"
+"#
+    )
+}
+
+// ---------------------------------------------------------------- bad input
+
+#[test]
+fn unknown_key_in_scene_names_file_key_and_allowed_keys() {
+    // A typo in a top-level key (it must sit before the [specimen] table).
+    assert_scene_refused(
+        &QUASISTATIC.replace("points = 51", "points = 51\nmax_displacment_m = 1e-4"),
+        &[
+            "max_displacment_m",
+            "unknown field",
+            // the allowed keys are listed
+            "`max_displacement_m`",
+            "`strain_rate_per_s`",
+        ],
+    );
+}
+
+#[test]
+fn missing_scene_file_is_named() {
+    let dir = TempDir::new().unwrap();
+    let scene = dir.path().join("no-such-scene.toml");
+    let out = run_scene(dir.path(), &scene);
+    assert_refused(
+        dir.path(),
+        &out,
+        None,
+        &[scene.to_str().unwrap(), "No such file"],
+    );
+}
+
+#[test]
+fn missing_force_csv_is_named() {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", &force_driven("no-such-force.csv"));
+    let out = run_scene(dir.path(), &scene);
+    let csv = dir.path().join("no-such-force.csv");
+    assert_refused(
+        dir.path(),
+        &out,
+        None,
+        &[csv.to_str().unwrap(), "No such file"],
+    );
+}
+
+/// The message should also name the scene file and its `force_csv` key; that needs the
+/// `force_csv` read in `Params::from_toml` (src/scene.rs) to map its I/O error to an input
+/// error of the scene's validator.
+#[test]
+fn missing_force_csv_names_scene_and_key() {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", &force_driven("no-such-force.csv"));
+    let out = run_scene(dir.path(), &scene);
+    assert_refused(
+        dir.path(),
+        &out,
+        Some(BAD_INPUT),
+        &[
+            scene.to_str().unwrap(),
+            "`force_csv`",
+            "no-such-force.csv",
+            "allowed:",
+        ],
+    );
+}
+
+#[test]
+fn negative_radius_names_key_and_range() {
+    assert_scene_refused(
+        r#"
+kind = "quasistatic"
+max_displacement_m = 100e-6
+
+[specimen.sphere1]
+material = "ss440c"
+radius_m = -1e-3
+
+[specimen.sphere2]
+material = "ss440c"
+radius_m = 3e-3
+"#,
+        &[
+            "`specimen.sphere1.radius_m`",
+            "-1e-3 m is out of range",
+            "allowed: greater than 0 and at most 5e0 m",
+        ],
+    );
+}
+
+#[test]
+fn nan_velocity_names_key_and_range() {
+    assert_scene_refused(
+        &COLLISION.replace("velocity1_m_s = 2.0", "velocity1_m_s = nan"),
+        &[
+            "`velocity1_m_s`",
+            "NaN is not a finite number",
+            "allowed: -1e4 to 1e4 m/s",
+        ],
+    );
+}
+
+#[test]
+fn non_monotonic_force_time_names_csv_column_and_row() {
+    let dir = TempDir::new().unwrap();
+    let csv = write(
+        dir.path(),
+        "force.csv",
+        "# a force history whose clock runs backwards once\n\
+         time_s,force_N\n\
+         0,0\n\
+         1e-6,100\n\
+         3e-6,300\n\
+         2e-6,200\n\
+         4e-6,0\n",
+    );
+    let scene = write(dir.path(), "scene.toml", &force_driven("force.csv"));
+    let out = run_scene(dir.path(), &scene);
+    assert_refused(
+        dir.path(),
+        &out,
+        Some(BAD_INPUT),
+        &[
+            csv.to_str().unwrap(),
+            "`time_s`",
+            "not strictly increasing at data row 4 (2e-6 after 3e-6)",
+            "allowed: strictly increasing times",
+        ],
+    );
+}
+
+#[test]
+fn unknown_material_names_key_and_builtin_materials() {
+    assert_scene_refused(
+        r#"
+kind = "quasistatic"
+max_displacement_m = 100e-6
+
+[specimen.sphere1]
+material = "unobtainium"
+diameter_m = 6.35e-3
+
+[specimen.sphere2]
+material = "ss440c"
+diameter_m = 6.35e-3
+"#,
+        &[
+            "`specimen.sphere1.material`",
+            "unknown material `unobtainium`",
+            "allowed: ss440c, ss302, al2017 or a path to a material .toml file",
+        ],
+    );
+}
+
+#[test]
+fn unknown_kind_names_key_and_all_kinds() {
+    assert_scene_refused(
+        &QUASISTATIC.replace("\"quasistatic\"", "\"teleport\""),
+        &[
+            "`kind`",
+            "unknown scene kind `teleport`",
+            "allowed: quasistatic, constant-rate, collision, force-driven",
+        ],
+    );
+}
+
+#[test]
+fn existing_output_is_kept_without_force() {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", QUASISTATIC);
+    let h5 = write(dir.path(), "out.h5", "precious results\n");
+    let out = shpb(
+        dir.path(),
+        &["run", scene.to_str().unwrap(), "-o", "out.h5"],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(BAD_INPUT), "stderr:\n{err}");
+    assert!(err.contains("out.h5"), "stderr lacks the file:\n{err}");
+    assert!(err.contains("--force"), "stderr lacks the remedy:\n{err}");
+    assert_eq!(std::fs::read_to_string(&h5).unwrap(), "precious results\n");
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+
+    // The same for a CSV output: an existing one stops the run before the HDF5 file is written.
+    let csv = write(dir.path(), "out.csv", "precious,table\n");
+    std::fs::remove_file(&h5).unwrap();
+    let out = shpb(
+        dir.path(),
+        &[
+            "run",
+            scene.to_str().unwrap(),
+            "-o",
+            "out.h5",
+            "--csv",
+            "out.csv",
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(BAD_INPUT), "stderr:\n{err}");
+    assert!(err.contains("out.csv"), "stderr lacks the file:\n{err}");
+    assert_eq!(std::fs::read_to_string(&csv).unwrap(), "precious,table\n");
+    assert!(!h5.exists(), "out.h5 written although the run was refused");
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn existing_output_is_replaced_with_force() {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", QUASISTATIC);
+    let h5 = write(dir.path(), "out.h5", "precious results\n");
+    let out = shpb(
+        dir.path(),
+        &["run", scene.to_str().unwrap(), "-o", "out.h5", "--force"],
+    );
+    assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+    assert_ne!(std::fs::read(&h5).unwrap(), b"precious results\n");
+    let f = hdf5::File::open(&h5).expect("replaced file is HDF5");
+    assert_eq!(f.dataset("contact/force").unwrap().size(), 51);
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn curve_negative_to_names_option_and_range() {
+    let dir = TempDir::new().unwrap();
+    let out = shpb(dir.path(), &["curve", "--to", "-1"]);
+    assert_refused(
+        dir.path(),
+        &out,
+        Some(BAD_INPUT),
+        &[
+            "command line",
+            "`--to`",
+            "-1e0 m is out of range",
+            "allowed: greater than 0 and at most 1.5875e-3 m",
+        ],
+    );
+    assert!(out.stdout.is_empty(), "no table on refusal");
+}
+
+#[test]
+fn curve_nan_rate_names_option_and_range() {
+    let dir = TempDir::new().unwrap();
+    let out = shpb(dir.path(), &["curve", "--rate", "nan"]);
+    assert_refused(
+        dir.path(),
+        &out,
+        Some(BAD_INPUT),
+        &[
+            "command line",
+            "`--rate`",
+            "NaN is not a finite number",
+            "allowed: 0e0 to 1e9 1/s",
+        ],
+    );
+    assert!(out.stdout.is_empty(), "no table on refusal");
+}
+
+// ---------------------------------------------------------------- good input
+
+fn string_attr(loc: &hdf5::Location, name: &str) -> String {
+    loc.attr(name)
+        .unwrap_or_else(|e| panic!("attribute `{name}`: {e}"))
+        .read_scalar::<VarLenUnicode>()
+        .unwrap_or_else(|e| panic!("attribute `{name}` as string: {e}"))
+        .as_str()
+        .to_string()
+}
+
+/// Runs `scene_text` with `-o` and checks the HDF5 layout: `/contact/*` with units (those in
+/// `absent` missing), root provenance attributes, `/summary`. Returns the number of samples.
+fn run_and_check_hdf5(scene_text: &str, present: &[(&str, &str)], absent: &[&str]) -> usize {
+    let dir = TempDir::new().unwrap();
+    let scene = write(dir.path(), "scene.toml", scene_text);
+    let out = shpb(
+        dir.path(),
+        &["run", scene.to_str().unwrap(), "-o", "out.h5"],
+    );
+    assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+
+    let f = hdf5::File::open(dir.path().join("out.h5")).expect("open output");
+    assert_eq!(string_attr(&f, "shpb_version"), env!("CARGO_PKG_VERSION"));
+    assert_eq!(string_attr(&f, "scene"), scene_text);
+    assert!(f.group("summary").is_ok(), "no /summary group");
+
+    let force = f.dataset("contact/force").expect("/contact/force");
+    assert_eq!(string_attr(&force, "units"), "N");
+    let n = force.size();
+    assert!(n >= 2, "/contact/force has {n} samples");
+    let values: Vec<f64> = force.read_raw().unwrap();
+    assert!(values.iter().all(|v| v.is_finite()), "non-finite force");
+    for (name, units) in present {
+        let ds = f
+            .dataset(&format!("contact/{name}"))
+            .unwrap_or_else(|e| panic!("/contact/{name}: {e}"));
+        assert_eq!(string_attr(&ds, "units"), *units, "/contact/{name} units");
+        assert_eq!(ds.size(), n, "/contact/{name} length");
+    }
+    let contact = f.group("contact").unwrap();
+    for name in absent {
+        assert!(
+            !contact.link_exists(name),
+            "/contact/{name} written for a scene that does not produce it"
+        );
+    }
+    n
+}
+
+#[test]
+fn run_quasistatic_writes_hdf5() {
+    let n = run_and_check_hdf5(
+        QUASISTATIC,
+        &[("displacement", "m")],
+        &["time", "yield_stress", "strain_rate"],
+    );
+    assert_eq!(n, 51);
+}
+
+#[test]
+fn run_constant_rate_writes_hdf5() {
+    let n = run_and_check_hdf5(
+        CONSTANT_RATE,
+        &[
+            ("time", "s"),
+            ("displacement", "m"),
+            ("yield_stress", "Pa"),
+            ("strain_rate", "1/s"),
+        ],
+        &[],
+    );
+    assert_eq!(n, 51);
+}
+
+#[test]
+fn run_collision_writes_hdf5() {
+    run_and_check_hdf5(
+        COLLISION,
+        &[
+            ("time", "s"),
+            ("displacement", "m"),
+            ("yield_stress", "Pa"),
+            ("strain_rate", "1/s"),
+        ],
+        &[],
+    );
+}
+
+#[test]
+fn run_force_driven_writes_hdf5() {
+    run_and_check_hdf5(
+        &force_driven(&measured_force_csv()),
+        &[
+            ("time", "s"),
+            ("displacement", "m"),
+            ("yield_stress", "Pa"),
+            ("strain_rate", "1/s"),
+        ],
+        &[],
+    );
+}
+
+#[test]
+fn csv_output_has_a_header_line() {
+    let dir = TempDir::new().unwrap();
+    for (name, scene_text, header, rows) in [
+        (
+            "quasistatic",
+            QUASISTATIC,
+            "displacement_m,force_N",
+            Some(51),
+        ),
+        (
+            "collision",
+            COLLISION,
+            "time_s,displacement_m,force_N,yield_stress_Pa,strain_rate_per_s",
+            None,
+        ),
+    ] {
+        let scene = write(dir.path(), &format!("{name}.toml"), scene_text);
+        let csv = format!("{name}.csv");
+        let out = shpb(dir.path(), &["run", scene.to_str().unwrap(), "--csv", &csv]);
+        assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+        let body = std::fs::read_to_string(dir.path().join(&csv)).unwrap();
+        let mut lines = body.lines();
+        assert_eq!(lines.next(), Some(header), "{name}: header");
+        let data: Vec<&str> = lines.collect();
+        if let Some(r) = rows {
+            assert_eq!(data.len(), r, "{name}: rows");
+        }
+        let columns = header.split(',').count();
+        for row in &data {
+            let cells: Vec<&str> = row.split(',').collect();
+            assert_eq!(cells.len(), columns, "{name}: row `{row}`");
+            for c in cells {
+                c.parse::<f64>()
+                    .unwrap_or_else(|_| panic!("{name}: `{c}` is not a number"));
+            }
+        }
+    }
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn help_mentions_all_scene_kinds() {
+    let dir = TempDir::new().unwrap();
+    for args in [&["--help"][..], &["run", "--help"][..]] {
+        let out = shpb(dir.path(), args);
+        assert!(out.status.success(), "shpb {args:?} failed");
+        let help = text(&out.stdout);
+        for kind in ["quasistatic", "constant-rate", "collision", "force-driven"] {
+            assert!(
+                help.contains(kind),
+                "`shpb {args:?}` lacks `{kind}`:\n{help}"
+            );
+        }
+        // …and every kind the scene parser knows.
+        for (kind, _) in shpb::kinds::SCENE_KINDS {
+            assert!(
+                help.contains(kind),
+                "`shpb {args:?}` lacks `{kind}`:\n{help}"
+            );
+        }
+    }
+}
+
+#[test]
+fn curve_prints_header_and_101_rows() {
+    let dir = TempDir::new().unwrap();
+    let out = shpb(
+        dir.path(),
+        &[
+            "curve",
+            "--specimen",
+            "ss440c",
+            "--rate",
+            "1000",
+            "--to",
+            "250e-6",
+        ],
+    );
+    assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+    let body = text(&out.stdout);
+    let mut lines = body.lines();
+    assert_eq!(lines.next(), Some("displacement_m,force_N"));
+    let rows: Vec<(f64, f64)> = lines
+        .map(|l| {
+            let (d, f) = l.split_once(',').unwrap_or_else(|| panic!("row `{l}`"));
+            (d.parse().unwrap(), f.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(rows.len(), 101);
+    assert_eq!(rows[0], (0.0, 0.0));
+    assert!(
+        (rows[100].0 - 250e-6).abs() < 1e-15,
+        "last δ {}",
+        rows[100].0
+    );
+    assert!(
+        rows.windows(2).all(|w| w[1].0 > w[0].0 && w[1].1 >= w[0].1),
+        "the loading curve is not increasing"
+    );
+    assert!(rows[100].1 > 0.0);
+}
+
+/// Every dataset under `group`, recursively, as (path, dataset).
+fn datasets(group: &hdf5::Group, prefix: &str, out: &mut Vec<(String, hdf5::Dataset)>) {
+    for name in group.member_names().unwrap() {
+        let path = format!("{prefix}/{name}");
+        if let Ok(ds) = group.dataset(&name) {
+            out.push((path, ds));
+        } else if let Ok(g) = group.group(&name) {
+            datasets(&g, &path, out);
+        }
+    }
+}
+
+/// The full SS440c test writes the documented HDF5 layout (README, "HDF5 layout"): every
+/// dataset with a `units` attribute, the reduction of the simulated records beside the true
+/// contact (round trip through bridge, amplifier, noise and digitiser within 2 %), the energy
+/// ledger and the x–t snapshots; `/summary` carries `warnings`.
+#[test]
+fn full_test_writes_the_documented_hdf5_layout() {
+    let dir = TempDir::new().unwrap();
+    let scene = format!(
+        "{}/scenes/shpb-ss440c-10psi.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = shpb(
+        dir.path(),
+        &["run", &scene, "-o", "out.h5", "--plot", "out.png"],
+    );
+    assert!(out.status.success(), "stderr:\n{}", text(&out.stderr));
+    assert!(dir.path().join("out.png").is_file());
+    let f = hdf5::File::open(dir.path().join("out.h5")).expect("open output");
+    assert_eq!(string_attr(&f, "shpb_version"), env!("CARGO_PKG_VERSION"));
+    assert_eq!(
+        string_attr(&f, "scene"),
+        std::fs::read_to_string(&scene).unwrap()
+    );
+    let mut all = Vec::new();
+    datasets(&f.group("/").unwrap(), "", &mut all);
+    let names: Vec<&str> = all.iter().map(|(p, _)| p.as_str()).collect();
+    for required in [
+        "/time",
+        "/gauges/incident/strain",
+        "/gauges/incident/voltage",
+        "/gauges/transmission/strain",
+        "/gauges/transmission/voltage",
+        "/contact/time",
+        "/contact/displacement",
+        "/contact/force",
+        "/reduction/time",
+        "/reduction/displacement",
+        "/reduction/force_front",
+        "/reduction/force_back",
+        "/reduction/strain_rate",
+        "/energy/striker",
+        "/energy/bars",
+        "/energy/shaper",
+        "/energy/contact",
+        "/energy/total",
+        "/bars/incident/snapshots",
+        "/bars/transmission/snapshots",
+    ] {
+        assert!(
+            names.contains(&required),
+            "{required} missing from {names:?}"
+        );
+    }
+    for (path, ds) in &all {
+        let units = string_attr(ds, "units");
+        assert!(!units.is_empty(), "{path} has empty units");
+        let v: Vec<f64> = ds.read_raw().unwrap();
+        assert!(!v.is_empty() && v.iter().all(|x| x.is_finite()), "{path}");
+    }
+    let n_time = f.dataset("time").unwrap().size();
+    for g in ["incident", "transmission"] {
+        assert_eq!(
+            f.dataset(&format!("gauges/{g}/voltage")).unwrap().size(),
+            n_time
+        );
+    }
+    let snap = f.dataset("bars/incident/snapshots").unwrap();
+    assert_eq!(snap.ndim(), 2, "snapshots are a time × x field");
+    let summary = f.group("summary").unwrap();
+    let _ = string_attr(&summary, "warnings");
+    let attr = |k: &str| -> f64 { summary.attr(k).unwrap().read_scalar().unwrap() };
+    let (f_true, d_true) = (
+        attr("peak_contact_force"),
+        attr("displacement_at_peak_contact_force"),
+    );
+    let (f_red, d_red) = (
+        attr("reduced_peak_back_force"),
+        attr("reduced_displacement_at_peak_force"),
+    );
+    assert!((f_red / f_true - 1.0).abs() < 0.02, "{f_red} vs {f_true}");
+    assert!((d_red / d_true - 1.0).abs() < 0.02, "{d_red} vs {d_true}");
+}
+
+#[test]
+fn incident_tells_which_striker_a_record_was_shot_with() {
+    // The Fig. 4 SS440c 10 psi record carries more energy, for its impulse, than the 10 cm striker
+    // at the calibrated gun's 10 psi velocity can give (momentum and energy conservation), and
+    // fits the 20 cm striker of bars/authors-20cm-striker.toml (validation/fig4-virtual-shpb).
+    let tmp = TempDir::new().unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let record = measured_force_csv();
+    let run = |bars: &str| {
+        let out = shpb(
+            tmp.path(),
+            &[
+                "incident",
+                &record,
+                "--bars",
+                &format!("{root}/bars/{bars}"),
+                "--pressure",
+                "10psi",
+            ],
+        );
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    let short = run("authors.toml");
+    assert!(short.contains("NOT possible"), "{short}");
+    // The width of the flat pulse is 2 L / c0 of a 20 cm striker, within 2 %.
+    let line = short
+        .lines()
+        .find(|l| l.starts_with("unshaped striker"))
+        .unwrap();
+    let length: f64 = line.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!((length / 0.20 - 1.0).abs() < 0.02, "{line}");
+    let long = run("authors-20cm-striker.toml");
+    assert!(long.contains(": possible"), "{long}");
+    // Energy conservation: a simulated shaped test's own pulse is always possible for its striker.
+    let out = shpb(
+        tmp.path(),
+        &[
+            "run",
+            &format!("{root}/scenes/shpb-ss440c-10psi.toml"),
+            "-o",
+            "sim.h5",
+            "--csv",
+            "sim.csv",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let sim = tmp.path().join("sim.csv");
+    let out = shpb(
+        tmp.path(),
+        &[
+            "incident",
+            sim.to_str().unwrap(),
+            "--bars",
+            &format!("{root}/bars/authors.toml"),
+            "--pressure",
+            "10psi",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains(": possible"),
+        "{}",
+        text(&out.stdout)
+    );
+}
+
+#[test]
+fn incident_refuses_bad_input_naming_file_and_key() {
+    let tmp = TempDir::new().unwrap();
+    let bars = format!("{}/bars/authors.toml", env!("CARGO_MANIFEST_DIR"));
+    let csv = write(tmp.path(), "f.csv", "time_s,force_N\n0,1\n1e-6,2\n");
+    let run = |args: &[&str]| {
+        let mut all = vec!["incident"];
+        all.extend_from_slice(args);
+        all.extend_from_slice(&["--bars", &bars]);
+        shpb(tmp.path(), &all)
+    };
+    let out = run(&[csv.to_str().unwrap()]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["f.csv", "displacement_m"],
+    );
+    let record = measured_force_csv();
+    let out = run(&[&record, "--smoothing-us", "-1"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--smoothing-us", "allowed"],
+    );
+    let out = run(&[&record, "--pressure", "90psi"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--pressure", "allowed"],
+    );
+    assert!(
+        out.stdout.is_empty(),
+        "printed before refusing: {}",
+        text(&out.stdout)
+    );
+    let out = shpb(tmp.path(), &["incident", &record, "--bars", "nothere.toml"]);
+    assert_refused(
+        tmp.path(),
+        &out,
+        Some(BAD_INPUT),
+        &["--bars", "nothere.toml"],
+    );
+}

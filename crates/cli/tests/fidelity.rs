@@ -1,0 +1,123 @@
+//! Fidelity presets and convergence studies: the order estimate on an analytic ladder, presets
+//! that agree with each other, explicit knobs that win over presets, and the observed order of
+//! the DEM collision (velocity Verlet with a trapezoidal dashpot: second order).
+
+use shpb::prelude::*;
+use shpb::convergence::{observed_order, richardson, study};
+use shpb::fidelity::Fidelity;
+use shpb::scene::{Params, SceneParams};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// f(h) = f0 + c h² sampled at h, h/2, h/4 has order exactly 2 and extrapolates to f0.
+#[test]
+fn observed_order_and_richardson_recover_an_analytic_ladder() {
+    let f = |h: f64| 3.0 + 0.7 * h * h;
+    let p = observed_order(f(0.4), f(0.2), f(0.1), 2.0).unwrap();
+    assert!((p - 2.0).abs() < 1e-9, "{p}");
+    let ex = richardson(f(0.2), f(0.1), 2.0, p);
+    assert!((ex - 3.0).abs() < 1e-12, "{ex}");
+    // Round-off level or non-monotone differences give no order.
+    assert!(observed_order(1.0, 1.0, 1.0, 2.0).is_none());
+    assert!(observed_order(1.0, 2.0, 1.0, 2.0).is_none());
+}
+
+fn cell_size(p: &Params) -> f64 {
+    match &p.params {
+        SceneParams::Pulse { options, .. } => options.cell_size_m,
+        _ => unreachable!("a shpb scene"),
+    }
+}
+
+/// The presets set the grid; an explicit `cell_size_m` in the scene wins over any preset; an
+/// unknown preset is refused naming the key and the allowed values.
+#[test]
+fn presets_set_the_knobs_and_explicit_keys_win() {
+    let scene = repo("scenes/shpb-ss440c-10psi.toml");
+    for f in Fidelity::ALL {
+        let p = Params::from_file_with(&scene, Some(f)).unwrap();
+        assert_eq!(p.fidelity, f);
+        assert_eq!(cell_size(&p), f.bar_knobs().cell_size_m);
+    }
+    let dir = tempfile::TempDir::new().unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap().replace(
+        "../bars/authors.toml",
+        repo("bars/authors.toml").to_str().unwrap(),
+    );
+    let explicit = dir.path().join("explicit.toml");
+    std::fs::write(&explicit, format!("cell_size_m = 2e-3\n{text}")).unwrap();
+    let p = Params::from_file_with(&explicit, Some(Fidelity::Reference)).unwrap();
+    assert_eq!(cell_size(&p), 2e-3);
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, format!("fidelity = \"ultra\"\n{text}")).unwrap();
+    let msg = Params::from_file(&bad).unwrap_err().to_string();
+    assert!(
+        msg.contains("fidelity") && msg.contains("fast, standard, reference"),
+        "{msg}"
+    );
+}
+
+/// `fast` (4 mm cells) and `standard` (1 mm) agree within 0.1 % in peak force and approach at
+/// peak: the bars are exact at Courant 1, so only the joints' O(Δt²) error differs
+/// (validation/perf/REPORT.md measures both against `reference`).
+#[test]
+fn fast_and_standard_presets_agree() {
+    let scene = repo("scenes/shpb-ss440c-10psi.toml");
+    let peak = |f| {
+        let out = Params::from_file_with(&scene, Some(f))
+            .unwrap()
+            .run()
+            .unwrap();
+        let c = out.contact.unwrap();
+        shpb::convergence::interpolated_peak(&c.force_n, &c.displacement_m)
+    };
+    let (f1, d1) = peak(Fidelity::Fast);
+    let (f2, d2) = peak(Fidelity::Standard);
+    assert!((f1 / f2 - 1.0).abs() < 1e-3, "{f1} vs {f2}");
+    assert!((d1 / d2 - 1.0).abs() < 1e-3, "{d1} vs {d2}");
+}
+
+/// The collision ladder (125 … 8000 steps per contact) converges at second order in the peak
+/// force, as velocity Verlet with the trapezoidal dashpot should (observed 1.8–2.6).
+#[test]
+fn collision_converges_at_second_order() {
+    let s = study(&repo("scenes/collision-ss440c-5ms.toml"), |_, _| {}).unwrap();
+    let p = s.peak_order.order.expect("an order");
+    assert!((1.5..3.0).contains(&p), "observed order {p}");
+    assert!(s.levels.iter().all(|l| l.metrics.peak.is_finite()));
+}
+
+/// `shpb run --fidelity fast` uses the preset's time step (Δt = 4 mm / c0) and
+/// `shpb convergence` refuses a scene kind with nothing to converge.
+#[test]
+fn cli_fidelity_flag_and_convergence_errors() {
+    let bin = env!("CARGO_BIN_EXE_shpb");
+    let out = Command::new(bin)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "scenes/shpb-ss440c-10psi.toml", "--fidelity", "fast"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let dt: f64 = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("time_step "))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let c0 = (192e9f64 / 8110.0).sqrt();
+    // The summary prints 7 significant digits.
+    assert!((dt * c0 / 4e-3 - 1.0).abs() < 1e-6, "Δt = {dt}");
+    let out = Command::new(bin)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["convergence", "scenes/quasistatic-fig2.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("kind"));
+}

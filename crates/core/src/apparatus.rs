@@ -1,0 +1,222 @@
+//! The SHPB set-up: bar material, incident and transmission bars, striker, gas gun, pulse shaper
+//! and gauge channels ([`Apparatus`]), and the bar chain a test runs on (physics.md §5–§6).
+
+use crate::bar::{BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
+use crate::error::Result;
+use crate::gauge::GaugeSetup;
+use crate::shaper::PulseShaper;
+use crate::striker::Gun;
+
+/// One bar's geometry: a uniform cylinder of the set-up's material.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarGeometry {
+    /// Length, m.
+    pub length_m: f64,
+    /// Diameter, m.
+    pub diameter_m: f64,
+}
+
+impl BarGeometry {
+    /// Cross-section area, m².
+    pub fn area_m2(&self) -> f64 {
+        std::f64::consts::PI * 0.25 * self.diameter_m * self.diameter_m
+    }
+}
+
+/// A validated SHPB set-up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Apparatus {
+    /// The file it came from.
+    pub source: String,
+    /// Bar material (all bars and the striker).
+    pub material: BarMaterial,
+    /// Incident bar.
+    pub incident: BarGeometry,
+    /// Transmission bar.
+    pub transmission: BarGeometry,
+    /// Whether the transmission bar's far end is absorbing (momentum trap) rather than free.
+    pub transmission_absorbing: bool,
+    /// Striker.
+    pub striker: BarGeometry,
+    /// Gas gun.
+    pub gun: Gun,
+    /// Default pulse shaper (None: no shaper).
+    pub shaper: Option<PulseShaper>,
+    /// Gauge channels.
+    pub gauges: GaugeSetup,
+}
+
+impl Apparatus {
+    /// Striker mass, kg.
+    pub fn striker_mass_kg(&self) -> f64 {
+        self.material.density_kg_m3 * self.striker.area_m2() * self.striker.length_m
+    }
+
+    /// Striker velocity at gauge pressure `p_pa` (an out-of-range pressure is an error naming the
+    /// gun's range).
+    pub fn striker_velocity_m_s(&self, p_pa: f64) -> Result<f64> {
+        self.gun
+            .striker_velocity_m_s(p_pa, self.striker_mass_kg(), self.striker.area_m2())
+    }
+
+    /// A uniform bar spec of this set-up's material.
+    pub fn bar_spec(
+        &self,
+        name: &str,
+        g: BarGeometry,
+        left: EndCondition,
+        right: EndCondition,
+        dispersion: Dispersion,
+    ) -> BarSpec {
+        BarSpec {
+            name: name.to_string(),
+            segments: vec![Segment {
+                length_m: g.length_m,
+                diameter_m: g.diameter_m,
+                material: self.material,
+            }],
+            left_end: left,
+            right_end: right,
+            dispersion,
+        }
+    }
+}
+
+/// What the incident bar's far end (the specimen face) touches in a `pulse` run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IncidentEnd {
+    /// The transmission bar is pressed against it (no specimen).
+    Transmission,
+    /// A free end.
+    Free,
+    /// A non-reflecting end.
+    Absorbing,
+    /// The two-sphere specimen, then the transmission bar (a full SHPB test).
+    Specimen,
+}
+
+/// The specimen of a full test: the sphere pair and its contact law.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpecimenSetup {
+    /// The spheres (sphere 1 on the incident bar).
+    pub pair: crate::specimen::SpherePair,
+    /// Contact law.
+    pub law: crate::contact::LawKind,
+    /// Form of region II of the loading law.
+    pub region2: crate::contact::Region2Form,
+}
+
+/// Options of a bar run (what a `pulse` or `shpb` scene sets).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PulseOptions {
+    /// The specimen, when `end` is `IncidentEnd::Specimen`.
+    pub specimen: Option<SpecimenSetup>,
+    /// Striker impact velocity, m/s.
+    pub striker_velocity_m_s: f64,
+    /// Pulse shaper (None: striker on bar).
+    pub shaper: Option<PulseShaper>,
+    /// What the incident bar's far end touches.
+    pub end: IncidentEnd,
+    /// Cell size in the bars, m (Δt = Δx/c0, Courant number 1).
+    pub cell_size_m: f64,
+    /// Bar dispersion model.
+    pub dispersion: Dispersion,
+    /// End of the run, s.
+    pub end_time_s: f64,
+    /// Gauge grid length over which strain is averaged, m.
+    pub gauge_length_m: f64,
+    /// Interval of the x–t stress snapshots of the bars, s (None: none).
+    pub snapshot_interval_s: Option<f64>,
+}
+
+impl Apparatus {
+    /// The chain striker → (shaper) → incident (→ transmission) at Courant 1 in the bars.
+    pub fn pulse_chain(&self, o: &PulseOptions) -> crate::solver::pulse::ChainSetup {
+        use crate::solver::pulse::{ChainSetup, GaugeProbe, Joint};
+        let c0 = self.material.wave_speed_m_s();
+        let dt = o.cell_size_m / c0;
+        let (shaper, end, dispersion) = (o.shaper, o.end, o.dispersion);
+        let incident_right = match end {
+            IncidentEnd::Absorbing => EndCondition::Absorbing,
+            _ => EndCondition::Free,
+        };
+        let with_transmission = matches!(end, IncidentEnd::Transmission | IncidentEnd::Specimen);
+        let mut bars = vec![
+            self.bar_spec(
+                "striker",
+                self.striker,
+                EndCondition::Free,
+                EndCondition::Free,
+                dispersion,
+            ),
+            self.bar_spec(
+                "incident",
+                self.incident,
+                EndCondition::Free,
+                incident_right,
+                dispersion,
+            ),
+        ];
+        let mut joints = vec![match shaper {
+            Some(s) => Joint::Shaper(s),
+            None => Joint::Butt,
+        }];
+        let mut end_masses = Vec::new();
+        if with_transmission {
+            let far = if self.transmission_absorbing {
+                EndCondition::Absorbing
+            } else {
+                EndCondition::Free
+            };
+            bars.push(self.bar_spec(
+                "transmission",
+                self.transmission,
+                EndCondition::Free,
+                far,
+                dispersion,
+            ));
+            match &o.specimen {
+                Some(sp) if end == IncidentEnd::Specimen => {
+                    joints.push(Joint::Spheres {
+                        props: sp.pair.contact_properties(),
+                        law: sp.law,
+                        region2: sp.region2,
+                    });
+                    // Each sphere's mass joins its bar's end node (the paper's DEM).
+                    end_masses.push((1, true, sp.pair.sphere1.mass_kg));
+                    end_masses.push((2, false, sp.pair.sphere2.mass_kg));
+                }
+                _ => joints.push(Joint::Butt),
+            }
+        }
+        let mut gauges = Vec::new();
+        for ch in &self.gauges.channels {
+            let (bar, x) = match ch.bar.as_str() {
+                "incident" => (1, self.incident.length_m - ch.distance_from_specimen_m),
+                "transmission" if with_transmission => (2, ch.distance_from_specimen_m),
+                _ => continue,
+            };
+            gauges.push(GaugeProbe {
+                name: ch.name.clone(),
+                bar,
+                x_m: x,
+                length_m: o.gauge_length_m,
+            });
+        }
+        let record_every = ((1.0 / 10e6) / dt).floor().max(1.0) as usize;
+        ChainSetup {
+            bars,
+            joints,
+            striker_velocity_m_s: o.striker_velocity_m_s,
+            dt_s: dt,
+            end_time_s: o.end_time_s,
+            gauges,
+            record_every,
+            end_masses,
+            snapshot_every: o
+                .snapshot_interval_s
+                .map(|i| ((i / dt).round() as usize).max(1)),
+            snapshot_spacing_m: 5e-3,
+        }
+    }
+}

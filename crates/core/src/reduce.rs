@@ -1,0 +1,947 @@
+//! The laboratory's data reduction (physics.md §7; shared/reference/README.md, "Reduction"):
+//! from the strains recorded at the incident and transmission gauges to the forces on the two
+//! specimen faces, the sphere approach δ(t), its rate and the global strain rate. It works on
+//! simulated records (`shpb run` HDF5) and on real ones (the authors' raw CSV).
+//!
+//! # Sign conventions
+//!
+//! Bar strain ε is positive in tension (physics.md). The incident bar lies at x < 0 with its
+//! specimen face at x = 0⁻, the transmission bar at x > 0; displacements u and velocities v are
+//! positive along +x (from the incident towards the transmission bar). For a wave running towards
+//! +x, v = −c0 ε; towards −x, v = +c0 ε. Hence, with εI, εR, εT the incident, reflected and
+//! transmitted strains *at the specimen faces*:
+//!
+//! * `v_front = −c0 (εI − εR)`, `u_front = ∫ v_front dt` (incident-bar face, positive when it
+//!   moves towards the specimen);
+//! * `v_back = −c0 εT`, `u_back = ∫ v_back dt` (transmission-bar face, positive when it is pushed
+//!   away);
+//! * sphere approach `δ = u_front − u_back = −c0 ∫ (εI − εR − εT) dt`, positive in compression
+//!   (physics.md §7 writes the same with the bar-axis signs left to the reader), and
+//!   `δ̇ = v_front − v_back`;
+//! * contact forces, positive in compression: `F_front = −E A (εI + εR)` (2-wave),
+//!   `F_back = −E A εT` (1-wave), `F_3wave = (F_front + F_back)/2`;
+//! * equilibrium ratio `|F_front − F_back| / max(|F_3wave|, 0.05·max|F_3wave|)` (the floor keeps
+//!   it finite before loading and after unloading), reported as a series and at the peak of
+//!   `F_back`;
+//! * global strain rate `δ̇/(r1 + r2)` (paper Eq. 3) when the sphere radii are given.
+//!
+//! Displacements are integrated with the trapezoidal rule from the first sample of the window
+//! (δ(0) = 0).
+//!
+//! # Windows (how each wave is cut from the records)
+//!
+//! 1. Baseline: the mean of the first `baseline_samples` samples of each channel is subtracted
+//!    (the authors use the pre-trigger part; if the incident pulse starts earlier than that, the
+//!    baseline is re-taken over the samples before the pulse start).
+//! 2. Incident start `t_I` (at the incident gauge, record clock): with `y = −εI` (compression),
+//!    `y_max` its largest value in the record, the first pulse is the first run of samples with
+//!    `y ≥ y_max/2`; its peak `y_p` is the largest `y` in that run; `t_I` is the time of the last
+//!    sample before the peak with `y < start_fraction·y_p` (default 2 %). `t_I` is therefore on
+//!    the sample grid, at the foot of the pulse. It can be overridden (`WindowOverride`).
+//! 3. Reflected window at the incident gauge: starts at `t_I + Δ_R`, `Δ_R = 2 d_I/c0`.
+//!    Transmitted window at the transmission gauge: starts at `t_I + Δ_T`,
+//!    `Δ_T = d_I/c0 + d_T/c0 + specimen_transit_s`; the transit through the specimen (two
+//!    6.35 mm spheres, ≈ 2.5 µs at the spheres' bar-wave speed, but really set by the contact
+//!    compliance) is neglected by default (0). Both delays can be overridden. Fractional-sample
+//!    delays are applied exactly for band-limited signals (Fourier phase shift), not rounded.
+//! 4. Window length `D`: the longest clean window, `min(Δ_R` (the incident gauge sees only the
+//!    incident wave until the reflected one arrives), `2 (L_I − d_I)/c0` (the reflected wave
+//!    comes back from the impact end after that), `2 (L_T − d_T)/c0` if the transmission bar's
+//!    far end is not absorbing`)`, then shortened so that both the reflected and the transmitted
+//!    windows lie inside the record. It can be overridden.
+//! 5. Time axis: `t = 0` is the arrival of the incident pulse's foot at the specimen face,
+//!    `t_I + d_I/c0` on the record clock (`Reduction::face_time_offset_s`); the three waves,
+//!    time-shifted to the faces, share it.
+//!
+//! # Dispersion correction
+//!
+//! Optional (on by default), as in the authors' `disp_corr.m`: every Fourier component of a
+//! wave is shifted in time by `τ(f) = Δx (1/c(f) − 1/c0)` (a spectrum factor `exp(−iωτ)`, i.e. a
+//! *delay* for τ > 0), where `c(f)` is the first-mode phase velocity of the Bancroft fit of
+//! physics.md §7, `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`, solved for the
+//! wavelength `Λ = c/f` at each frequency (a scalar monotone equation, bisection). The plain
+//! transit `Δx/c0` is the window offset of step 3; the correction adds only what dispersion
+//! changes. Signs: the incident wave is moved *forward* to the face (`Δx = +d_I`: its slow,
+//! high-frequency components arrive later at the face than at the gauge, so they are delayed);
+//! the reflected and transmitted waves are moved *back* from their gauges to the faces
+//! (`Δx = −d_I`, `−d_T`: their slow components left the face earlier than they reached the gauge,
+//! so they are advanced). The fit is the ν = 0.31 one the authors used; a warning is given for
+//! bars with another Poisson's ratio. As f → 0 the fit gives c → (A + B) c0 = 1.0013 c0, so the
+//! longest waves are shifted by −0.13 % of the transit (−0.18 µs over 0.64 m), as in the
+//! authors' code.
+
+use crate::apparatus::Apparatus;
+use crate::error::{Error, Result};
+use crate::gauge::{GaugeChannel, RawRecord};
+use crate::numeric::{bisect, cumulative_trapezoid, moving_average, phase_shift};
+
+/// Bancroft first-mode fit for ν = 0.31 (physics.md §7): A, B, C, D, E, F of
+/// `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`.
+pub const BANCROFT_FIT: [f64; 6] = [0.57344, 0.42790, 18.668, 19.664, -6.6213, 2.3118];
+
+/// Poisson's ratio the Bancroft fit was made for.
+pub const BANCROFT_FIT_POISSON_RATIO: f64 = 0.31;
+
+/// Radii of the paper's specimen, two 6.35 mm spheres, m (used by `shpb reduce` for the strain
+/// rate; the authors' `analysis.m` divides by 0.0254/4 m = r1 + r2 too).
+pub const PAPER_SPHERE_RADII_M: (f64, f64) = (3.175e-3, 3.175e-3);
+
+/// `c/c0` of the Bancroft fit at `y = a/Λ` (radius over wavelength).
+pub fn bancroft_velocity_ratio(radius_over_wavelength: f64) -> f64 {
+    let [a, b, c, d, e, f] = BANCROFT_FIT;
+    let y = radius_over_wavelength.max(0.0);
+    a + b / (c * y.powi(4) + d * y.powi(3) + e * y * y + f * y.powf(1.5) + 1.0)
+}
+
+/// Phase velocity of the first longitudinal mode at frequency `frequency_hz` on a bar of radius
+/// `radius_m` and bar-wave speed `c0_m_s`, m/s: the root of `c/c0 = g(a f/c)` (Bancroft fit `g`).
+/// `c/c0 − g(a f/c)` increases monotonically with c and changes sign on
+/// `[A c0 (1 − 1e-9), (A + B) c0 (1 + 1e-9)]`, so bisection always converges.
+pub fn bancroft_phase_velocity_m_s(frequency_hz: f64, radius_m: f64, c0_m_s: f64) -> f64 {
+    let f = frequency_hz.abs();
+    if f == 0.0 {
+        return c0_m_s * (BANCROFT_FIT[0] + BANCROFT_FIT[1]);
+    }
+    let h = |c: f64| c / c0_m_s - bancroft_velocity_ratio(radius_m * f / c);
+    let (lo, hi) = bisect(
+        BANCROFT_FIT[0] * c0_m_s * (1.0 - 1e-9),
+        (BANCROFT_FIT[0] + BANCROFT_FIT[1]) * c0_m_s * (1.0 + 1e-9),
+        100,
+        |lo, hi| hi - lo <= 1e-13 * c0_m_s,
+        |c| h(c) <= 0.0,
+    );
+    0.5 * (lo + hi)
+}
+
+/// Extra travel time of the component at `frequency_hz` over `distance_m` beyond `distance/c0`,
+/// `Δx (1/c(f) − 1/c0)`, s (negative distance: moved back against the propagation).
+pub fn dispersion_delay_s(frequency_hz: f64, distance_m: f64, radius_m: f64, c0_m_s: f64) -> f64 {
+    let c = bancroft_phase_velocity_m_s(frequency_hz, radius_m, c0_m_s);
+    distance_m * (1.0 / c - 1.0 / c0_m_s)
+}
+
+/// One bar as the reduction sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarProperties {
+    /// Young's modulus E, Pa.
+    pub youngs_modulus_pa: f64,
+    /// Bar-wave speed c0, m/s.
+    pub wave_speed_m_s: f64,
+    /// Cross-section A, m².
+    pub area_m2: f64,
+    /// Radius a, m (dispersion correction).
+    pub radius_m: f64,
+    /// Poisson's ratio ν (checked against the Bancroft fit's 0.31).
+    pub poisson_ratio: f64,
+    /// Length, m (None: unknown, no limit on the window from its far end).
+    pub length_m: Option<f64>,
+}
+
+/// Bars and gauge positions of a reduction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReductionSetup {
+    /// Incident bar.
+    pub incident_bar: BarProperties,
+    /// Transmission bar.
+    pub transmission_bar: BarProperties,
+    /// Distance of the incident gauge from the specimen face, m.
+    pub incident_gauge_m: f64,
+    /// Distance of the transmission gauge from the specimen face, m.
+    pub transmission_gauge_m: f64,
+    /// Whether the transmission bar's far end absorbs (no reflection from it limits the window).
+    pub transmission_absorbing: bool,
+}
+
+impl ReductionSetup {
+    /// Bars and gauge distances of a set-up file (its `incident` and `transmission` channels).
+    pub fn from_apparatus(a: &Apparatus) -> Result<ReductionSetup> {
+        let m = &a.material;
+        let bar = |g: &crate::apparatus::BarGeometry| BarProperties {
+            youngs_modulus_pa: m.youngs_modulus_pa,
+            wave_speed_m_s: m.wave_speed_m_s(),
+            area_m2: g.area_m2(),
+            radius_m: g.diameter_m / 2.0,
+            poisson_ratio: m.poisson_ratio,
+            length_m: Some(g.length_m),
+        };
+        Ok(ReductionSetup {
+            incident_bar: bar(&a.incident),
+            transmission_bar: bar(&a.transmission),
+            incident_gauge_m: channel(a, "incident")?.distance_from_specimen_m,
+            transmission_gauge_m: channel(a, "transmission")?.distance_from_specimen_m,
+            transmission_absorbing: a.transmission_absorbing,
+        })
+    }
+}
+
+/// The gauge channel called `name` of a set-up, or an input error naming the set-up file.
+fn channel<'a>(a: &'a Apparatus, name: &str) -> Result<&'a GaugeChannel> {
+    a.gauges.channel(name).ok_or_else(|| {
+        crate::error::Named::new(a.source.clone()).error(
+            "gauges",
+            format!("no `{name}` channel in the gauge set-up"),
+            "channels named incident and transmission",
+        )
+    })
+}
+
+/// The two gauge strain histories to reduce (strain positive in tension).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReductionInput {
+    /// Sample times, s (uniform).
+    pub time_s: Vec<f64>,
+    /// Incident-gauge strain (incident and reflected waves).
+    pub incident_strain: Vec<f64>,
+    /// Transmission-gauge strain.
+    pub transmission_strain: Vec<f64>,
+}
+
+impl ReductionInput {
+    /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`
+    /// of `shpb run`), if it recorded both channels.
+    pub fn from_noise_free_gauges(out: &crate::run::RunOutput) -> Option<ReductionInput> {
+        let strain = |name: &str| {
+            out.gauges
+                .iter()
+                .find(|g| g.name == name)
+                .map(|g| g.strain.clone())
+        };
+        Some(ReductionInput {
+            time_s: out.time_s.clone()?,
+            incident_strain: strain("incident")?,
+            transmission_strain: strain("transmission")?,
+        })
+    }
+}
+
+/// Manual window settings; each `None` keeps the automatic rule (module docs, "Windows").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct WindowOverride {
+    /// Incident window start at the incident gauge, record clock, s (may fall between samples).
+    pub incident_start_s: Option<f64>,
+    /// Reflected window start minus incident start, s (default 2 d_I/c0).
+    pub reflected_delay_s: Option<f64>,
+    /// Transmitted window start minus incident start, s (default (d_I + d_T)/c0 + transit).
+    pub transmitted_delay_s: Option<f64>,
+    /// Window length, s (default: the longest clean window that fits the record).
+    pub duration_s: Option<f64>,
+}
+
+/// Options of a reduction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReductionOptions {
+    /// Samples at the start of each record whose mean is the baseline (default 900: 90 µs at
+    /// 10 MHz, the pre-trigger part of the authors' records).
+    pub baseline_samples: usize,
+    /// Correct the waves for Bancroft dispersion between gauges and faces (default true).
+    pub dispersion_correction: bool,
+    /// Manual windows (default None: the automatic rule).
+    pub window: Option<WindowOverride>,
+    /// Fraction of the incident peak that marks its foot (default 0.02).
+    pub start_fraction: f64,
+    /// Transit time through the specimen added to the transmitted delay, s (default 0).
+    pub specimen_transit_s: f64,
+    /// Sphere radii (r1, r2), m, for the global strain rate δ̇/(r1 + r2) (default None).
+    pub specimen_radii_m: Option<(f64, f64)>,
+    /// Width of a centred moving average applied to both strain records before the reduction,
+    /// s (default 0: off). A box of width w attenuates noise by √(w/Δt) and changes a pulse of
+    /// rise time τ by about w²/(24 τ²) of its peak.
+    pub smoothing_window_s: f64,
+}
+
+impl Default for ReductionOptions {
+    fn default() -> Self {
+        ReductionOptions {
+            baseline_samples: 900,
+            dispersion_correction: true,
+            window: None,
+            start_fraction: 0.02,
+            specimen_transit_s: 0.0,
+            specimen_radii_m: None,
+            smoothing_window_s: 0.0,
+        }
+    }
+}
+
+/// The windows a reduction used (record clock).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Windows {
+    /// Incident window start at the incident gauge, s.
+    pub incident_start_s: f64,
+    /// Reflected window start minus incident start, s.
+    pub reflected_delay_s: f64,
+    /// Transmitted window start minus incident start, s.
+    pub transmitted_delay_s: f64,
+    /// Window length, s.
+    pub duration_s: f64,
+    /// Samples per window.
+    pub samples: usize,
+    /// Baseline samples actually averaged.
+    pub baseline_samples: usize,
+}
+
+/// Result of a reduction, on the common time axis of the specimen faces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reduction {
+    /// Time since the incident pulse's foot reached the specimen face, s (starts at 0).
+    pub time_s: Vec<f64>,
+    /// Record-clock time of `time_s = 0`: incident start + d_I/c0, s.
+    pub face_time_offset_s: f64,
+    /// Incident strain at the incident-bar face (tension positive).
+    pub incident_strain: Vec<f64>,
+    /// Reflected strain at the incident-bar face.
+    pub reflected_strain: Vec<f64>,
+    /// Transmitted strain at the transmission-bar face.
+    pub transmitted_strain: Vec<f64>,
+    /// 2-wave force on the incident-bar face, −E A (εI + εR), N (compression positive).
+    pub force_front_n: Vec<f64>,
+    /// 1-wave force on the transmission-bar face, −E A εT, N (compression positive).
+    pub force_back_n: Vec<f64>,
+    /// 3-wave force, mean of front and back, N.
+    pub force_3wave_n: Vec<f64>,
+    /// Incident-bar face displacement along +x, m.
+    pub front_displacement_m: Vec<f64>,
+    /// Transmission-bar face displacement along +x, m.
+    pub back_displacement_m: Vec<f64>,
+    /// Sphere approach δ = u_front − u_back, m (compression positive).
+    pub displacement_m: Vec<f64>,
+    /// Approach velocity δ̇ = v_front − v_back, m/s.
+    pub approach_velocity_m_s: Vec<f64>,
+    /// Global strain rate δ̇/(r1 + r2), 1/s (when the radii were given).
+    pub strain_rate_per_s: Option<Vec<f64>>,
+    /// |F_front − F_back| / max(|F_3wave|, 0.05 max|F_3wave|).
+    pub equilibrium_ratio: Vec<f64>,
+    /// Largest back (transmitted) force, N.
+    pub peak_back_force_n: f64,
+    /// Time of the peak back force, s.
+    pub peak_back_force_time_s: f64,
+    /// Index of the peak back force in the series.
+    pub peak_index: usize,
+    /// δ at the peak back force, m.
+    pub displacement_at_peak_force_m: f64,
+    /// Equilibrium ratio at the peak back force.
+    pub equilibrium_ratio_at_peak: f64,
+    /// Largest front force, N.
+    pub peak_front_force_n: f64,
+    /// Largest δ, m.
+    pub max_displacement_m: f64,
+    /// The windows used.
+    pub windows: Windows,
+    /// Start of the reflected pulse measured in the incident record (same foot rule as the
+    /// incident, on its largest tensile excursion), minus the incident start, s; None if no
+    /// tensile pulse of at least 10 % of the incident peak is found.
+    pub measured_reflected_delay_s: Option<f64>,
+    /// Whether the dispersion correction was applied.
+    pub dispersion_corrected: bool,
+    /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
+    pub warnings: Vec<String>,
+}
+
+/// An input error of the reduction (`file` names the record or "reduction options").
+fn input_err(
+    file: &str,
+    key: &str,
+    problem: impl Into<String>,
+    allowed: impl Into<String>,
+) -> Error {
+    Error::Invalid {
+        object: file.to_string(),
+        quantity: key.to_string(),
+        problem: problem.into(),
+        allowed: allowed.into(),
+    }
+}
+
+/// The incident pulse a measured specimen history implies (what the incident gauge saw, moved to
+/// the specimen face), from force F(t) and sphere approach δ(t) alone: see [`implied_incident`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImpliedIncident {
+    /// Incident stress at the face at the history's sample times, compression positive, Pa.
+    pub stress_pa: Vec<f64>,
+    /// Largest incident stress, Pa.
+    pub peak_pa: f64,
+    /// Time of the largest incident stress, s.
+    pub peak_time_s: f64,
+    /// Full width of the pulse at half its peak, s (for an unshaped pulse: 2 L_striker / c0).
+    pub duration_half_s: f64,
+    /// Mean stress over that width, Pa (the plateau of an unshaped pulse, which its peak is not:
+    /// the spheres' inertia adds a spike at the start).
+    pub mean_over_half_pa: f64,
+    /// Impulse A ∫σ dt over the pulse (above 5 % of peak), N s: a stopped striker's momentum.
+    pub impulse_n_s: f64,
+    /// Energy the pulse carries, A c0 / E ∫σ² dt over the pulse (above 5 % of peak), J.
+    pub energy_j: f64,
+}
+
+/// Incident stress at the specimen face implied by force F and approach δ (physics.md §7 run
+/// backwards): with the front force equal to the back force F (equilibrium), the transmission
+/// face moving at F/(ρ c0 A) and the incident face at that plus δ̇, the one-wave relations
+/// F = A(σI + σR), v = (σI − σR)/(ρ c0) give σI = F/A + ρ c0 δ̇ / 2. δ̇ is a central difference over
+/// `smoothing_s` and F is averaged over the same span (the records are noisy). None if the
+/// history has fewer than 3 samples or no compressive pulse.
+pub fn implied_incident(
+    time_s: &[f64],
+    displacement_m: &[f64],
+    force_n: &[f64],
+    bar: &BarProperties,
+    smoothing_s: f64,
+) -> Option<ImpliedIncident> {
+    let n = time_s.len();
+    if n < 3 || displacement_m.len() != n || force_n.len() != n {
+        return None;
+    }
+    let dt = (time_s[n - 1] - time_s[0]) / (n - 1) as f64;
+    let half = ((smoothing_s / (2.0 * dt)).round() as usize).max(1);
+    let rho_c = bar.youngs_modulus_pa / bar.wave_speed_m_s;
+    let force = moving_average(force_n, half);
+    let stress_pa: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(half), (i + half).min(n - 1));
+            let rate = (displacement_m[b] - displacement_m[a]) / (time_s[b] - time_s[a]);
+            force[i] / bar.area_m2 + 0.5 * rho_c * rate
+        })
+        .collect();
+    let (k, &peak_pa) = stress_pa
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    if peak_pa <= 0.0 {
+        return None;
+    }
+    let half_peak = index_interval_above(&stress_pa, k, 0.5 * peak_pa);
+    let (h0, h1) = crossing_times(time_s, &stress_pa, half_peak, 0.5 * peak_pa);
+    let (lo, hi) = index_interval_above(&stress_pa, k, 0.05 * peak_pa);
+    let integral = |f: &dyn Fn(f64) -> f64| -> f64 {
+        (lo..hi)
+            .map(|i| 0.5 * (f(stress_pa[i]) + f(stress_pa[i + 1])) * (time_s[i + 1] - time_s[i]))
+            .sum()
+    };
+    let impulse_n_s = bar.area_m2 * integral(&|s| s);
+    let (m0, m1) = half_peak;
+    let mean_over_half_pa = stress_pa[m0..=m1].iter().sum::<f64>() / (m1 - m0 + 1) as f64;
+    let energy_j = bar.area_m2 / rho_c * integral(&|s| s * s);
+    Some(ImpliedIncident {
+        peak_time_s: time_s[k],
+        duration_half_s: h1 - h0,
+        mean_over_half_pa,
+        impulse_n_s,
+        energy_j,
+        peak_pa,
+        stress_pa,
+    })
+}
+
+/// Sample indices (first, last) of the contiguous run around `k` where `y` ≥ `level`.
+fn index_interval_above(y: &[f64], k: usize, level: f64) -> (usize, usize) {
+    let lo = (0..k).rev().find(|&i| y[i] < level).map_or(0, |i| i + 1);
+    let hi = (k + 1..y.len())
+        .find(|&j| y[j] < level)
+        .map_or(y.len() - 1, |j| j - 1);
+    (lo, hi)
+}
+
+/// Times where `y` crosses `level` just outside the run of samples `(lo, hi)` at or above it
+/// (linear between samples; the record's ends if it never drops below).
+fn crossing_times(t: &[f64], y: &[f64], (lo, hi): (usize, usize), level: f64) -> (f64, f64) {
+    let cross = |i: usize| t[i] + (level - y[i]) * (t[i + 1] - t[i]) / (y[i + 1] - y[i]);
+    let start = if lo > 0 { cross(lo - 1) } else { t[0] };
+    let end = if hi + 1 < y.len() {
+        cross(hi)
+    } else {
+        t[y.len() - 1]
+    };
+    (start, end)
+}
+
+/// Subtracts the mean of the first `n` samples (none if `n` is 0).
+fn debias(v: &[f64], n: usize) -> Vec<f64> {
+    crate::gauge::remove_baseline(v, n)
+}
+
+/// Index of the foot of the first pulse of `y` (positive pulse) and its peak index, by the rule
+/// of the module docs; None if `y` has no positive value.
+fn pulse_foot(y: &[f64], fraction: f64) -> Option<(usize, usize)> {
+    let y_max = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if y_max.is_nan() || y_max <= 0.0 {
+        return None;
+    }
+    let half = 0.5 * y_max;
+    let k_half = y.iter().position(|&v| v >= half)?;
+    let k_end = (k_half..y.len()).find(|&k| y[k] < half).unwrap_or(y.len());
+    let mut k_peak = k_half;
+    for k in k_half..k_end {
+        if y[k] > y[k_peak] {
+            k_peak = k;
+        }
+    }
+    let level = fraction * y[k_peak];
+    let foot = (0..=k_peak).rev().find(|&k| y[k] < level).unwrap_or(0);
+    Some((foot, k_peak))
+}
+
+/// Cuts `n` samples starting at fractional index `start` out of `x` (uniform step `dt`), after
+/// delaying every Fourier component by `dispersion_delay_s(f, distance)` when `dispersion` is
+/// given as (distance, radius, c0). Exact copy when the start is on a sample and there is no
+/// dispersion; otherwise a Fourier phase shift (see `phase_shift`) of the window extended by
+/// margins on both sides that cover the largest dispersion delay, so that what the shift moves
+/// into the window comes from the record, not from the wrap-around. Samples outside the record
+/// read as 0 (the caller keeps the window itself inside the record).
+fn cut(x: &[f64], dt: f64, start: f64, n: usize, dispersion: Option<(f64, f64, f64)>) -> Vec<f64> {
+    let i = start.floor();
+    let mut frac = start - i;
+    let mut i = i as isize;
+    if frac > 1.0 - 1e-9 {
+        i += 1;
+        frac = 0.0;
+    } else if frac < 1e-9 {
+        frac = 0.0;
+    }
+    if frac == 0.0 && dispersion.is_none() {
+        return (0..n)
+            .map(|k| {
+                let j = i + k as isize;
+                if j >= 0 && (j as usize) < x.len() {
+                    x[j as usize]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+    }
+    // Margin: the largest dispersion delay (slowest components travel at A·c0) plus slack.
+    let max_delay = dispersion
+        .map(|(d, _, c0)| d.abs() / c0 * (1.0 / BANCROFT_FIT[0] - 1.0))
+        .unwrap_or(0.0);
+    let margin = (max_delay / dt).ceil() as isize + 64;
+    let lo = (i - margin).max(0);
+    let hi = (i + n as isize + margin).min(x.len() as isize);
+    let seg = &x[lo as usize..hi as usize];
+    let shifted = phase_shift(seg, dt, |f| {
+        // Advance by `frac` samples (y(t) = x(t + frac·dt)), then the dispersion delay.
+        let disp = dispersion
+            .map(|(d, a, c0)| dispersion_delay_s(f, d, a, c0))
+            .unwrap_or(0.0);
+        disp - frac * dt
+    });
+    let off = i - lo;
+    (0..n)
+        .map(|k| {
+            let j = off + k as isize;
+            if j >= 0 && (j as usize) < shifted.len() {
+                shifted[j as usize]
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Moves a whole uniformly sampled signal by `distance_m` along a dispersive bar beyond the plain
+/// transit `distance/c0`: each Fourier component is delayed by `distance (1/c(f) − 1/c0)`
+/// (Bancroft first mode). Positive distance propagates forward (the incident wave from its gauge
+/// to the face); negative moves back (reflected and transmitted waves from their gauges to the
+/// faces). The same operation the reduction applies to each window.
+pub fn dispersion_shift(
+    signal: &[f64],
+    dt_s: f64,
+    distance_m: f64,
+    bar: &BarProperties,
+) -> Vec<f64> {
+    cut(
+        signal,
+        dt_s,
+        0.0,
+        signal.len(),
+        Some((distance_m, bar.radius_m, bar.wave_speed_m_s)),
+    )
+}
+
+/// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
+fn check_input(input: &ReductionInput, file: &str) -> Result<f64> {
+    let n = input.time_s.len();
+    if input.incident_strain.len() != n || input.transmission_strain.len() != n {
+        return Err(input_err(
+            file,
+            "incident_strain/transmission_strain",
+            format!(
+                "{} times but {} incident and {} transmission samples",
+                n,
+                input.incident_strain.len(),
+                input.transmission_strain.len()
+            ),
+            "one strain sample per time on both channels",
+        ));
+    }
+    if n < 16 {
+        return Err(input_err(
+            file,
+            "time_s",
+            format!("{n} samples"),
+            "at least 16 samples",
+        ));
+    }
+    for (key, v) in [
+        ("time_s", &input.time_s),
+        ("incident_strain", &input.incident_strain),
+        ("transmission_strain", &input.transmission_strain),
+    ] {
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            return Err(input_err(
+                file,
+                key,
+                format!("sample {k} is {}", v[k]),
+                "finite numbers",
+            ));
+        }
+    }
+    let t = &input.time_s;
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    if dt.is_nan() || dt <= 0.0 {
+        return Err(input_err(
+            file,
+            "time_s",
+            "times do not increase",
+            "a uniform increasing time axis",
+        ));
+    }
+    if let Some(k) = t
+        .windows(2)
+        .position(|w| ((w[1] - w[0]) - dt).abs() > 0.01 * dt)
+    {
+        return Err(input_err(
+            file,
+            "time_s",
+            format!(
+                "step {:e} s between samples {k} and {} differs from the mean step {dt:e} s by more than 1 %",
+                t[k + 1] - t[k],
+                k + 1
+            ),
+            "a uniform time axis (steps within 1 % of their mean)",
+        ));
+    }
+    Ok(dt)
+}
+
+fn check_options(o: &ReductionOptions) -> Result<()> {
+    let file = "reduction options";
+    if !(o.start_fraction > 0.0 && o.start_fraction < 0.5) {
+        return Err(input_err(
+            file,
+            "start_fraction",
+            format!("{} is out of range", o.start_fraction),
+            "greater than 0 and less than 0.5",
+        ));
+    }
+    if !(o.specimen_transit_s.is_finite() && o.specimen_transit_s >= 0.0) {
+        return Err(input_err(
+            file,
+            "specimen_transit_s",
+            format!("{} is out of range", o.specimen_transit_s),
+            "0 or more seconds",
+        ));
+    }
+    if !(o.smoothing_window_s.is_finite() && o.smoothing_window_s >= 0.0) {
+        return Err(input_err(
+            file,
+            "smoothing_window_s",
+            format!("{} is out of range", o.smoothing_window_s),
+            "0 (off) or more seconds",
+        ));
+    }
+    if let Some((r1, r2)) = o.specimen_radii_m
+        && !(r1 > 0.0 && r2 > 0.0 && r1.is_finite() && r2.is_finite())
+    {
+        return Err(input_err(
+            file,
+            "specimen_radii_m",
+            format!("({r1}, {r2}) m"),
+            "two positive radii",
+        ));
+    }
+    if let Some(w) = o.window {
+        for (key, v) in [
+            ("window.reflected_delay_s", w.reflected_delay_s),
+            ("window.transmitted_delay_s", w.transmitted_delay_s),
+            ("window.duration_s", w.duration_s),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(input_err(
+                    file,
+                    key,
+                    format!("{v} s"),
+                    "a positive number of seconds",
+                ));
+            }
+        }
+        if let Some(v) = w.incident_start_s
+            && !v.is_finite()
+        {
+            return Err(input_err(
+                file,
+                "window.incident_start_s",
+                format!("{v}"),
+                "a finite time on the record clock",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Reduces two gauge strain histories to face forces, approach, its rate and the strain rate
+/// (module docs give every rule and sign). Errors name `"reduction input"`/`"reduction options"`
+/// and the key at fault.
+pub fn reduce(
+    input: &ReductionInput,
+    setup: &ReductionSetup,
+    options: &ReductionOptions,
+) -> Result<Reduction> {
+    reduce_named(input, setup, options, "reduction input")
+}
+
+/// [`reduce`] with the record's name for error messages (`<name>: <series>`).
+pub fn reduce_named(
+    input: &ReductionInput,
+    setup: &ReductionSetup,
+    options: &ReductionOptions,
+    file: &str,
+) -> Result<Reduction> {
+    check_options(options)?;
+    let dt = check_input(input, file)?;
+    let n = input.time_s.len();
+    let t0 = input.time_s[0];
+    let (bi, bt) = (&setup.incident_bar, &setup.transmission_bar);
+    let (d_i, d_t) = (setup.incident_gauge_m, setup.transmission_gauge_m);
+    let ov = options.window.unwrap_or_default();
+    let mut warnings = Vec::new();
+
+    // 0. Optional smoothing (a centred moving average over an odd number of samples).
+    let half = (options.smoothing_window_s / dt / 2.0).round() as usize;
+    let incident_strain = moving_average(&input.incident_strain, half);
+    let transmission_strain = moving_average(&input.transmission_strain, half);
+
+    // 1–2. Baseline, then the incident foot; the baseline must end before the pulse.
+    let mut nb = options.baseline_samples.min(n / 2);
+    let mut eps_i = debias(&incident_strain, nb);
+    let foot = |e: &[f64]| {
+        let y: Vec<f64> = e.iter().map(|v| -v).collect();
+        pulse_foot(&y, options.start_fraction)
+    };
+    let mut detected = foot(&eps_i);
+    if let Some((k_foot, _)) = detected
+        && k_foot < nb
+    {
+        nb = k_foot;
+        eps_i = debias(&incident_strain, nb);
+        detected = foot(&eps_i);
+    }
+    let eps_t = debias(&transmission_strain, nb);
+    let incident_start_s = match ov.incident_start_s {
+        Some(s) => s,
+        None => {
+            let (k_foot, _) = detected.ok_or_else(|| {
+                input_err(
+                    file,
+                    "incident_strain",
+                    "no compressive (negative) incident pulse",
+                    "an incident record with a compressive pulse",
+                )
+            })?;
+            input.time_s[k_foot]
+        }
+    };
+    let incident_peak = detected.map(|(_, k)| -eps_i[k]).unwrap_or(0.0);
+
+    // 3. Delays.
+    let c_i = bi.wave_speed_m_s;
+    let c_t = bt.wave_speed_m_s;
+    let nominal_r = 2.0 * d_i / c_i;
+    let reflected_delay_s = ov.reflected_delay_s.unwrap_or(nominal_r);
+    let transmitted_delay_s = ov
+        .transmitted_delay_s
+        .unwrap_or(d_i / c_i + d_t / c_t + options.specimen_transit_s);
+
+    // 4. Window length.
+    let record_end = input.time_s[n - 1];
+    let duration_s = match ov.duration_s {
+        Some(d) => d,
+        None => {
+            let mut d = reflected_delay_s;
+            if let Some(l) = bi.length_m {
+                d = d.min(2.0 * (l - d_i) / c_i);
+            }
+            if !setup.transmission_absorbing
+                && let Some(l) = bt.length_m
+            {
+                d = d.min(2.0 * (l - d_t) / c_t);
+            }
+            d.min(record_end - (incident_start_s + reflected_delay_s))
+                .min(record_end - (incident_start_s + transmitted_delay_s))
+        }
+    };
+    let samples = (duration_s / dt * (1.0 + 1e-12)).floor() as usize + 1;
+    let s_i = (incident_start_s - t0) / dt;
+    let s_r = s_i + reflected_delay_s / dt;
+    let s_t = s_i + transmitted_delay_s / dt;
+    let last = (n - 1) as f64 + 1e-6;
+    if samples < 8
+        || s_i < -1e-6
+        || s_r + (samples - 1) as f64 > last
+        || s_t + (samples - 1) as f64 > last
+    {
+        return Err(input_err(
+            file,
+            "time_s",
+            format!(
+                "the record ({:.1} µs to {:.1} µs) does not hold the windows: incident from {:.1} µs, \
+                 reflected from {:.1} µs, transmitted from {:.1} µs, {:.1} µs long",
+                t0 * 1e6,
+                record_end * 1e6,
+                incident_start_s * 1e6,
+                (incident_start_s + reflected_delay_s) * 1e6,
+                (incident_start_s + transmitted_delay_s) * 1e6,
+                duration_s.max(0.0) * 1e6
+            ),
+            "a record long enough for the incident, reflected and transmitted windows (at least 8 samples each)",
+        ));
+    }
+
+    // Reflected start measured in the record (a check of the gauge distance and c0).
+    let measured_reflected_delay_s = {
+        let from = (s_i + 0.5 * reflected_delay_s / dt).max(0.0) as usize;
+        let to = ((s_r + samples as f64) as usize).min(n);
+        if from + 2 < to {
+            let y = &eps_i[from..to];
+            pulse_foot(y, options.start_fraction)
+                .filter(|&(_, kp)| y[kp] >= 0.1 * incident_peak && incident_peak > 0.0)
+                .map(|(kf, _)| input.time_s[from + kf] - incident_start_s)
+        } else {
+            None
+        }
+    };
+    if let Some(m) = measured_reflected_delay_s
+        && (m - reflected_delay_s).abs() > 0.02 * reflected_delay_s
+    {
+        warnings.push(format!(
+            "the reflected pulse starts {:.1} µs after the incident one in the record, the window \
+             uses {:.1} µs (2 d_I/c0 = {:.1} µs): check the gauge distance and c0",
+            m * 1e6,
+            reflected_delay_s * 1e6,
+            nominal_r * 1e6
+        ));
+    }
+    if options.dispersion_correction {
+        for (name, b) in [("incident", bi), ("transmission", bt)] {
+            if (b.poisson_ratio - BANCROFT_FIT_POISSON_RATIO).abs() > 0.02 {
+                warnings.push(format!(
+                    "the {name} bar's Poisson's ratio {} differs from the Bancroft fit's 0.31",
+                    b.poisson_ratio
+                ));
+            }
+        }
+    }
+
+    // Waves at the faces.
+    let disp = |d: f64, b: &BarProperties| {
+        options
+            .dispersion_correction
+            .then_some((d, b.radius_m, b.wave_speed_m_s))
+    };
+    let e_in = cut(&eps_i, dt, s_i, samples, disp(d_i, bi));
+    let e_re = cut(&eps_i, dt, s_r, samples, disp(-d_i, bi));
+    let e_tr = cut(&eps_t, dt, s_t, samples, disp(-d_t, bt));
+
+    // Quantities.
+    let (ea_i, ea_t) = (
+        bi.youngs_modulus_pa * bi.area_m2,
+        bt.youngs_modulus_pa * bt.area_m2,
+    );
+    let force_front_n: Vec<f64> = (0..samples).map(|k| -ea_i * (e_in[k] + e_re[k])).collect();
+    let force_back_n: Vec<f64> = e_tr.iter().map(|e| -ea_t * e).collect();
+    let force_3wave_n: Vec<f64> = (0..samples)
+        .map(|k| 0.5 * (force_front_n[k] + force_back_n[k]))
+        .collect();
+    let v_front: Vec<f64> = (0..samples).map(|k| -c_i * (e_in[k] - e_re[k])).collect();
+    let v_back: Vec<f64> = e_tr.iter().map(|e| -c_t * e).collect();
+    let front_displacement_m = cumulative_trapezoid(&v_front, dt);
+    let back_displacement_m = cumulative_trapezoid(&v_back, dt);
+    let displacement_m: Vec<f64> = (0..samples)
+        .map(|k| front_displacement_m[k] - back_displacement_m[k])
+        .collect();
+    let approach_velocity_m_s: Vec<f64> = (0..samples).map(|k| v_front[k] - v_back[k]).collect();
+    let strain_rate_per_s = options.specimen_radii_m.map(|(r1, r2)| {
+        approach_velocity_m_s
+            .iter()
+            .map(|v| v / (r1 + r2))
+            .collect()
+    });
+    let f3_max = force_3wave_n.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let floor = (0.05 * f3_max).max(f64::MIN_POSITIVE);
+    let equilibrium_ratio: Vec<f64> = (0..samples)
+        .map(|k| (force_front_n[k] - force_back_n[k]).abs() / force_3wave_n[k].abs().max(floor))
+        .collect();
+    let peak_index = (0..samples)
+        .max_by(|&a, &b| force_back_n[a].total_cmp(&force_back_n[b]))
+        .unwrap_or(0);
+    let time_s: Vec<f64> = (0..samples).map(|k| k as f64 * dt).collect();
+    Ok(Reduction {
+        face_time_offset_s: incident_start_s + d_i / c_i,
+        peak_back_force_n: force_back_n[peak_index],
+        peak_back_force_time_s: time_s[peak_index],
+        peak_index,
+        displacement_at_peak_force_m: displacement_m[peak_index],
+        equilibrium_ratio_at_peak: equilibrium_ratio[peak_index],
+        peak_front_force_n: force_front_n
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
+        max_displacement_m: displacement_m
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
+        windows: Windows {
+            incident_start_s,
+            reflected_delay_s,
+            transmitted_delay_s,
+            duration_s: (samples - 1) as f64 * dt,
+            samples,
+            baseline_samples: nb,
+        },
+        measured_reflected_delay_s,
+        dispersion_corrected: options.dispersion_correction,
+        warnings,
+        time_s,
+        incident_strain: e_in,
+        reflected_strain: e_re,
+        transmitted_strain: e_tr,
+        force_front_n,
+        force_back_n,
+        force_3wave_n,
+        front_displacement_m,
+        back_displacement_m,
+        displacement_m,
+        approach_velocity_m_s,
+        strain_rate_per_s,
+        equilibrium_ratio,
+    })
+}
+
+/// Bar strains of a raw record (the authors' CSV) read through the set-up's `incident` and
+/// `transmission` channels (bridge, gain, polarity), after removing each channel's voltage
+/// baseline (the mean of its first `baseline_samples` samples, as the authors do).
+pub fn record_strains(
+    record: &RawRecord,
+    apparatus: &Apparatus,
+    baseline_samples: usize,
+) -> Result<ReductionInput> {
+    let n = baseline_samples.min(record.time_s.len() / 2);
+    let inc = channel(apparatus, "incident")?;
+    let tra = channel(apparatus, "transmission")?;
+    Ok(ReductionInput {
+        time_s: record.time_s.clone(),
+        incident_strain: inc.strains_from_voltages(&debias(&record.incident_v, n)),
+        transmission_strain: tra.strains_from_voltages(&debias(&record.transmission_v, n)),
+    })
+}
+

@@ -1,0 +1,74 @@
+//! The result of one run ([`RunOutput`]): contact series, gauge traces, energies, bar
+//! snapshots, scalar summary, the lab's reduction of simulated records, and warnings. Plain data:
+//! the writers of `shpb-output` turn it into HDF5, CSV and PNG.
+
+use crate::solver::ContactSeries;
+
+/// A scalar result of a run (peak force, restitution, …) with its unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SummaryItem {
+    /// Name, snake_case (used as HDF5 attribute name).
+    pub key: String,
+    /// Value in SI units.
+    pub value: f64,
+    /// Unit (`N`, `m`, `1`, …).
+    pub unit: &'static str,
+}
+
+/// Shorthand constructor of a [`SummaryItem`].
+pub fn item(key: &str, value: f64, unit: &'static str) -> SummaryItem {
+    SummaryItem {
+        key: key.to_string(),
+        value,
+        unit,
+    }
+}
+
+/// The output of one scene run, ready to be written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutput {
+    /// The `/contact` time series (absent for scenes without spheres).
+    pub contact: Option<ContactSeries>,
+    /// The `/time` axis of the gauge and energy series, s.
+    pub time_s: Option<Vec<f64>>,
+    /// `/gauges/<name>/{strain,voltage}`.
+    pub gauges: Vec<GaugeTrace>,
+    /// `/energy/<name>`, J, on the `/time` axis.
+    pub energy: Vec<(String, Vec<f64>)>,
+    /// `/bars/<name>/{snapshots,x,time}`: decimated x–t stress fields.
+    pub bars: Vec<crate::solver::pulse::BarSnapshots>,
+    /// Scalar results (attributes of `/summary`).
+    pub summary: Vec<SummaryItem>,
+    /// The lab's reduction of the simulated gauge records (`/reduction/*`), full SHPB tests only.
+    pub reduction: Option<crate::reduce::Reduction>,
+    /// Things the user should know about the run (`/summary` attribute `warnings`, one per line).
+    pub warnings: Vec<String>,
+}
+
+/// One recorded gauge channel: bar strain and the digitised voltage on the `/time` axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaugeTrace {
+    /// Channel name.
+    pub name: String,
+    /// Bar strain at the gauge (positive in tension), noise-free.
+    pub strain: Vec<f64>,
+    /// Recorded voltage: bridge, amplifier, noise and quantisation, V.
+    pub voltage_v: Vec<f64>,
+}
+
+impl RunOutput {
+    /// An output with only a contact series and a summary.
+    pub fn contact_only(contact: ContactSeries, summary: Vec<SummaryItem>) -> RunOutput {
+        RunOutput {
+            contact: Some(contact),
+            time_s: None,
+            gauges: Vec::new(),
+            energy: Vec::new(),
+            bars: Vec::new(),
+            summary,
+            reduction: None,
+            warnings: Vec::new(),
+        }
+    }
+}
+

@@ -1,0 +1,473 @@
+//! A validated virtual test ([`Params`]: specimen, contact law, fidelity and the kind-specific
+//! [`SceneParams`]) and how it runs into a [`RunOutput`]. Scene files are parsed into it by
+//! `shpb-input`; nothing here reads a file.
+
+use crate::apparatus::{Apparatus, PulseOptions};
+use crate::bar::Dispersion;
+use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
+use crate::error::Result;
+use crate::fidelity::Fidelity;
+use crate::run::{RunOutput, SummaryItem, item};
+use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
+use crate::numeric::resample;
+use crate::specimen::SpherePair;
+
+/// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
+/// radius 9.525 mm; physics.md §5), kg/s.
+pub const AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S: f64 =
+    8110.0 * 4865.5 * std::f64::consts::PI * 9.525e-3 * 9.525e-3;
+
+/// Validated parameters of a scene, by kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneParams {
+    /// Loading law F(δ) on a grid (Fig. 2).
+    Quasistatic {
+        /// Largest approach, m.
+        max_displacement_m: f64,
+        /// Number of grid points.
+        points: usize,
+        /// Strain rate at which the curve is evaluated (0: static), 1/s.
+        strain_rate_per_s: f64,
+    },
+    /// Constant approach speed (Fig. 3).
+    ConstantRate {
+        /// Global strain rate of paper Eq. 3, 1/s.
+        strain_rate_per_s: f64,
+        /// Largest approach, m.
+        max_displacement_m: f64,
+        /// Number of samples.
+        points: usize,
+    },
+    /// Free collision.
+    Collision(CollisionSetup),
+    /// Striker, shaper and bars: the gauge signals of a bar test without specimen.
+    Pulse {
+        /// The bar set-up.
+        apparatus: Box<Apparatus>,
+        /// Gas-gun gauge pressure, Pa.
+        pressure_pa: f64,
+        /// Solver options (striker velocity from the gun).
+        options: Box<PulseOptions>,
+    },
+    /// Fig. 4 force-driven DEM; `measured` holds the CSV's displacement column when present.
+    ForceDriven {
+        /// Solver inputs.
+        setup: ForceDrivenSetup,
+        /// Measured approach at the drive's sample times, if the CSV has `displacement_m`.
+        measured_displacement_m: Option<Vec<f64>>,
+    },
+}
+
+/// A parsed, validated scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Params {
+    /// The scene file (or label).
+    pub source: String,
+    /// The TOML text, stored in the output for provenance.
+    pub text: String,
+    /// Scene kind name.
+    pub kind: String,
+    /// The specimen.
+    pub pair: SpherePair,
+    /// The contact law selected.
+    pub law: LawKind,
+    /// The fidelity preset the numerical knobs were taken from (explicit keys win).
+    pub fidelity: Fidelity,
+    /// Form of region II of the loading law (`smooth` C¹ default, or `published`).
+    pub region2: Region2Form,
+    /// Kind-specific parameters.
+    pub params: SceneParams,
+}
+
+impl Params {
+    /// The contact law of this scene.
+    pub fn contact_law(&self) -> Box<dyn ContactLaw> {
+        self.law
+            .build_with(self.pair.contact_properties(), self.region2)
+    }
+
+    /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).
+    pub fn warnings(&self) -> Vec<String> {
+        let p = self.pair.contact_properties();
+        let c = LoadingCurve::new(p.e_star_pa, p.radius_m, p.yield_stress_pa);
+        let q = p.e_star_pa / p.yield_stress_pa;
+        match c.degenerate {
+            Degenerate::No => vec![],
+            Degenerate::HertzToPlasticAt(d) => vec![format!(
+                "{}: δp ≤ δy for this pair (q = E*/σy = {q:.3}): region II does not exist; the law goes from Hertz to region III at δ = {d:.4e} m",
+                self.source
+            )],
+            Degenerate::HertzOnly => vec![format!(
+                "{}: δp ≤ δy for this pair (q = E*/σy = {q:.3}) and region III never crosses Hertz: the law stays elastic (Hertz)",
+                self.source
+            )],
+        }
+    }
+
+    /// Runs the scene.
+    pub fn run(&self) -> Result<RunOutput> {
+        let law = self.contact_law();
+        let law = law.as_ref();
+        match &self.params {
+            SceneParams::Quasistatic {
+                max_displacement_m,
+                points,
+                strain_rate_per_s,
+            } => {
+                let s =
+                    solver::loading_curve(law, *max_displacement_m, *points, *strain_rate_per_s);
+                let summary = vec![item("max_force", *s.force_n.last().unwrap_or(&0.0), "N")];
+                Ok(RunOutput::contact_only(s, summary))
+            }
+            SceneParams::ConstantRate {
+                strain_rate_per_s,
+                max_displacement_m,
+                points,
+            } => {
+                let s = solver::constant_rate(
+                    law,
+                    &self.pair,
+                    *strain_rate_per_s,
+                    *max_displacement_m,
+                    *points,
+                );
+                let summary = vec![
+                    item("max_force", *s.force_n.last().unwrap_or(&0.0), "N"),
+                    item(
+                        "approach_speed",
+                        strain_rate_per_s
+                            * (self.pair.sphere1.radius_m + self.pair.sphere2.radius_m),
+                        "m/s",
+                    ),
+                ];
+                Ok(RunOutput::contact_only(s, summary))
+            }
+            SceneParams::Collision(setup) => {
+                let r = solver::collision(law, &self.pair, setup)?;
+                let p = self.pair.contact_properties();
+                let tc = solver::hertz_impact_duration(
+                    self.pair.reduced_mass_kg(),
+                    p.e_star_pa,
+                    p.radius_m,
+                    setup.velocity1_m_s - setup.velocity2_m_s,
+                );
+                let summary = vec![
+                    item("restitution", r.restitution, "1"),
+                    item("contact_time", r.contact_time_s, "s"),
+                    item("hertz_contact_time", tc, "s"),
+                    item("peak_force", r.peak_force_n, "N"),
+                    item("max_approach", r.max_approach_m, "m"),
+                    item("residual_approach", r.residual_approach_m, "m"),
+                    item("kinetic_energy_before", r.kinetic_energy_before_j, "J"),
+                    item("kinetic_energy_after", r.kinetic_energy_after_j, "J"),
+                    item("energy_dissipated", r.dissipated_j, "J"),
+                    item("time_step", setup.dt_s, "s"),
+                ];
+                Ok(RunOutput::contact_only(r.series, summary))
+            }
+            SceneParams::Pulse {
+                apparatus,
+                pressure_pa,
+                options,
+            } => run_pulse(apparatus, *pressure_pa, options),
+            SceneParams::ForceDriven {
+                setup,
+                measured_displacement_m,
+            } => {
+                let r = solver::force_driven(law, &self.pair, setup)?;
+                let mut summary = force_driven_summary(
+                    &r.series,
+                    &setup.drive,
+                    measured_displacement_m.as_deref(),
+                );
+                summary.push(item("time_step", setup.dt_s, "s"));
+                summary.push(item("energy_radiated", r.energy.radiated_j, "J"));
+                summary.push(item("external_work", r.energy.external_work_j, "J"));
+                summary.push(item("contact_work", r.energy.contact_work_j, "J"));
+                summary.push(item("kinetic_energy_end", r.kinetic_energy_j, "J"));
+                Ok(RunOutput::contact_only(r.series, summary))
+            }
+        }
+    }
+}
+
+/// Comparison of a force-driven run with the measured displacement (paper Fig. 4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fig4Comparison {
+    /// Peak contact force of the model, N.
+    pub model_peak_force_n: f64,
+    /// Model approach at its peak force, m.
+    pub model_displacement_at_peak_m: f64,
+    /// Peak measured force, N.
+    pub measured_peak_force_n: f64,
+    /// Measured approach at the peak measured force, m.
+    pub measured_displacement_at_peak_m: f64,
+    /// Measured approach at t = 0 (the reduction's offset; the model starts at δ = 0), m.
+    pub measured_initial_displacement_m: f64,
+}
+
+impl Fig4Comparison {
+    /// Relative error of the model's displacement at peak force against the measured one,
+    /// both counted from t = 0 (the measured offset δ(0) removed).
+    pub fn relative_error(&self) -> f64 {
+        let measured = self.measured_displacement_at_peak_m - self.measured_initial_displacement_m;
+        (self.model_displacement_at_peak_m - measured) / measured
+    }
+}
+
+/// Compares a force-driven series with the measured displacement sampled at the drive's times.
+pub fn compare_fig4(
+    series: &ContactSeries,
+    drive: &ForceHistory,
+    measured_displacement_m: &[f64],
+) -> Fig4Comparison {
+    let k = series.peak_index();
+    let j = solver::argmax(&drive.force_n);
+    Fig4Comparison {
+        model_peak_force_n: series.force_n[k],
+        model_displacement_at_peak_m: series.displacement_m[k],
+        measured_peak_force_n: drive.force_n[j],
+        measured_displacement_at_peak_m: measured_displacement_m[j],
+        measured_initial_displacement_m: measured_displacement_m[0],
+    }
+}
+
+fn force_driven_summary(
+    series: &ContactSeries,
+    drive: &ForceHistory,
+    measured: Option<&[f64]>,
+) -> Vec<SummaryItem> {
+    let k = series.peak_index();
+    let mut out = vec![
+        item("peak_force", series.force_n[k], "N"),
+        item("displacement_at_peak_force", series.displacement_m[k], "m"),
+        item(
+            "time_of_peak_force",
+            series.time_s.as_ref().map(|t| t[k]).unwrap_or(0.0),
+            "s",
+        ),
+        item(
+            "max_displacement",
+            series.displacement_m.iter().cloned().fold(0.0, f64::max),
+            "m",
+        ),
+    ];
+    if let Some(d) = measured {
+        let c = compare_fig4(series, drive, d);
+        out.push(item("measured_peak_force", c.measured_peak_force_n, "N"));
+        out.push(item(
+            "measured_displacement_at_peak_force",
+            c.measured_displacement_at_peak_m,
+            "m",
+        ));
+        out.push(item(
+            "measured_initial_displacement",
+            c.measured_initial_displacement_m,
+            "m",
+        ));
+        out.push(item(
+            "displacement_at_peak_relative_error",
+            c.relative_error(),
+            "1",
+        ));
+    }
+    out
+}
+
+/// Runs a `pulse` scene: simulates the chain, digitises every gauge, and summarises each pulse.
+fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) -> Result<RunOutput> {
+    let chain = apparatus.pulse_chain(options);
+    let r = crate::solver::pulse::simulate_chain(&chain)?;
+    let e = apparatus.material.youngs_modulus_pa;
+    let mut summary = vec![
+        item("pressure", pressure_pa, "Pa"),
+        item("striker_velocity", options.striker_velocity_m_s, "m/s"),
+        item("striker_energy", r.striker_energy_j, "J"),
+        item(
+            "striker_final_velocity",
+            r.striker_final_velocity_m_s,
+            "m/s",
+        ),
+        item("time_step", chain.dt_s, "s"),
+    ];
+    let mut gauges = Vec::new();
+    let mut time = None;
+    for (k, probe) in chain.gauges.iter().enumerate() {
+        let ch = apparatus
+            .gauges
+            .channel(&probe.name)
+            .expect("probes come from the gauge set-up");
+        let n = (options.end_time_s * ch.digitiser.sample_rate_hz).floor() as usize;
+        let (t, v) = ch.record(&r.time_s, &r.strain[k], 0.0, n);
+        let strain = resample(&r.time_s, &r.strain[k], &t);
+        if let Some(m) = crate::gauge::pulse_metrics(&t, &strain, true) {
+            summary.push(item(
+                &format!("{}_peak_stress", probe.name),
+                -e * m.peak,
+                "Pa",
+            ));
+            summary.push(item(
+                &format!("{}_rise_10_90", probe.name),
+                m.rise_10_90_s,
+                "s",
+            ));
+            summary.push(item(
+                &format!("{}_duration_10", probe.name),
+                m.duration_10_s,
+                "s",
+            ));
+            summary.push(item(&format!("{}_start_10", probe.name), m.start_10_s, "s"));
+        }
+        gauges.push(crate::run::GaugeTrace {
+            name: probe.name.clone(),
+            strain,
+            voltage_v: v,
+        });
+        time = Some(t);
+    }
+    let t = time.unwrap_or_else(|| r.time_s.clone());
+    let striker = vec![r.striker_energy_j; t.len()];
+    let bars = resample(&r.time_s, &r.bar_energy_j, &t);
+    let absorbed = resample(&r.time_s, &r.absorbed_energy_j, &t);
+    let shaper = resample(&r.time_s, &r.shaper_energy_j, &t);
+    let contact_work = resample(&r.time_s, &r.contact_energy_j, &t);
+    let total: Vec<f64> = (0..t.len())
+        .map(|i| bars[i] + absorbed[i] + shaper[i] + contact_work[i])
+        .collect();
+    if let Some(c) = &r.contact {
+        let k = c.peak_index();
+        summary.push(item("peak_contact_force", c.force_n[k], "N"));
+        summary.push(item(
+            "displacement_at_peak_contact_force",
+            c.displacement_m[k],
+            "m",
+        ));
+        summary.push(item(
+            "time_of_peak_contact_force",
+            c.time_s.as_ref().map(|t| t[k]).unwrap_or(0.0),
+            "s",
+        ));
+        summary.push(item(
+            "max_displacement",
+            c.displacement_m.iter().cloned().fold(0.0, f64::max),
+            "m",
+        ));
+        summary.push(item(
+            "contact_work_end",
+            *r.contact_energy_j.last().unwrap_or(&0.0),
+            "J",
+        ));
+    }
+    let worst = total
+        .iter()
+        .map(|x| (x - r.striker_energy_j).abs())
+        .fold(0.0, f64::max)
+        / r.striker_energy_j;
+    summary.push(item("energy_balance_max_relative_error", worst, "1"));
+    let mut energy = vec![
+        ("striker".into(), striker),
+        ("bars".into(), bars),
+        ("absorbed".into(), absorbed),
+        ("shaper".into(), shaper),
+    ];
+    if r.contact.is_some() {
+        energy.push(("contact".into(), contact_work));
+    }
+    energy.push(("total".into(), total));
+    let mut warnings = Vec::new();
+    let reduction = match &options.specimen {
+        Some(spec) => match reduce_simulated_records(apparatus, options, spec, &t, &gauges) {
+            Ok(red) => {
+                summary.extend(reduced_summary(&red));
+                warnings.extend(red.warnings.iter().map(|w| format!("reduction: {w}")));
+                Some(red)
+            }
+            Err(e) => {
+                warnings.push(format!("reduction of the simulated records failed: {e}"));
+                None
+            }
+        },
+        None => None,
+    };
+    Ok(RunOutput {
+        contact: r.contact,
+        time_s: Some(t),
+        gauges,
+        energy,
+        bars: r.snapshots,
+        summary,
+        reduction,
+        warnings,
+    })
+}
+
+/// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
+/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
+/// < 0.02 % of its peak.
+pub const SIMULATED_RECORD_SMOOTHING_S: f64 = 2e-6;
+
+/// The lab's reduction of a simulated test: the digitised voltages read back through each
+/// channel's bridge (as the lab gets them), dispersion correction only when the bars disperse.
+fn reduce_simulated_records(
+    apparatus: &Apparatus,
+    options: &PulseOptions,
+    spec: &crate::apparatus::SpecimenSetup,
+    time_s: &[f64],
+    gauges: &[crate::run::GaugeTrace],
+) -> Result<crate::reduce::Reduction> {
+    let strain = |name: &str| -> Result<Vec<f64>> {
+        let trace = gauges.iter().find(|g| g.name == name);
+        let channel = apparatus.gauges.channel(name);
+        match (trace, channel) {
+            (Some(g), Some(ch)) => Ok(ch.strains_from_voltages(&g.voltage_v)),
+            _ => Err(crate::error::Named::new(apparatus.source.clone()).error(
+                "gauges",
+                format!("no `{name}` gauge channel to reduce"),
+                "channels named incident and transmission",
+            )),
+        }
+    };
+    let input = crate::reduce::ReductionInput {
+        time_s: time_s.to_vec(),
+        incident_strain: strain("incident")?,
+        transmission_strain: strain("transmission")?,
+    };
+    let reduction_options = crate::reduce::ReductionOptions {
+        dispersion_correction: options.dispersion != Dispersion::None,
+        specimen_radii_m: Some((spec.pair.sphere1.radius_m, spec.pair.sphere2.radius_m)),
+        smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
+        ..Default::default()
+    };
+    crate::reduce::reduce(
+        &input,
+        &crate::reduce::ReductionSetup::from_apparatus(apparatus)?,
+        &reduction_options,
+    )
+}
+
+/// Summary items of the reduction of a simulated test (`reduced_*`).
+fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
+    let mut v = vec![
+        item("reduced_peak_back_force", r.peak_back_force_n, "N"),
+        item("reduced_peak_front_force", r.peak_front_force_n, "N"),
+        item(
+            "reduced_displacement_at_peak_force",
+            r.displacement_at_peak_force_m,
+            "m",
+        ),
+        item(
+            "reduced_equilibrium_ratio_at_peak",
+            r.equilibrium_ratio_at_peak,
+            "1",
+        ),
+    ];
+    if let Some(rate) = &r.strain_rate_per_s {
+        v.push(item(
+            "reduced_peak_strain_rate",
+            rate.iter().copied().fold(0.0, f64::max),
+            "1/s",
+        ));
+    }
+    v
+}
+

@@ -1,0 +1,91 @@
+//! The specimen: two (possibly dissimilar) spheres and their effective contact properties
+//! (paper Sec. II: E*, r; physics.md §1).
+
+use crate::material::{JohnsonCook, Material};
+
+/// One sphere of the specimen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sphere {
+    /// Its material.
+    pub material: Material,
+    /// Radius of curvature at the contact, m.
+    pub radius_m: f64,
+    /// Mass, kg (default: the full sphere, a fair approximation for the truncated ones, physics.md §5).
+    pub mass_kg: f64,
+}
+
+impl Sphere {
+    /// A full sphere of `material` with radius `radius_m`.
+    pub fn full(material: Material, radius_m: f64) -> Sphere {
+        let mass_kg = material.density_kg_m3 * 4.0 / 3.0 * std::f64::consts::PI * radius_m.powi(3);
+        Sphere {
+            material,
+            radius_m,
+            mass_kg,
+        }
+    }
+}
+
+/// Effective properties of a pair as used by the contact law (paper Sec. II; authors' code for
+/// dissimilar spheres: the yield stress and rate hardening of the weaker sphere).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactProperties {
+    /// Effective modulus E* = [(1−ν1²)/E1 + (1−ν2²)/E2]⁻¹, Pa.
+    pub e_star_pa: f64,
+    /// Effective radius r = (1/r1 + 1/r2)⁻¹, m.
+    pub radius_m: f64,
+    /// r1 + r2, the length in the global strain rate of paper Eq. 3, m.
+    pub sum_of_radii_m: f64,
+    /// Quasi-static yield stress min(σy1, σy2), Pa.
+    pub yield_stress_pa: f64,
+    /// Rate hardening of the sphere with the smaller yield stress (paper Eq. 2).
+    pub rate: JohnsonCook,
+}
+
+/// Two spheres in contact: sphere 1 is on the incident side, sphere 2 on the transmission side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpherePair {
+    /// Incident-side sphere.
+    pub sphere1: Sphere,
+    /// Transmission-side sphere.
+    pub sphere2: Sphere,
+}
+
+impl SpherePair {
+    /// The paper's specimen: two full spheres of `material`, 6.35 mm in diameter.
+    pub fn paper(material: Material) -> SpherePair {
+        let s = Sphere::full(material, 6.35e-3 / 2.0);
+        SpherePair {
+            sphere1: s.clone(),
+            sphere2: s,
+        }
+    }
+
+    /// Effective contact properties of the pair (physics.md §1).
+    pub fn contact_properties(&self) -> ContactProperties {
+        let (a, b) = (&self.sphere1, &self.sphere2);
+        let e_star_pa = 1.0
+            / (1.0 / a.material.plane_strain_modulus_pa()
+                + 1.0 / b.material.plane_strain_modulus_pa());
+        let radius_m = 1.0 / (1.0 / a.radius_m + 1.0 / b.radius_m);
+        let weaker = if a.material.yield_stress_pa <= b.material.yield_stress_pa {
+            a
+        } else {
+            b
+        };
+        ContactProperties {
+            e_star_pa,
+            radius_m,
+            sum_of_radii_m: a.radius_m + b.radius_m,
+            yield_stress_pa: weaker.material.yield_stress_pa,
+            rate: weaker.material.rate,
+        }
+    }
+
+    /// Reduced mass m1 m2 / (m1 + m2), kg.
+    pub fn reduced_mass_kg(&self) -> f64 {
+        let (m1, m2) = (self.sphere1.mass_kg, self.sphere2.mass_kg);
+        m1 * m2 / (m1 + m2)
+    }
+}
+

@@ -1,0 +1,240 @@
+//! Gauge files (`bars/gauges-*.toml`) and raw gauge records (the authors' CSV), validated into
+//! the core's [`GaugeSetup`] and [`RawRecord`].
+
+use crate::csv::CsvTable;
+use crate::error::{Error, Result, Validator};
+use serde::Deserialize;
+use shpb_core::apparatus::Apparatus;
+use shpb_core::gauge::{Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup, RawRecord};
+use shpb_core::reduce::{Reduction, ReductionOptions, ReductionSetup, record_strains, reduce_named};
+use std::path::Path;
+
+/// One `[[channel]]` table of a gauge file, before validation.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ChannelSpec {
+    name: String,
+    bar: String,
+    distance_from_specimen_m: f64,
+    bridge: String,
+    gauge_factor: f64,
+    excitation_v: f64,
+    poisson_ratio: f64,
+    #[serde(default = "unit_gain")]
+    amplifier_gain: f64,
+    polarity: f64,
+    sample_rate_hz: f64,
+    adc_bits: i64,
+    adc_range_v: f64,
+    #[serde(default)]
+    noise_rms_v: f64,
+    seed: Option<i64>,
+}
+
+fn unit_gain() -> f64 {
+    1.0
+}
+
+/// A gauge file: an optional description and one or more `[[channel]]` tables.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SetupFile {
+    #[serde(default)]
+    #[allow(dead_code)]
+    description: Option<String>,
+    channel: Vec<ChannelSpec>,
+}
+
+impl ChannelSpec {
+    /// Validates one channel; `index` is its position (seed default), `v` reports `channel[i].*`.
+    fn build(&self, index: usize, v: &Validator) -> Result<GaugeChannel> {
+        let text = |key: &str, s: &str| -> Result<String> {
+            if s.trim().is_empty() {
+                Err(v.error(key, "empty", "a non-empty name"))
+            } else {
+                Ok(s.trim().to_string())
+            }
+        };
+        let kind = BridgeKind::from_name(self.bridge.trim()).ok_or_else(|| {
+            v.error(
+                "bridge",
+                format!("unknown bridge kind `{}`", self.bridge),
+                BridgeKind::ALL
+                    .iter()
+                    .map(|(_, n)| format!("\"{n}\""))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            )
+        })?;
+        if self.polarity != 1.0 && self.polarity != -1.0 {
+            return Err(v.error(
+                "polarity",
+                format!("{} is not ±1", self.polarity),
+                "1 or -1",
+            ));
+        }
+        if !(1..=32).contains(&self.adc_bits) {
+            return Err(v.error(
+                "adc_bits",
+                format!("{} bits is out of range", self.adc_bits),
+                "1 to 32 bits",
+            ));
+        }
+        let seed = match self.seed {
+            Some(s) if s < 0 => {
+                return Err(v.error(
+                    "seed",
+                    format!("{s} is negative"),
+                    "0 to 9223372036854775807",
+                ));
+            }
+            Some(s) => s as u64,
+            None => index as u64,
+        };
+        Ok(GaugeChannel {
+            name: text("name", &self.name)?,
+            bar: text("bar", &self.bar)?,
+            distance_from_specimen_m: v.in_range(
+                "distance_from_specimen_m",
+                self.distance_from_specimen_m,
+                0.0,
+                100.0,
+                "m",
+            )?,
+            bridge: Bridge {
+                kind,
+                gauge_factor: v.positive("gauge_factor", self.gauge_factor, 1000.0, "")?,
+                excitation_v: v.positive("excitation_v", self.excitation_v, 1000.0, "V")?,
+                poisson_ratio: v.in_range("poisson_ratio", self.poisson_ratio, 0.0, 0.5, "")?,
+            },
+            amplifier_gain: v.positive("amplifier_gain", self.amplifier_gain, 1e6, "")?,
+            polarity: self.polarity,
+            digitiser: Digitiser {
+                sample_rate_hz: v.positive("sample_rate_hz", self.sample_rate_hz, 1e12, "Hz")?,
+                bits: self.adc_bits as u32,
+                range_v: v.positive("adc_range_v", self.adc_range_v, 1e4, "V")?,
+                noise_rms_v: v.in_range("noise_rms_v", self.noise_rms_v, 0.0, 1e4, "V")?,
+                seed,
+            },
+        })
+    }
+}
+
+/// Reading and validating gauge files.
+pub trait GaugeSetupFile: Sized {
+    /// Parses and validates a gauge file's text; `file` names it in errors (keys `channel[i].*`).
+    fn from_toml(text: &str, file: &str) -> Result<Self>;
+    /// Reads and validates a gauge file.
+    fn from_file(path: impl AsRef<Path>) -> Result<Self>;
+}
+
+impl GaugeSetupFile for GaugeSetup {
+    /// Parses and validates a gauge file's text; `file` names it in errors (keys `channel[i].*`).
+    fn from_toml(text: &str, file: &str) -> Result<GaugeSetup> {
+        let spec: SetupFile = toml::from_str(text).map_err(|e| Error::Parse {
+            file: file.to_string(),
+            message: e.to_string(),
+        })?;
+        let root = Validator::new(file);
+        if spec.channel.is_empty() {
+            return Err(root.error("channel", "no channels", "one or more [[channel]] tables"));
+        }
+        let mut channels: Vec<GaugeChannel> = Vec::with_capacity(spec.channel.len());
+        for (i, c) in spec.channel.iter().enumerate() {
+            let v = root.table(&format!("channel[{i}]"));
+            let ch = c.build(i, &v)?;
+            if channels.iter().any(|o| o.name == ch.name) {
+                return Err(v.error(
+                    "name",
+                    format!("`{}` is used by an earlier channel", ch.name),
+                    "a name unique in the file",
+                ));
+            }
+            channels.push(ch);
+        }
+        Ok(GaugeSetup { channels })
+    }
+
+    /// Reads and validates a gauge file.
+    fn from_file(path: impl AsRef<Path>) -> Result<GaugeSetup> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        GaugeSetup::from_toml(&text, &path.display().to_string())
+    }
+}
+
+/// Reading raw gauge records (`time_s,incident_V,transmission_V`).
+pub trait RawRecordFile: Sized {
+    /// Parses a record from CSV text; `file` names it in errors, which give `file:line`.
+    fn parse(text: &str, file: &str) -> Result<Self>;
+    /// Reads a record file (see [`RawRecord::parse`]).
+    fn read(path: &Path) -> Result<Self>;
+}
+
+impl RawRecordFile for RawRecord {
+    /// Parses a record from CSV text; `file` names it in errors, which give `file:line`.
+    fn parse(text: &str, file: &str) -> Result<RawRecord> {
+        let table = CsvTable::parse(text, file)?;
+        let time_s = table.column("time_s")?.to_vec();
+        let incident_v = table.column("incident_V")?.to_vec();
+        let transmission_v = table.column("transmission_V")?.to_vec();
+        if time_s.len() < 2 {
+            return Err(Error::Input {
+                file: file.to_string(),
+                key: "time_s".into(),
+                problem: "fewer than two samples".into(),
+                allowed: "at least two strictly increasing times".into(),
+            });
+        }
+        if let Some(i) = time_s.windows(2).position(|w| w[1] <= w[0]) {
+            // Data row i + 1 is the offender; find its line in the file as CsvTable counts them.
+            let line = text
+                .lines()
+                .enumerate()
+                .filter(|(_, l)| !l.trim().is_empty() && !l.trim().starts_with('#'))
+                .nth(i + 2)
+                .map(|(n, _)| n + 1)
+                .unwrap_or(0);
+            return Err(Error::Input {
+                file: format!("{file}:{line}"),
+                key: "time_s".into(),
+                problem: format!(
+                    "time {:e} s does not follow {:e} s on the line before",
+                    time_s[i + 1],
+                    time_s[i]
+                ),
+                allowed: "strictly increasing times".into(),
+            });
+        }
+        Ok(RawRecord {
+            time_s,
+            incident_v,
+            transmission_v,
+        })
+    }
+
+    /// Reads a record file (see [`RawRecord::parse`]).
+    fn read(path: &Path) -> Result<RawRecord> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        RawRecord::parse(&text, &path.display().to_string())
+    }
+}
+
+/// Reduces a raw gauge record in the authors' CSV format (`time_s,incident_V,transmission_V`)
+/// with the bars and gauge channels of `apparatus`.
+pub fn reduce_record_file(
+    record: &Path,
+    apparatus: &Apparatus,
+    options: &ReductionOptions,
+) -> Result<Reduction> {
+    let rec = RawRecord::read(record)?;
+    let input = record_strains(&rec, apparatus, options.baseline_samples)?;
+    reduce_named(
+        &input,
+        &ReductionSetup::from_apparatus(apparatus)?,
+        options,
+        &record.display().to_string(),
+    )
+    .map_err(Error::from)
+}
+

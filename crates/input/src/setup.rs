@@ -1,0 +1,291 @@
+//! Bar set-up files (`bars/*.toml`: bar material, incident and transmission bars, striker, gas
+//! gun, pulse shaper and the gauge file) and the built-in set-ups, validated into the core's
+//! [`Apparatus`]; a scene's `[shaper]` override.
+
+use crate::error::{Error, Result, Validator};
+use crate::gauges::GaugeSetupFile;
+use serde::Deserialize;
+use shpb_core::apparatus::{Apparatus, BarGeometry};
+use shpb_core::bar::BarMaterial;
+use shpb_core::gauge::GaugeSetup;
+use shpb_core::shaper::PulseShaper;
+use shpb_core::striker::{GasGun, Gun, LinearGun};
+use std::path::Path;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialToml {
+    density_kg_m3: f64,
+    youngs_modulus_pa: f64,
+    poisson_ratio: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BarToml {
+    length_m: f64,
+    diameter_m: f64,
+    #[serde(default)]
+    far_end: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GunToml {
+    model: String,
+    k_m2_per_s2_per_pa: Option<f64>,
+    loss_pressure_pa: Option<f64>,
+    reservoir_volume_m3: Option<f64>,
+    barrel_length_m: Option<f64>,
+    friction_n: Option<f64>,
+    gamma: Option<f64>,
+    min_pressure_pa: f64,
+    max_pressure_pa: f64,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct ShaperToml {
+    diameter_m: f64,
+    thickness_m: f64,
+    sigma0_pa: f64,
+    n: f64,
+    m: f64,
+    youngs_modulus_pa: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ApparatusToml {
+    gauges: String,
+    material: MaterialToml,
+    incident: BarToml,
+    transmission: BarToml,
+    striker: BarToml,
+    gun: GunToml,
+    shaper: Option<ShaperToml>,
+}
+
+fn bar_geometry(b: &BarToml, v: &Validator) -> Result<BarGeometry> {
+    Ok(BarGeometry {
+        length_m: v.positive("length_m", b.length_m, 100.0, "m")?,
+        diameter_m: v.positive("diameter_m", b.diameter_m, 1.0, "m")?,
+    })
+}
+
+/// Validates a shaper table (shared by set-up files and scenes).
+fn shaper_from(s: &ShaperToml, v: &Validator) -> Result<PulseShaper> {
+    Ok(PulseShaper {
+        diameter_m: v.positive("diameter_m", s.diameter_m, 0.1, "m")?,
+        thickness_m: v.positive("thickness_m", s.thickness_m, 0.05, "m")?,
+        sigma0_pa: v.positive("sigma0_pa", s.sigma0_pa, 1e11, "Pa")?,
+        n: v.in_range("n", s.n, 0.01, 1.0, "")?,
+        m: v.in_range("m", s.m, 0.5, 50.0, "")?,
+        youngs_modulus_pa: v.positive("youngs_modulus_pa", s.youngs_modulus_pa, 1e13, "Pa")?,
+    })
+}
+
+/// Reading and validating bar set-up files.
+pub trait ApparatusFile: Sized {
+    /// Reads and validates a set-up file; its `gauges` file is resolved relative to it.
+    fn from_file(path: &Path) -> Result<Self>;
+}
+
+impl ApparatusFile for Apparatus {
+    /// Reads and validates a set-up file; its `gauges` file is resolved relative to it.
+    fn from_file(path: &Path) -> Result<Apparatus> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let file = path.display().to_string();
+        let raw: ApparatusToml = toml::from_str(&text).map_err(|e| Error::Parse {
+            file: file.clone(),
+            message: e.to_string(),
+        })?;
+        let v = Validator::new(file.clone());
+        let mv = v.table("material");
+        let material = BarMaterial {
+            density_kg_m3: mv.positive(
+                "density_kg_m3",
+                raw.material.density_kg_m3,
+                1e5,
+                "kg/m³",
+            )?,
+            youngs_modulus_pa: mv.positive(
+                "youngs_modulus_pa",
+                raw.material.youngs_modulus_pa,
+                1e13,
+                "Pa",
+            )?,
+            poisson_ratio: mv.in_range(
+                "poisson_ratio",
+                raw.material.poisson_ratio,
+                0.0,
+                0.4999,
+                "",
+            )?,
+        };
+        let transmission_absorbing = match raw.transmission.far_end.as_deref() {
+            None | Some("absorbing") => true,
+            Some("free") => false,
+            Some(other) => {
+                return Err(v.table("transmission").error(
+                    "far_end",
+                    format!("unknown end `{other}`"),
+                    "absorbing, free",
+                ));
+            }
+        };
+        if raw.incident.far_end.is_some() || raw.striker.far_end.is_some() {
+            return Err(v.error(
+                "incident.far_end",
+                "only the transmission bar has a far end to choose",
+                "far_end in [transmission] only",
+            ));
+        }
+        let gv = v.table("gun");
+        let g = &raw.gun;
+        let (pmin, pmax) = (
+            gv.positive("min_pressure_pa", g.min_pressure_pa, 1e8, "Pa")?,
+            gv.positive("max_pressure_pa", g.max_pressure_pa, 1e8, "Pa")?,
+        );
+        if pmin >= pmax {
+            return Err(gv.error(
+                "min_pressure_pa",
+                "not below max_pressure_pa",
+                "min_pressure_pa < max_pressure_pa",
+            ));
+        }
+        let need = |key: &str, x: Option<f64>| {
+            x.ok_or_else(|| {
+                gv.error(
+                    key,
+                    format!("missing for model = \"{}\"", g.model),
+                    "a positive number",
+                )
+            })
+        };
+        let gun = match g.model.as_str() {
+            "linear" => Gun::Linear(LinearGun {
+                k_m2_per_s2_per_pa: gv.positive(
+                    "k_m2_per_s2_per_pa",
+                    need("k_m2_per_s2_per_pa", g.k_m2_per_s2_per_pa)?,
+                    1.0,
+                    "m²/s²/Pa",
+                )?,
+                loss_pressure_pa: gv.in_range(
+                    "loss_pressure_pa",
+                    need("loss_pressure_pa", g.loss_pressure_pa)?,
+                    0.0,
+                    pmin,
+                    "Pa (below min_pressure_pa)",
+                )?,
+                min_pressure_pa: pmin,
+                max_pressure_pa: pmax,
+            }),
+            "adiabatic" => Gun::Adiabatic(GasGun {
+                reservoir_volume_m3: gv.positive(
+                    "reservoir_volume_m3",
+                    need("reservoir_volume_m3", g.reservoir_volume_m3)?,
+                    10.0,
+                    "m³",
+                )?,
+                barrel_length_m: gv.positive(
+                    "barrel_length_m",
+                    need("barrel_length_m", g.barrel_length_m)?,
+                    100.0,
+                    "m",
+                )?,
+                friction_n: gv.in_range(
+                    "friction_n",
+                    g.friction_n.unwrap_or(0.0),
+                    0.0,
+                    1e6,
+                    "N",
+                )?,
+                gamma: gv.in_range("gamma", g.gamma.unwrap_or(1.4), 1.01, 1.67, "")?,
+                atmospheric_pa: shpb_core::striker::ATMOSPHERE_PA,
+                min_pressure_pa: pmin,
+                max_pressure_pa: pmax,
+            }),
+            other => {
+                return Err(gv.error(
+                    "model",
+                    format!("unknown gun model `{other}`"),
+                    "linear, adiabatic",
+                ));
+            }
+        };
+        let shaper = match &raw.shaper {
+            Some(s) => Some(shaper_from(s, &v.table("shaper"))?),
+            None => None,
+        };
+        let base = path.parent().unwrap_or(Path::new("."));
+        let gauges = GaugeSetup::from_file(base.join(&raw.gauges))?;
+        Ok(Apparatus {
+            source: file,
+            material,
+            incident: bar_geometry(&raw.incident, &v.table("incident"))?,
+            transmission: bar_geometry(&raw.transmission, &v.table("transmission"))?,
+            transmission_absorbing,
+            striker: bar_geometry(&raw.striker, &v.table("striker"))?,
+            gun,
+            shaper,
+            gauges,
+        })
+    }
+}
+
+/// A scene's shaper override table (same keys as the set-up file's `[shaper]`, all optional).
+#[derive(Debug, Clone, Copy, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ShaperOverride {
+    /// Use a shaper at all (default: if the set-up has one).
+    pub enabled: Option<bool>,
+    /// Diameter, m.
+    pub diameter_m: Option<f64>,
+    /// Thickness, m.
+    pub thickness_m: Option<f64>,
+    /// σ0, Pa.
+    pub sigma0_pa: Option<f64>,
+    /// n.
+    pub n: Option<f64>,
+    /// m.
+    pub m: Option<f64>,
+    /// Young's modulus, Pa.
+    pub youngs_modulus_pa: Option<f64>,
+}
+
+impl ShaperOverride {
+    /// Applies the override to the set-up's shaper; errors name the scene keys.
+    pub fn apply(&self, base: Option<PulseShaper>, v: &Validator) -> Result<Option<PulseShaper>> {
+        if self.enabled == Some(false) {
+            return Ok(None);
+        }
+        let b = match base {
+            Some(b) => b,
+            None if self.enabled == Some(true)
+                || self.diameter_m.is_some()
+                || self.thickness_m.is_some() =>
+            {
+                PulseShaper {
+                    diameter_m: f64::NAN,
+                    thickness_m: f64::NAN,
+                    sigma0_pa: 0.75e9,
+                    n: 0.37,
+                    m: 4.25,
+                    youngs_modulus_pa: 117e9,
+                }
+            }
+            None => return Ok(None),
+        };
+        let s = ShaperToml {
+            diameter_m: self.diameter_m.unwrap_or(b.diameter_m),
+            thickness_m: self.thickness_m.unwrap_or(b.thickness_m),
+            sigma0_pa: self.sigma0_pa.unwrap_or(b.sigma0_pa),
+            n: self.n.unwrap_or(b.n),
+            m: self.m.unwrap_or(b.m),
+            youngs_modulus_pa: self.youngs_modulus_pa.unwrap_or(b.youngs_modulus_pa),
+        };
+        shaper_from(&s, v).map(Some)
+    }
+}
+

@@ -1,0 +1,237 @@
+//! Input and output: CSV tables in, HDF5 and CSV results out, written atomically
+//! (temporary name, then rename; never overwriting without `--force`).
+
+use shpb_core::run::RunOutput;
+use shpb_core::solver::ContactSeries;
+use shpb_input::{Error, Result};
+use hdf5::types::VarLenUnicode;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// Refuses to overwrite `path` unless `force`.
+pub fn check_output(path: &Path, force: bool) -> Result<()> {
+    if path.exists() && !force {
+        return Err(Error::OutputExists(path.to_path_buf()));
+    }
+    Ok(())
+}
+
+/// Writes a file through `write` to a temporary name beside `path`, then renames it into place;
+/// on failure the temporary file is removed, so no half-written output is left.
+pub fn write_atomically(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    check_output(path, force)?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| "out".into());
+    // The temporary name keeps the extension (plotters picks the image format from it).
+    let tmp: PathBuf = dir.join(format!(".tmp-{}-{name}", std::process::id()));
+    let result =
+        write(&tmp).and_then(|_| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Converts an HDF5 error into the crate's error naming `file`.
+pub fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
+    move |e| Error::Hdf5 {
+        file: file.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// An HDF5 variable-length UTF-8 string.
+pub fn vlu(s: &str) -> VarLenUnicode {
+    VarLenUnicode::from_str(s)
+        .unwrap_or_else(|_| VarLenUnicode::from_str("").expect("empty string is valid"))
+}
+
+/// Writes a string attribute.
+pub fn string_attr(
+    loc: &hdf5::Location,
+    name: &str,
+    value: &str,
+    file: &Path,
+) -> Result<()> {
+    loc.new_attr::<VarLenUnicode>()
+        .shape(())
+        .create(name)
+        .and_then(|a| a.write_scalar(&vlu(value)))
+        .map_err(h5err(file))
+}
+
+/// Writes a 1-D f64 dataset with a `units` attribute.
+pub fn write_dataset(
+    group: &hdf5::Group,
+    name: &str,
+    data: &[f64],
+    units: &str,
+    file: &Path,
+) -> Result<()> {
+    let ds = group
+        .new_dataset_builder()
+        .with_data(data)
+        .create(name)
+        .map_err(h5err(file))?;
+    string_attr(&ds, "units", units, file)
+}
+
+/// The `/contact` datasets of a series: (name, data, units), absent ones skipped.
+pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static str)> {
+    let mut cols = Vec::new();
+    if let Some(t) = &s.time_s {
+        cols.push(("time", t.as_slice(), "s"));
+    }
+    cols.push(("displacement", s.displacement_m.as_slice(), "m"));
+    cols.push(("force", s.force_n.as_slice(), "N"));
+    if let Some(v) = &s.yield_stress_pa {
+        cols.push(("yield_stress", v.as_slice(), "Pa"));
+    }
+    if let Some(v) = &s.strain_rate_per_s {
+        cols.push(("strain_rate", v.as_slice(), "1/s"));
+    }
+    cols
+}
+
+/// Writes a run to HDF5: `/contact/*` with units, `/summary` attributes, root `shpb_version` and `scene`.
+pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
+        string_attr(&f, "scene", scene_text, path)?;
+        if let Some(contact) = &out.contact {
+            let g = f.create_group("contact").map_err(h5err(path))?;
+            for (name, data, units) in contact_columns(contact) {
+                write_dataset(&g, name, data, units, path)?;
+            }
+        }
+        if let Some(t) = &out.time_s {
+            let root = f.group("/").map_err(h5err(path))?;
+            write_dataset(&root, "time", t, "s", path)?;
+        }
+        if !out.gauges.is_empty() {
+            let g = f.create_group("gauges").map_err(h5err(path))?;
+            for tr in &out.gauges {
+                let c = g.create_group(&tr.name).map_err(h5err(path))?;
+                write_dataset(&c, "strain", &tr.strain, "1", path)?;
+                write_dataset(&c, "voltage", &tr.voltage_v, "V", path)?;
+            }
+        }
+        if !out.bars.is_empty() {
+            let g = f.create_group("bars").map_err(h5err(path))?;
+            for b in &out.bars {
+                let c = g.create_group(&b.name).map_err(h5err(path))?;
+                write_dataset(&c, "x", &b.x_m, "m", path)?;
+                write_dataset(&c, "time", &b.time_s, "s", path)?;
+                let flat: Vec<f64> = b.stress_pa.iter().flatten().copied().collect();
+                let field = ndarray::Array2::from_shape_vec((b.time_s.len(), b.x_m.len()), flat)
+                    .map_err(|e| Error::Hdf5 {
+                        file: path.display().to_string(),
+                        message: e.to_string(),
+                    })?;
+                let ds = c
+                    .new_dataset_builder()
+                    .with_data(&field)
+                    .create("snapshots")
+                    .map_err(h5err(path))?;
+                string_attr(&ds, "units", "Pa", path)?;
+                string_attr(
+                    &ds,
+                    "description",
+                    "axial stress (tension positive), rows: time, columns: x",
+                    path,
+                )?;
+            }
+        }
+        if let Some(r) = &out.reduction {
+            let g = f.create_group("reduction").map_err(h5err(path))?;
+            for (name, data, units, _) in crate::reduction::reduction_columns(r) {
+                write_dataset(&g, name, data, units, path)?;
+            }
+        }
+        if !out.energy.is_empty() {
+            let g = f.create_group("energy").map_err(h5err(path))?;
+            for (name, data) in &out.energy {
+                write_dataset(&g, name, data, "J", path)?;
+            }
+        }
+        let s = f.create_group("summary").map_err(h5err(path))?;
+        for it in &out.summary {
+            let a = s
+                .new_attr::<f64>()
+                .shape(())
+                .create(it.key.as_str())
+                .map_err(h5err(path))?;
+            a.write_scalar(&it.value).map_err(h5err(path))?;
+        }
+        string_attr(
+            &s,
+            "units",
+            &out.summary
+                .iter()
+                .map(|i| format!("{}={}", i.key, i.unit))
+                .collect::<Vec<_>>()
+                .join(", "),
+            path,
+        )?;
+        string_attr(&s, "warnings", &out.warnings.join("\n"), path)?;
+        f.close().map_err(h5err(path))
+    })
+}
+
+/// Writes `text` to `path` atomically (refusing to overwrite without `force`).
+pub fn write_text_atomically(path: &Path, force: bool, text: &str) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        std::fs::write(tmp, text).map_err(|e| Error::io(path, e))
+    })
+}
+
+/// Writes a run as CSV with one header line (units in the column names): the contact series,
+/// or for bar scenes the time axis with each gauge's strain and voltage.
+pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
+    let mut cols: Vec<(String, &[f64])> = Vec::new();
+    if let Some(c) = &out.contact {
+        for (n, d, u) in contact_columns(c) {
+            cols.push((csv_name(n, u), d));
+        }
+    } else if let Some(t) = &out.time_s {
+        cols.push(("time_s".into(), t));
+        for g in &out.gauges {
+            cols.push((format!("{}_strain", g.name), &g.strain));
+            cols.push((format!("{}_voltage_V", g.name), &g.voltage_v));
+        }
+    }
+    let rows = cols.iter().map(|(_, d)| d.len()).min().unwrap_or(0);
+    let mut text = cols
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect::<Vec<_>>()
+        .join(",");
+    text.push('\n');
+    for i in 0..rows {
+        let row: Vec<String> = cols.iter().map(|(_, d)| format!("{:e}", d[i])).collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    write_text_atomically(path, force, &text)
+}
+
+/// CSV column name with unit, e.g. `force_N`, `strain_rate_per_s`.
+pub fn csv_name(name: &str, unit: &str) -> String {
+    let u = match unit {
+        "1/s" => "per_s",
+        u => u,
+    };
+    format!("{name}_{u}")
+}
+

@@ -1,0 +1,643 @@
+//! PNG plots with plotters: force–displacement curves (as in the paper's Figs. 2–4).
+
+use shpb_input::{Error, Result};
+use crate::io::write_atomically;
+use shpb_core::run::RunOutput;
+use shpb_core::scene::{Params, SceneParams};
+use plotters::prelude::*;
+use std::path::Path;
+
+/// One curve of a plot: label, x values, y values, and whether to draw it dashed (measured data).
+pub struct Curve<'a> {
+    /// Legend label.
+    pub label: String,
+    /// Abscissae.
+    pub x: &'a [f64],
+    /// Ordinates.
+    pub y: &'a [f64],
+    /// Draw as measured data (dashed, dark red) rather than a model line.
+    pub measured: bool,
+}
+
+const PALETTE: [RGBColor; 5] = [
+    RGBColor(230, 140, 20),
+    RGBColor(0, 0, 0),
+    RGBColor(30, 90, 200),
+    RGBColor(40, 150, 60),
+    RGBColor(150, 60, 170),
+];
+
+/// Title, axis labels and display scale factors of a plot.
+pub struct Axes<'a> {
+    /// Caption.
+    pub title: &'a str,
+    /// x-axis label with unit.
+    pub x_label: &'a str,
+    /// y-axis label with unit.
+    pub y_label: &'a str,
+    /// Factor applied to x values for display (e.g. 1e3 for m → mm).
+    pub x_scale: f64,
+    /// Factor applied to y values for display.
+    pub y_scale: f64,
+}
+
+/// A drawing area of the bitmap backend.
+type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
+
+/// Converts a plotters error into the crate's error for `path`.
+fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Io {
+        file: path.display().to_string(),
+        source: std::io::Error::other(e.to_string()),
+    }
+}
+
+/// Data range of the scaled curves, padded so a flat curve still has an axis.
+fn range(curves: &[Curve], axes: &Axes) -> (f64, f64, f64, f64) {
+    let (mut xmin, mut xmax, mut ymin, mut ymax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for c in curves {
+        for (&x, &y) in c.x.iter().zip(c.y) {
+            xmax = xmax.max(x * axes.x_scale);
+            ymax = ymax.max(y * axes.y_scale);
+            xmin = xmin.min(x * axes.x_scale);
+            ymin = ymin.min(y * axes.y_scale);
+        }
+    }
+    if xmax <= xmin {
+        xmax = xmin + 1.0;
+    }
+    if ymax <= ymin {
+        ymax = ymin + 1.0;
+    }
+    (xmin, xmax * 1.03, ymin - 0.02 * (ymax - ymin), ymax * 1.08)
+}
+
+/// Draws line curves with axes and a legend into one panel.
+fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    let (xmin, xmax, ymin, ymax) = range(curves, axes);
+    let mut chart = ChartBuilder::on(area)
+        .caption(axes.title, ("sans-serif", 24))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xmin..xmax, ymin..ymax)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(axes.x_label)
+        .y_desc(axes.y_label)
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(perr(path))?;
+    for (i, c) in curves.iter().enumerate() {
+        let pts: Vec<(f64, f64)> =
+            c.x.iter()
+                .zip(c.y)
+                .map(|(&x, &y)| (x * axes.x_scale, y * axes.y_scale))
+                .collect();
+        let color = if c.measured {
+            RGBColor(140, 20, 20)
+        } else {
+            PALETTE[i % PALETTE.len()]
+        };
+        let series = if c.measured {
+            chart.draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(3)))
+        } else {
+            chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+        }
+        .map_err(perr(path))?;
+        series.label(c.label.clone()).legend(move |(x, y)| {
+            PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+        });
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 17))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(perr(path))?;
+    Ok(())
+}
+
+/// Draws curves into a PNG (written atomically), scaled as `axes` says.
+pub fn xy_plot(path: &Path, force: bool, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1000, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        draw_xy(&root, path, axes, curves)?;
+        root.present().map_err(perr(path))
+    })
+}
+
+/// A stress field over position and time (a Lagrange x–t diagram): rows of `stress_pa` at
+/// `time_s`, columns at `x_m` (positions along the apparatus).
+pub struct Field<'a> {
+    /// Positions, m.
+    pub x_m: &'a [f64],
+    /// Times, s.
+    pub time_s: &'a [f64],
+    /// Stress rows, Pa (tension positive).
+    pub stress_pa: &'a [Vec<f64>],
+}
+
+/// Diverging colour: compression blue, tension red, zero white.
+fn stress_colour(s: f64, scale: f64) -> RGBColor {
+    let a = (s / scale).clamp(-1.0, 1.0);
+    let fade = |v: f64| (255.0 * (1.0 - v.abs())) as u8;
+    if a < 0.0 {
+        RGBColor(fade(a), fade(a), 255)
+    } else {
+        RGBColor(255, fade(a), fade(a))
+    }
+}
+
+/// Draws x–t fields (several bars side by side) as coloured cells.
+fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result<()> {
+    let (mut xmin, mut xmax, mut tmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+    let mut magnitudes: Vec<f64> = Vec::new();
+    for f in fields {
+        for &x in f.x_m {
+            xmin = xmin.min(x);
+            xmax = xmax.max(x);
+        }
+        tmax = f.time_s.iter().cloned().fold(tmax, f64::max);
+        magnitudes.extend(f.stress_pa.iter().flatten().map(|v| v.abs()));
+    }
+    // Full colour at the 99.5th percentile, so one hot spot does not wash out the waves.
+    magnitudes.sort_by(|a, b| a.total_cmp(b));
+    let smax = magnitudes
+        .get(magnitudes.len() * 995 / 1000)
+        .copied()
+        .unwrap_or(1.0);
+    if !xmin.is_finite() || xmax <= xmin || tmax <= 0.0 {
+        return Ok(());
+    }
+    let smax = smax.max(1.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "{title} (blue: compression, red: tension, full colour at {:.0} MPa)",
+                smax / 1e6
+            ),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(75)
+        .build_cartesian_2d(xmin * 1e3..xmax * 1e3, 0.0..tmax * 1e6)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("position along the bars (mm, 0 = specimen)")
+        .y_desc("time (µs)")
+        .label_style(("sans-serif", 16))
+        .draw()
+        .map_err(perr(path))?;
+    for f in fields {
+        for (k, row) in f.stress_pa.iter().enumerate() {
+            let t0 = if k == 0 { 0.0 } else { f.time_s[k - 1] };
+            let t1 = f.time_s[k];
+            for j in 0..f.x_m.len().saturating_sub(1) {
+                let s = 0.5 * (row[j] + row[j + 1]);
+                let rect = Rectangle::new(
+                    [(f.x_m[j] * 1e3, t0 * 1e6), (f.x_m[j + 1] * 1e3, t1 * 1e6)],
+                    stress_colour(s, smax).filled(),
+                );
+                chart.plotting_area().draw(&rect).map_err(perr(path))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The figure of a full virtual test: gauge signals, force–displacement (true and
+/// reconstructed), and the x–t diagram of the bars' stress.
+pub fn test_figure(
+    path: &Path,
+    force: bool,
+    gauges: (&Axes, &[Curve]),
+    force_displacement: (&Axes, &[Curve]),
+    fields: &[Field],
+) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1600, 1300)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let (top, bottom) = root.split_vertically(620);
+        let (left, right) = top.split_horizontally(800);
+        draw_xy(&left, path, gauges.0, gauges.1)?;
+        draw_xy(&right, path, force_displacement.0, force_displacement.1)?;
+        draw_field(
+            &bottom,
+            path,
+            "x–t (Lagrange) diagram of the bar stress",
+            fields,
+        )?;
+        root.present().map_err(perr(path))
+    })
+}
+
+/// Sequential colour (white → dark blue) of `v` within [lo, hi].
+fn level_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
+    let a = if hi > lo {
+        ((v - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    RGBColor(
+        (255.0 - 225.0 * a) as u8,
+        (255.0 - 165.0 * a) as u8,
+        (255.0 - 55.0 * a) as u8,
+    )
+}
+
+/// One quantity of a two-parameter study as a heat map: cell (i, j) at (x_i, y_j), value
+/// `z[i][j]` (NaN cells left blank); the caption gives the colour range.
+fn draw_heat_map(
+    area: &Area,
+    path: &Path,
+    labels: (&str, &str, &str),
+    x: &[f64],
+    y: &[f64],
+    z: &[Vec<f64>],
+) -> Result<()> {
+    let edges = |v: &[f64]| -> Vec<f64> {
+        let n = v.len();
+        let step = |i: usize| {
+            if n > 1 {
+                (v[i.min(n - 1)] - v[i.saturating_sub(1).min(n - 2)]).abs()
+            } else {
+                1.0
+            }
+        };
+        let mut e = vec![v[0] - 0.5 * step(1)];
+        for i in 1..n {
+            e.push(0.5 * (v[i - 1] + v[i]));
+        }
+        e.push(v[n - 1] + 0.5 * step(n - 1));
+        e
+    };
+    let (xe, ye) = (edges(x), edges(y));
+    let finite: Vec<f64> = z
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .collect();
+    let lo = finite.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (x0, x1) = (xe[0].min(xe[xe.len() - 1]), xe[0].max(xe[xe.len() - 1]));
+    let (y0, y1) = (ye[0].min(ye[ye.len() - 1]), ye[0].max(ye[ye.len() - 1]));
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!("{} (white {:.4e} → blue {:.4e})", labels.2, lo, hi),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(50)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style(("sans-serif", 16))
+        .draw()
+        .map_err(perr(path))?;
+    for i in 0..x.len() {
+        for j in 0..y.len() {
+            let v = z[i][j];
+            if !v.is_finite() {
+                continue;
+            }
+            let rect = Rectangle::new(
+                [(xe[i], ye[j]), (xe[i + 1], ye[j + 1])],
+                level_colour(v, lo, hi).filled(),
+            );
+            chart.plotting_area().draw(&rect).map_err(perr(path))?;
+            chart
+                .plotting_area()
+                .draw(&Text::new(
+                    format!("{v:.3e}"),
+                    (0.5 * (xe[i] + xe[i + 1]), 0.5 * (ye[j] + ye[j + 1])),
+                    ("sans-serif", 12),
+                ))
+                .map_err(perr(path))?;
+        }
+    }
+    Ok(())
+}
+
+/// The summary plot of a study with one or two swept parameters: peak force and peak strain
+/// rate against the parameter (lines) or over the two parameters (heat maps). `x` and `y` hold
+/// the numeric values of the swept parameters with their axis labels; `force[i][j]` and
+/// `rate[i][j]` the results (j = 0 only for one parameter).
+pub fn sweep_figure(
+    path: &Path,
+    force: bool,
+    x: (&str, &[f64]),
+    y: Option<(&str, &[f64])>,
+    force_n: &[Vec<f64>],
+    rate_per_s: &[Vec<f64>],
+) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1600, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let (left, right) = root.split_horizontally(800);
+        match y {
+            None => {
+                let f: Vec<f64> = force_n.iter().map(|r| r[0]).collect();
+                let r: Vec<f64> = rate_per_s.iter().map(|r| r[0]).collect();
+                for (area, title, ylab, data, scale) in [
+                    (&left, "peak contact force", "force (kN)", &f, 1e-3),
+                    (
+                        &right,
+                        "peak strain rate (reduced)",
+                        "strain rate (1/s)",
+                        &r,
+                        1.0,
+                    ),
+                ] {
+                    let axes = Axes {
+                        title,
+                        x_label: x.0,
+                        y_label: ylab,
+                        x_scale: 1.0,
+                        y_scale: scale,
+                    };
+                    let curves = [Curve {
+                        label: title.to_string(),
+                        x: x.1,
+                        y: data,
+                        measured: false,
+                    }];
+                    draw_xy(area, path, &axes, &curves)?;
+                }
+            }
+            Some((ylab, yv)) => {
+                let kn: Vec<Vec<f64>> = force_n
+                    .iter()
+                    .map(|r| r.iter().map(|v| v * 1e-3).collect())
+                    .collect();
+                draw_heat_map(
+                    &left,
+                    path,
+                    (x.0, ylab, "peak contact force (kN)"),
+                    x.1,
+                    yv,
+                    &kn,
+                )?;
+                draw_heat_map(
+                    &right,
+                    path,
+                    (x.0, ylab, "peak strain rate (1/s)"),
+                    x.1,
+                    yv,
+                    rate_per_s,
+                )?;
+            }
+        }
+        root.present().map_err(perr(path))
+    })
+}
+
+/// Draws a run: force against displacement for sphere scenes (with the measured curve for
+/// force-driven ones), gauge signals as bar stress against time for bar scenes.
+pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()> {
+    let name = Path::new(&params.source)
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let title = format!("{} — {}", params.kind, name);
+    if let (Some(contact), SceneParams::Pulse { apparatus, .. }) = (&out.contact, &params.params) {
+        return plot_test(path, force, &title, apparatus, out, contact);
+    }
+    if let Some(contact) = &out.contact {
+        let mut curves = vec![Curve {
+            label: format!("shpb ({})", params.contact_law().name()),
+            x: &contact.displacement_m,
+            y: &contact.force_n,
+            measured: false,
+        }];
+        let shifted: Vec<f64>;
+        if let SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m: Some(d),
+        } = &params.params
+        {
+            shifted = d.iter().map(|x| x - d[0]).collect();
+            curves.push(Curve {
+                label: "measured (authors' SHPB, offset δ(0) removed)".into(),
+                x: &shifted,
+                y: &setup.drive.force_n,
+                measured: true,
+            });
+        }
+        let axes = Axes {
+            title: &title,
+            x_label: "sphere approach δ (mm)",
+            y_label: "force F (kN)",
+            x_scale: 1e3,
+            y_scale: 1e-3,
+        };
+        return xy_plot(path, force, &axes, &curves);
+    }
+    let e = match &params.params {
+        SceneParams::Pulse { apparatus, .. } => apparatus.material.youngs_modulus_pa,
+        _ => 1.0,
+    };
+    let stresses = gauge_stresses(out, e);
+    let curves = gauge_curves(out, &stresses);
+    let axes = Axes {
+        title: &title,
+        x_label: "time after impact (µs)",
+        y_label: "bar stress at the gauge, compression positive (MPa)",
+        x_scale: 1e6,
+        y_scale: 1e-6,
+    };
+    xy_plot(path, force, &axes, &curves)
+}
+
+/// Bar stress at each gauge, compression positive (−E ε), Pa.
+fn gauge_stresses(out: &RunOutput, e_pa: f64) -> Vec<Vec<f64>> {
+    out.gauges
+        .iter()
+        .map(|g| g.strain.iter().map(|s| -e_pa * s).collect())
+        .collect()
+}
+
+/// One curve per gauge against the run's time axis.
+fn gauge_curves<'a>(out: &'a RunOutput, stresses: &'a [Vec<f64>]) -> Vec<Curve<'a>> {
+    let t = out.time_s.as_deref().unwrap_or(&[]);
+    out.gauges
+        .iter()
+        .zip(stresses)
+        .map(|(g, s)| Curve {
+            label: format!("{} gauge", g.name),
+            x: t,
+            y: s,
+            measured: false,
+        })
+        .collect()
+}
+
+/// The three-panel figure of a full virtual test (gauges, F–δ, x–t diagram).
+fn plot_test(
+    path: &Path,
+    force: bool,
+    title: &str,
+    apparatus: &shpb_core::apparatus::Apparatus,
+    out: &RunOutput,
+    contact: &shpb_core::solver::ContactSeries,
+) -> Result<()> {
+    let e = apparatus.material.youngs_modulus_pa;
+    let stresses = gauge_stresses(out, e);
+    let gauge_curves = gauge_curves(out, &stresses);
+    let gauge_title = format!("{title}: gauge signals");
+    let gauge_axes = Axes {
+        title: &gauge_title,
+        x_label: "time after impact (µs)",
+        y_label: "bar stress, compression positive (MPa)",
+        x_scale: 1e6,
+        y_scale: 1e-6,
+    };
+    let mut fd_curves = vec![Curve {
+        label: "true contact (simulation)".into(),
+        x: &contact.displacement_m,
+        y: &contact.force_n,
+        measured: false,
+    }];
+    if let Some(r) = &out.reduction {
+        fd_curves.push(Curve {
+            label: "reduced from the gauges (back force)".into(),
+            x: &r.displacement_m,
+            y: &r.force_back_n,
+            measured: true,
+        });
+    }
+    let fd_axes = Axes {
+        title: "force against sphere approach",
+        x_label: "sphere approach δ (mm)",
+        y_label: "force F (kN)",
+        x_scale: 1e3,
+        y_scale: 1e-3,
+    };
+    // Positions along the apparatus with the specimen at 0: striker and incident bar to the left.
+    let (li, ls) = (apparatus.incident.length_m, apparatus.striker.length_m);
+    let shifted: Vec<Vec<f64>> = out
+        .bars
+        .iter()
+        .map(|b| {
+            let offset = match b.name.as_str() {
+                "striker" => -li - ls,
+                "incident" => -li,
+                _ => 0.0,
+            };
+            b.x_m.iter().map(|x| x + offset).collect()
+        })
+        .collect();
+    let fields: Vec<crate::plot::Field> = out
+        .bars
+        .iter()
+        .zip(&shifted)
+        .map(|(b, x)| crate::plot::Field {
+            x_m: x,
+            time_s: &b.time_s,
+            stress_pa: &b.stress_pa,
+        })
+        .collect();
+    crate::plot::test_figure(
+        path,
+        force,
+        (&gauge_axes, &gauge_curves),
+        (&fd_axes, &fd_curves),
+        &fields,
+    )
+}
+
+
+/// One line of a [`loglog_plot`]: points (x, y > 0) and an RGB colour.
+#[derive(Debug, Clone)]
+pub struct LogLine<'a> {
+    /// Legend label.
+    pub label: &'a str,
+    /// The points.
+    pub points: Vec<(f64, f64)>,
+    /// Colour.
+    pub rgb: (u8, u8, u8),
+}
+
+/// Draws lines with markers on log–log axes (e.g. error against run time).
+pub fn loglog_plot(
+    path: &Path,
+    force: bool,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    lines: &[LogLine],
+) -> Result<()> {
+    use plotters::prelude::*;
+    let perr = |e: &dyn std::fmt::Display| Error::Io {
+        file: path.display().to_string(),
+        source: std::io::Error::other(e.to_string()),
+    };
+    let all: Vec<(f64, f64)> = lines.iter().flat_map(|l| l.points.clone()).collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in &all {
+        (x0, x1, y0, y1) = (x0.min(*x), x1.max(*x), y0.min(*y), y1.max(*y));
+    }
+    if all.is_empty() {
+        (x0, x1, y0, y1) = (1e-3, 1.0, 1e-9, 1.0);
+    }
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1000, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| perr(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(55)
+            .y_label_area_size(85)
+            .build_cartesian_2d(
+                ((x0 / 1.5)..(x1 * 1.5)).log_scale(),
+                ((y0 / 3.0)..(y1 * 3.0)).log_scale(),
+            )
+            .map_err(|e| perr(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 17))
+            .draw()
+            .map_err(|e| perr(&e))?;
+        for line in lines {
+            let color = RGBColor(line.rgb.0, line.rgb.1, line.rgb.2);
+            chart
+                .draw_series(LineSeries::new(line.points.clone(), color.stroke_width(2)))
+                .map_err(|e| perr(&e))?
+                .label(line.label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                });
+            chart
+                .draw_series(
+                    line.points
+                        .iter()
+                        .map(|q| Circle::new(*q, 4, color.filled())),
+                )
+                .map_err(|e| perr(&e))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 17))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| perr(&e))?;
+        root.present().map_err(|e| perr(&e))
+    })
+}

@@ -1,0 +1,160 @@
+//! The lab's reduction written out (`/reduction/*` in HDF5, or CSV), and the gauge strains of a
+//! run file read back for `shpb reduce`.
+
+use crate::io::{h5err, string_attr};
+use shpb_core::reduce::{Reduction, ReductionInput};
+use shpb_input::{Error, Result};
+use std::path::Path;
+
+/// Reads `/time` and `/gauges/{incident,transmission}/strain` of an HDF5 file written by
+/// `shpb run`.
+pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
+    let f = hdf5::File::open(path).map_err(h5err(path))?;
+    let read = |name: &str| -> Result<Vec<f64>> {
+        let ds = f.dataset(name).map_err(|e| {
+            Error::Input {
+                file: path.display().to_string(),
+                key: name.to_string(),
+                problem: format!("cannot read it ({e})"),
+                allowed: "an HDF5 file written by `shpb run` of a bar scene (/time, /gauges/incident/strain, /gauges/transmission/strain)".into(),
+            }
+        })?;
+        ds.read_raw::<f64>().map_err(h5err(path))
+    };
+    Ok(ReductionInput {
+        time_s: read("time")?,
+        incident_strain: read("gauges/incident/strain")?,
+        transmission_strain: read("gauges/transmission/strain")?,
+    })
+}
+
+/// Whether `path` starts with the HDF5 signature.
+pub fn is_hdf5(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut f = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut sig = [0u8; 8];
+    let n = f.read(&mut sig).map_err(|e| Error::io(path, e))?;
+    Ok(n == 8 && sig == *b"\x89HDF\r\n\x1a\n")
+}
+
+/// The `/reduction` datasets: (name, data, units, CSV column).
+pub fn reduction_columns(r: &Reduction) -> Vec<(&'static str, &[f64], &'static str, &'static str)> {
+    let mut cols = vec![
+        ("time", r.time_s.as_slice(), "s", "time_s"),
+        (
+            "displacement",
+            r.displacement_m.as_slice(),
+            "m",
+            "displacement_m",
+        ),
+        (
+            "force_front",
+            r.force_front_n.as_slice(),
+            "N",
+            "force_front_N",
+        ),
+        ("force_back", r.force_back_n.as_slice(), "N", "force_back_N"),
+        (
+            "force_3wave",
+            r.force_3wave_n.as_slice(),
+            "N",
+            "force_3wave_N",
+        ),
+        (
+            "approach_velocity",
+            r.approach_velocity_m_s.as_slice(),
+            "m/s",
+            "approach_velocity_m_s",
+        ),
+    ];
+    if let Some(s) = &r.strain_rate_per_s {
+        cols.push(("strain_rate", s.as_slice(), "1/s", "strain_rate_per_s"));
+    }
+    cols.push((
+        "equilibrium_ratio",
+        r.equilibrium_ratio.as_slice(),
+        "1",
+        "equilibrium_ratio",
+    ));
+    cols
+}
+
+/// Scalar results: (key, value, unit).
+fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
+    let mut v = vec![
+        ("peak_back_force", r.peak_back_force_n, "N"),
+        ("peak_back_force_time", r.peak_back_force_time_s, "s"),
+        (
+            "displacement_at_peak_force",
+            r.displacement_at_peak_force_m,
+            "m",
+        ),
+        (
+            "equilibrium_ratio_at_peak",
+            r.equilibrium_ratio_at_peak,
+            "1",
+        ),
+        ("peak_front_force", r.peak_front_force_n, "N"),
+        ("max_displacement", r.max_displacement_m, "m"),
+        ("face_time_offset", r.face_time_offset_s, "s"),
+        ("incident_start", r.windows.incident_start_s, "s"),
+        ("reflected_delay", r.windows.reflected_delay_s, "s"),
+        ("transmitted_delay", r.windows.transmitted_delay_s, "s"),
+        ("window_duration", r.windows.duration_s, "s"),
+        (
+            "dispersion_corrected",
+            if r.dispersion_corrected { 1.0 } else { 0.0 },
+            "1",
+        ),
+    ];
+    if let Some(m) = r.measured_reflected_delay_s {
+        v.push(("measured_reflected_delay", m, "s"));
+    }
+    v
+}
+
+/// Writes a reduction to HDF5 atomically: root attributes `shpb_version` and `scene` (the
+/// command line), `/reduction/<series>` with `units` attributes, `/summary` scalar attributes
+/// with a `units` list.
+pub fn write_reduction_hdf5(path: &Path, force: bool, scene: &str, r: &Reduction) -> Result<()> {
+    crate::io::write_atomically(path, force, |tmp| {
+        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
+        string_attr(&f, "scene", scene, path)?;
+        let g = f.create_group("reduction").map_err(h5err(path))?;
+        for (name, data, units, _) in reduction_columns(r) {
+            crate::io::write_dataset(&g, name, data, units, path)?;
+        }
+        let s = f.create_group("summary").map_err(h5err(path))?;
+        let items = summary_items(r);
+        for (key, value, _) in &items {
+            s.new_attr::<f64>()
+                .shape(())
+                .create(*key)
+                .and_then(|a| a.write_scalar(value))
+                .map_err(h5err(path))?;
+        }
+        let units = items
+            .iter()
+            .map(|(k, _, u)| format!("{k}={u}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        string_attr(&s, "units", &units, path)?;
+        string_attr(&s, "warnings", &r.warnings.join("\n"), path)?;
+        f.close().map_err(h5err(path))
+    })
+}
+
+/// Writes the reduction series as CSV (one header line, units in the column names).
+pub fn write_reduction_csv(path: &Path, force: bool, r: &Reduction) -> Result<()> {
+    let cols = reduction_columns(r);
+    let mut text = cols.iter().map(|c| c.3).collect::<Vec<_>>().join(",");
+    text.push('\n');
+    for i in 0..r.time_s.len() {
+        let row: Vec<String> = cols.iter().map(|c| format!("{:e}", c.1[i])).collect();
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    crate::io::write_text_atomically(path, force, &text)
+}
+

@@ -1,0 +1,12 @@
+//! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`), the
+//! convergence of a scene under refinement (`shpb convergence`) and the speed/accuracy bench of
+//! the fidelity presets (`shpb bench`).
+
+#![warn(missing_docs)]
+
+pub mod bench;
+pub mod convergence;
+pub mod file;
+pub mod sweep;
+
+pub use shpb_input::{Error, Result};
