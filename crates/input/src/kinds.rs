@@ -28,3 +28,9 @@ pub const SCENE_KINDS: &[(&str, &str)] = &[
     ),
 ];
 
+
+/// (name, one-line help) of every scene kind, in registry order: what `shpb --help`, `shpb list`,
+/// the "unknown kind" error and the README table show.
+pub fn names_and_help() -> Vec<(&'static str, &'static str)> {
+    SCENE_KINDS.to_vec()
+}

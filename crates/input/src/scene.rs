@@ -436,10 +436,17 @@ impl SceneFile for Params {
                     (None, false) => None,
                 };
                 let set_up = base_dir.join(&f.bars);
-                if !set_up.is_file() {
-                    return Err(v.error("bars", format!("cannot read {}: no such file", set_up.display()), "a bar set-up .toml file (e.g. bars/authors.toml), relative to the scene file"));
+                if crate::builtin::setup(&f.bars).is_none() && !set_up.is_file() {
+                    return Err(v.error(
+                        "bars",
+                        format!("cannot read {}: no such file", set_up.display()),
+                        format!(
+                            "a built-in set-up ({}) or a bar set-up .toml file, relative to the scene file",
+                            crate::builtin::setup_names()
+                        ),
+                    ));
                 }
-                let apparatus = Apparatus::from_file(&set_up)?;
+                let apparatus = Apparatus::resolve(&f.bars, base_dir)?;
                 let pressure_pa = crate::units::pressure_from_text(&f.pressure, &v, "pressure")?;
                 let velocity = apparatus
                     .striker_velocity_m_s(pressure_pa)

@@ -89,6 +89,14 @@ fn shaper_from(s: &ShaperToml, v: &Validator) -> Result<PulseShaper> {
 pub trait ApparatusFile: Sized {
     /// Reads and validates a set-up file; its `gauges` file is resolved relative to it.
     fn from_file(path: &Path) -> Result<Self>;
+    /// Validates set-up TOML text named `file`; `gauges` reads the gauge file it names.
+    fn from_toml(
+        text: &str,
+        file: &str,
+        gauges: &dyn Fn(&str) -> Result<GaugeSetup>,
+    ) -> Result<Self>;
+    /// A built-in set-up by name (`authors`, `authors-20cm-striker`), or a set-up file path.
+    fn resolve(reference: &str, base_dir: &Path) -> Result<Self>;
 }
 
 impl ApparatusFile for Apparatus {
@@ -96,6 +104,41 @@ impl ApparatusFile for Apparatus {
     fn from_file(path: &Path) -> Result<Apparatus> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file = path.display().to_string();
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Apparatus::from_toml(&text, &file, &|g: &str| {
+            GaugeSetup::from_file(base.join(g))
+        })
+    }
+
+    fn resolve(reference: &str, base_dir: &Path) -> Result<Apparatus> {
+        match crate::builtin::setup(reference) {
+            Some(text) => Apparatus::from_toml(
+                text,
+                &format!("built-in set-up `{reference}`"),
+                &|g: &str| match crate::builtin::gauges(g) {
+                    Some(t) => GaugeSetup::from_toml(t, &format!("built-in gauges `{g}`")),
+                    None => Err(Error::Input {
+                        file: format!("built-in set-up `{reference}`"),
+                        key: "gauges".into(),
+                        problem: format!("no built-in gauge file `{g}`"),
+                        allowed: crate::builtin::GAUGES
+                            .iter()
+                            .map(|(n, _)| *n)
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                    }),
+                },
+            ),
+            None => Apparatus::from_file(&base_dir.join(reference)),
+        }
+    }
+
+    fn from_toml(
+        text: &str,
+        file: &str,
+        gauges: &dyn Fn(&str) -> Result<GaugeSetup>,
+    ) -> Result<Apparatus> {
+        let file = file.to_string();
         let raw: ApparatusToml = toml::from_str(&text).map_err(|e| Error::Parse {
             file: file.clone(),
             message: e.to_string(),
@@ -218,8 +261,7 @@ impl ApparatusFile for Apparatus {
             Some(s) => Some(shaper_from(s, &v.table("shaper"))?),
             None => None,
         };
-        let base = path.parent().unwrap_or(Path::new("."));
-        let gauges = GaugeSetup::from_file(base.join(&raw.gauges))?;
+        let gauges = gauges(&raw.gauges)?;
         Ok(Apparatus {
             source: file,
             material,
