@@ -7,6 +7,7 @@
 #   make test    rustfmt check, clippy (warnings are errors) and the test suite
 #
 # Run from the repository root (or `make -C <repo>`); .ci/run calls `make test`.
+# The workspace: crates/core, input, output, study, validate, cli (ARCHITECTURE.md).
 
 SHELL := /bin/bash
 .DEFAULT_GOAL := build
@@ -54,7 +55,7 @@ deps:
 	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y $(APT_PACKAGES)
 
 build: deps
-	$(CARGO) build --release
+	$(CARGO) build --release -p shpb
 
 # The paper's Fig. 4 SS440c test at 10 psi, end to end: gas gun, copper shaper, bars, two
 # 6.35 mm spheres, gauges and the data reduction of the simulated records.
@@ -68,9 +69,9 @@ demo: build
 	@echo "  plot: $(abspath $(DEMO_PNG))"
 
 test: deps
-	$(CARGO) fmt --check
-	$(CARGO) clippy --release --all-targets -- -D warnings
-	$(CARGO) test --release
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
+	$(CARGO) test --release --workspace
 
 # Speed/accuracy measurements of validation/perf/REPORT.md (≈ 1 min; not part of `test`).
 perf-report: build

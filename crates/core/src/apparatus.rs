@@ -1,5 +1,5 @@
 //! The SHPB set-up: bar material, incident and transmission bars, striker, gas gun, pulse shaper
-//! and gauge channels ([`Apparatus`]), and the bar chain a test runs on (physics.md §5–§6).
+//! and gauge channels ([`Apparatus`]), and the bar chain a test runs on (docs/physics.md §5–§6).
 
 use crate::bar::{BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
 use crate::error::Result;

@@ -1,4 +1,4 @@
-//! The bars: 1D longitudinal waves `ρA ü = ∂/∂x(EA ∂u/∂x)` (physics.md §6) on a lumped-mass
+//! The bars: 1D longitudinal waves `ρA ü = ∂/∂x(EA ∂u/∂x)` (docs/physics.md §6) on a lumped-mass
 //! chain advanced by the explicit central-difference (leapfrog) scheme, with optional Love-rod
 //! lateral inertia `ρA ü = EA u'' + ρν²J ü''` (J = πa⁴/2).
 //!
@@ -79,7 +79,7 @@ const CELL_COUNT_SLACK: f64 = 1e-12;
 /// Relative slack for rounding when comparing Δt with the stability limit (Courant 1 sits on it).
 const STABILITY_SLACK: f64 = 1e-9;
 
-/// Elastic bar material (physics.md §6): density, Young's modulus, Poisson's ratio (Love rod only).
+/// Elastic bar material (docs/physics.md §6): density, Young's modulus, Poisson's ratio (Love rod only).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BarMaterial {
     /// Mass density ρ, kg/m³.
@@ -91,13 +91,13 @@ pub struct BarMaterial {
 }
 
 impl BarMaterial {
-    /// Bar wave speed c0 = √(E/ρ) (physics.md §6).
+    /// Bar wave speed c0 = √(E/ρ) (docs/physics.md §6).
     pub fn wave_speed_m_s(&self) -> f64 {
         (self.youngs_modulus_pa / self.density_kg_m3).sqrt()
     }
 }
 
-/// One uniform piece of a piecewise-uniform bar (physics.md §6); impedance Z = ρ c0 A.
+/// One uniform piece of a piecewise-uniform bar (docs/physics.md §6); impedance Z = ρ c0 A.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Segment {
     /// Length L, m.
@@ -114,7 +114,7 @@ impl Segment {
         PI * self.diameter_m * self.diameter_m / 4.0
     }
 
-    /// Mechanical impedance Z = ρ c0 A, kg/s (physics.md §6).
+    /// Mechanical impedance Z = ρ c0 A, kg/s (docs/physics.md §6).
     pub fn impedance_kg_s(&self) -> f64 {
         self.material.density_kg_m3 * self.material.wave_speed_m_s() * self.area_m2()
     }
@@ -138,7 +138,7 @@ pub enum EndCondition {
     Absorbing,
 }
 
-/// Which 1D bar theory to integrate (physics.md §6).
+/// Which 1D bar theory to integrate (docs/physics.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Dispersion {
     /// Elementary bar theory, `ρA ü = (EA u')'`: non-dispersive.
@@ -148,7 +148,7 @@ pub enum Dispersion {
     LoveRod,
 }
 
-/// A bar: uniform segments from left to right, its end conditions and theory (physics.md §6).
+/// A bar: uniform segments from left to right, its end conditions and theory (docs/physics.md §6).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BarSpec {
     /// Name used in error messages (`bar <name>`).
@@ -1089,7 +1089,7 @@ pub fn rigid_contact_force_n(left: &Bar, right: &Bar, initial_gap_m: f64) -> f64
     }
 }
 
-/// Rayleigh–Love phase velocity c/c0 = 1/√(1 + ν²k²a²/2) at y = a/Λ (k a = 2πy) (physics.md §6).
+/// Rayleigh–Love phase velocity c/c0 = 1/√(1 + ν²k²a²/2) at y = a/Λ (k a = 2πy) (docs/physics.md §6).
 pub fn rayleigh_love_velocity_ratio(poisson_ratio: f64, radius_over_wavelength: f64) -> f64 {
     let ka = 2.0 * PI * radius_over_wavelength;
     1.0 / (1.0 + 0.5 * poisson_ratio * poisson_ratio * ka * ka).sqrt()
@@ -1206,7 +1206,7 @@ impl HarmonicFit {
 }
 
 /// Measures the phase velocity at ω on a simulated uniform bar (validation of the Love scheme,
-/// physics.md §6): a long bar at Courant 1 with cells `cell_m`, both ends absorbing, is driven at
+/// docs/physics.md §6): a long bar at Courant 1 with cells `cell_m`, both ends absorbing, is driven at
 /// its left end by a force sin ωt switched on over 8 periods (sin² ramp); the strain at two
 /// element centres ≈ Λ and 1.75Λ from the driven end (Λ from the scheme's own relation, for
 /// placement only) is fitted to c + a cos ωt + b sin ωt over 24 periods that start 8 periods

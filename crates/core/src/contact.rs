@@ -1,7 +1,7 @@
 //! Contact laws of two spheres: the Burgoyne–Daraio loading law (paper Eq. 1) with Johnson–Cook
-//! rate hardening (Eqs. 2–3) and Thornton unloading (physics.md §3), and plain Hertz.
+//! rate hardening (Eqs. 2–3) and Thornton unloading (docs/physics.md §3), and plain Hertz.
 //!
-//! Sign convention (physics.md): approach δ and contact force F are positive in compression.
+//! Sign convention (docs/physics.md): approach δ and contact force F are positive in compression.
 
 use crate::specimen::ContactProperties;
 use std::f64::consts::PI;
@@ -39,7 +39,7 @@ pub struct FittedParameters {
 }
 
 impl FittedParameters {
-    /// Evaluates the fits at `q = E*/σy` for effective radius `radius_m` (physics.md §1).
+    /// Evaluates the fits at `q = E*/σy` for effective radius `radius_m` (docs/physics.md §1).
     pub fn at(q: f64, radius_m: f64) -> FittedParameters {
         let scale = radius_m / FIT_REFERENCE_RADIUS_M;
         FittedParameters {
@@ -63,12 +63,12 @@ pub enum Region {
 
 /// The form of region II (δy < δ ≤ δp) of the loading law.
 ///
-/// With α, β fixed by F(δy) = Fy and F(δp) = Fp (physics.md §1), the published law has a slope
+/// With α, β fixed by F(δy) = Fy and F(δp) = Fp (docs/physics.md §1), the published law has a slope
 /// jump of 13–17 % at δy, and region II starts *above* the Hertz curve. Together with Thornton
 /// unloading (and with rate hardening, which moves δy) that lets a contact return more energy
 /// than it received in impacts just past yield (restitution above 1). `Smooth` adds the term
 /// γ(δ − δy)(δp − δ), which vanishes at both ends (so δy, Fy, δp, Fp, α, β are the paper's) and whose
-/// γ makes dF/dδ continuous at δy, as physics.md §1 requires.
+/// γ makes dF/dδ continuous at δy, as docs/physics.md §1 requires.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Region2Form {
     /// F = δ(α + β ln δ) + γ(δ − δy)(δp − δ), C¹ at δy (default).
@@ -78,7 +78,7 @@ pub enum Region2Form {
     Published,
 }
 
-/// How region I joins region III when region II does not exist (δp ≤ δy, physics.md §1).
+/// How region I joins region III when region II does not exist (δp ≤ δy, docs/physics.md §1).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Degenerate {
     /// Region II exists (δy < δp): the normal three-region law.
@@ -119,7 +119,7 @@ pub struct LoadingCurve {
 }
 
 impl LoadingCurve {
-    /// Builds Eq. 1 for effective modulus, radius and yield stress with the C¹ region II (physics.md §1).
+    /// Builds Eq. 1 for effective modulus, radius and yield stress with the C¹ region II (docs/physics.md §1).
     pub fn new(e_star_pa: f64, radius_m: f64, yield_stress_pa: f64) -> LoadingCurve {
         LoadingCurve::with_form(e_star_pa, radius_m, yield_stress_pa, Region2Form::Smooth)
     }
@@ -167,7 +167,7 @@ impl LoadingCurve {
         curve
     }
 
-    /// The crossing where Hertz overtakes the region-III line, used when δp ≤ δy (physics.md §1).
+    /// The crossing where Hertz overtakes the region-III line, used when δp ≤ δy (docs/physics.md §1).
     fn hertz_plastic_crossing(&self) -> Degenerate {
         if self.p0_pa <= 0.0 {
             return Degenerate::HertzOnly;
@@ -250,7 +250,7 @@ impl LoadingCurve {
     }
 }
 
-/// Per-contact memory for unloading and reloading (physics.md §3).
+/// Per-contact memory for unloading and reloading (docs/physics.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ContactHistory {
     /// Largest approach reached so far, m.
@@ -347,7 +347,7 @@ impl ContactLaw for Hertz {
 }
 
 /// The Burgoyne–Daraio elastoplastic law: Eq. 1 loading, Johnson–Cook σy* from the global strain
-/// rate (Eqs. 2–3) when `rate_dependent`, Thornton unloading/reloading (physics.md §3).
+/// rate (Eqs. 2–3) when `rate_dependent`, Thornton unloading/reloading (docs/physics.md §3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BurgoyneDaraio {
     /// Effective properties of the pair.
@@ -409,7 +409,7 @@ impl BurgoyneDaraio {
         }
     }
 
-    /// The loading curve at strain rate `rate` (re-evaluated, not integrated: physics.md §2).
+    /// The loading curve at strain rate `rate` (re-evaluated, not integrated: docs/physics.md §2).
     pub fn curve_at(&self, rate_per_s: f64) -> LoadingCurve {
         let s = self.yield_stress(rate_per_s);
         if s == self.props.yield_stress_pa {
@@ -419,7 +419,7 @@ impl BurgoyneDaraio {
         }
     }
 
-    /// Thornton's unloading radius Rp and residual approach δr from (δmax, Fmax) (physics.md §3).
+    /// Thornton's unloading radius Rp and residual approach δr from (δmax, Fmax) (docs/physics.md §3).
     pub fn thornton_unloading(&self, delta_max_m: f64, force_max_n: f64) -> (f64, f64) {
         let e = self.props.e_star_pa;
         let sy = self.props.yield_stress_pa;
@@ -542,5 +542,134 @@ impl LawKind {
                 sum_of_radii_m: props.sum_of_radii_m,
             }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Every law against its analytic form: Hertz (docs/physics.md §1), Eq. 1 continuity at δy
+    //! and δp, the C¹ region II, Johnson–Cook hardening (§2) and Thornton unloading (§3).
+    use super::*;
+    use crate::material::JohnsonCook;
+    use approx::assert_relative_eq;
+
+    /// Two 6.35 mm SS440c spheres (E 200 GPa, ν 0.28, σy 1.9 GPa, C 0.035): the paper's pair.
+    fn ss440c() -> ContactProperties {
+        let plane = 200e9 / (1.0 - 0.28 * 0.28);
+        ContactProperties {
+            e_star_pa: plane / 2.0,
+            radius_m: 3.175e-3 / 2.0,
+            sum_of_radii_m: 6.35e-3,
+            yield_stress_pa: 1.9e9,
+            rate: JohnsonCook {
+                c: 0.035,
+                reference_rate_per_s: 1e-3,
+            },
+        }
+    }
+
+    #[test]
+    fn hertz_force_is_the_derivative_of_its_energy_and_elastic_on_unloading() {
+        let p = ss440c();
+        let (e, r) = (p.e_star_pa, p.radius_m);
+        let d = 20e-6;
+        assert_relative_eq!(
+            hertz_force(e, r, d),
+            4.0 / 3.0 * e * r.sqrt() * d.powf(1.5),
+            max_relative = 1e-14
+        );
+        let h = 1e-10;
+        let numeric = (hertz_energy(e, r, d + h) - hertz_energy(e, r, d - h)) / (2.0 * h);
+        assert_relative_eq!(numeric, hertz_force(e, r, d), max_relative = 1e-6);
+        let law = LawKind::Hertz.build(p);
+        let mut hist = ContactHistory::default();
+        let up = law.evaluate(&mut hist, d, 1.0).force_n;
+        let down = law.evaluate(&mut hist, 0.5 * d, -1.0).force_n;
+        assert_relative_eq!(up, hertz_force(e, r, d), max_relative = 1e-12);
+        assert_relative_eq!(down, hertz_force(e, r, 0.5 * d), max_relative = 1e-12);
+    }
+
+    #[test]
+    fn eq1_is_continuous_at_yield_and_at_full_plasticity_in_both_forms() {
+        let p = ss440c();
+        for form in [Region2Form::Smooth, Region2Form::Published] {
+            let c = LoadingCurve::with_form(p.e_star_pa, p.radius_m, p.yield_stress_pa, form);
+            assert_eq!(c.degenerate, Degenerate::No);
+            let (dy, dp) = (c.delta_y_m, c.fit.delta_p_m);
+            assert!(dy < dp);
+            let eps = 1e-9;
+            assert_relative_eq!(c.force(dy * (1.0 - eps)), c.force_y_n, max_relative = 1e-6);
+            assert_relative_eq!(c.force(dy * (1.0 + eps)), c.force_y_n, max_relative = 1e-6);
+            assert_relative_eq!(c.force(dp * (1.0 - eps)), c.force_p_n, max_relative = 1e-6);
+            assert_relative_eq!(c.force(dp * (1.0 + eps)), c.force_p_n, max_relative = 1e-6);
+            assert_eq!(c.region(0.5 * dy), Region::Hertz);
+            assert_eq!(c.region(2.0 * dp), Region::Plastic);
+            // Region III is the straight line F = p0 π (2 r δ + c2).
+            let slope = (c.force(3.0 * dp) - c.force(2.0 * dp)) / dp;
+            assert_relative_eq!(
+                slope,
+                2.0 * PI * c.fit.c1 * p.yield_stress_pa * p.radius_m,
+                max_relative = 1e-9
+            );
+        }
+    }
+
+    #[test]
+    fn the_smooth_region2_is_c1_at_yield_and_the_published_one_is_not() {
+        let p = ss440c();
+        let slope = |c: &LoadingCurve, d: f64| {
+            let h = 1e-6 * d;
+            (c.force(d + h) - c.force(d - h)) / (2.0 * h)
+        };
+        let smooth = LoadingCurve::new(p.e_star_pa, p.radius_m, p.yield_stress_pa);
+        let published = LoadingCurve::with_form(
+            p.e_star_pa,
+            p.radius_m,
+            p.yield_stress_pa,
+            Region2Form::Published,
+        );
+        let dy = smooth.delta_y_m;
+        let jump = |c: &LoadingCurve| {
+            (slope(c, dy * (1.0 + 1e-3)) - slope(c, dy * (1.0 - 1e-3))).abs() / slope(c, dy)
+        };
+        assert!(jump(&smooth) < 2e-3, "smooth jump {}", jump(&smooth));
+        // docs/physics.md §1: the paper's form jumps by 13–17 % for the paper's materials.
+        assert!(jump(&published) > 0.10, "published jump {}", jump(&published));
+    }
+
+    #[test]
+    fn johnson_cook_raises_the_loading_force_with_rate_and_not_below_the_reference_rate() {
+        let law = BurgoyneDaraio::new(ss440c(), true);
+        let d = 3.0 * law.static_curve().fit.delta_p_m;
+        assert_eq!(law.loading_force(d, 1e-4), law.loading_force(d, 0.0));
+        let (slow, fast) = (law.loading_force(d, 1.0), law.loading_force(d, 1e4));
+        assert!(fast > slow);
+        assert_relative_eq!(
+            law.yield_stress(1e4),
+            1.9e9 * (1.0 + 0.035 * (1e4f64 / 1e-3).ln()),
+            max_relative = 1e-12
+        );
+        let independent = BurgoyneDaraio::new(ss440c(), false);
+        assert_eq!(independent.loading_force(d, 1e4), independent.loading_force(d, 0.0));
+    }
+
+    #[test]
+    fn thornton_unloading_starts_at_the_peak_force_and_ends_at_the_residual_approach() {
+        let law = BurgoyneDaraio::new(ss440c(), false);
+        let mut h = ContactHistory::default();
+        let dmax = 2.0 * law.static_curve().fit.delta_p_m;
+        let fmax = law.evaluate(&mut h, dmax, 1.0).force_n;
+        assert!(h.yielded);
+        let (rp, dr) = law.thornton_unloading(dmax, fmax);
+        assert!(rp > 0.0 && dr > 0.0 && dr < dmax);
+        // Unloading curve F = (4/3) E* √Rp (δ − δr)^{3/2} passes through (δmax, Fmax).
+        let back = 4.0 / 3.0 * ss440c().e_star_pa * rp.sqrt() * (dmax - dr).powf(1.5);
+        assert_relative_eq!(back, fmax, max_relative = 1e-9);
+        // Passive: less force on the way down than on the way up, none below δr.
+        let d = 0.5 * (dr + dmax);
+        let down = law.evaluate(&mut h, d, -1.0).force_n;
+        assert!(down < law.loading_force(d, 0.0));
+        assert_eq!(law.evaluate(&mut h, 0.9 * dr, -1.0).force_n, 0.0);
+        assert_relative_eq!(law.zero_force_approach(&h), dr, max_relative = 1e-12);
     }
 }

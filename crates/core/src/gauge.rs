@@ -1,5 +1,5 @@
 //! Strain gauges on a bar → Wheatstone bridge → amplifier → digitiser, and back from recorded
-//! voltages to bar strain (physics.md §7; the authors' `analysis.m`, shared/reference/README.md).
+//! voltages to bar strain (docs/physics.md §7; the authors' `analysis.m`, shared/reference/README.md).
 //!
 //! Sign conventions: bar strain ε is positive in tension (compression is negative). A bridge's
 //! output is taken with the sign that makes it rise with the axial gauge's resistance, so it is
@@ -405,4 +405,75 @@ pub fn pulse_metrics(
         duration_10_s: end - start,
         start_10_s: start,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn baseline_removal_subtracts_the_mean_of_the_first_samples() {
+        let v = [1.0, 3.0, 10.0, 12.0];
+        assert_eq!(remove_baseline(&v, 2), vec![-1.0, 1.0, 8.0, 10.0]);
+        assert_eq!(remove_baseline(&v, 0), v.to_vec());
+        assert_eq!(remove_baseline(&v, 99).iter().sum::<f64>(), 0.0);
+    }
+
+    #[test]
+    fn pulse_metrics_of_a_trapezoid_are_its_analytic_crossings() {
+        // Trapezoid, compressive negative: 0 until 10 µs, ramp to −1 at 20 µs, flat to 50 µs,
+        // back to 0 at 60 µs; 10 % crossings at 11 and 59 µs, 90 % at 19 µs.
+        let dt = 0.1e-6;
+        let t: Vec<f64> = (0..800).map(|k| k as f64 * dt).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|&s| {
+                let us = s * 1e6;
+                -if us < 10.0 {
+                    0.0
+                } else if us < 20.0 {
+                    (us - 10.0) / 10.0
+                } else if us < 50.0 {
+                    1.0
+                } else if us < 60.0 {
+                    (60.0 - us) / 10.0
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let m = pulse_metrics(&t, &y, true).unwrap();
+        assert_relative_eq!(m.peak, -1.0);
+        assert_relative_eq!(m.start_10_s, 11e-6, max_relative = 1e-9);
+        assert_relative_eq!(m.rise_10_90_s, 8e-6, max_relative = 1e-9);
+        assert_relative_eq!(m.duration_10_s, 48e-6, max_relative = 1e-9);
+        // No tensile pulse in it; a pulse cut off by the record's end has no metrics.
+        assert!(pulse_metrics(&t, &y, false).is_none());
+        assert!(pulse_metrics(&t[..300], &y[..300], true).is_none());
+    }
+
+    #[test]
+    fn bridges_invert_exactly() {
+        for kind in [
+            BridgeKind::QuarterAxial,
+            BridgeKind::HalfPoisson,
+            BridgeKind::FullPoisson,
+        ] {
+            let b = Bridge {
+                kind,
+                gauge_factor: 2.1,
+                excitation_v: 10.0,
+                poisson_ratio: 0.3,
+            };
+            for strain in [-2e-3, -1e-5, 0.0, 4e-4] {
+                assert_relative_eq!(
+                    b.strain_from_output(b.output_v(strain)),
+                    strain,
+                    epsilon = 1e-15,
+                    max_relative = 1e-12
+                );
+            }
+        }
+    }
 }

@@ -2,7 +2,7 @@
 
 
 /// Johnson–Cook rate hardening of the yield stress, `σy* = σy (1 + C ln(ε̇/ε̇0))` (paper Eq. 2 with
-/// the sign corrected as in the authors' code, physics.md §2).
+/// the sign corrected as in the authors' code, docs/physics.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JohnsonCook {
     /// Dimensionless rate sensitivity C.
@@ -18,7 +18,7 @@ impl JohnsonCook {
         reference_rate_per_s: 1e-3,
     };
 
-    /// Dynamic yield stress at strain rate `rate_per_s`; equals `sigma_y_pa` for ε̇ ≤ ε̇0 (physics.md §2).
+    /// Dynamic yield stress at strain rate `rate_per_s`; equals `sigma_y_pa` for ε̇ ≤ ε̇0 (docs/physics.md §2).
     pub fn dynamic_yield_stress(&self, sigma_y_pa: f64, rate_per_s: f64) -> f64 {
         if rate_per_s > self.reference_rate_per_s && self.c != 0.0 {
             sigma_y_pa * (1.0 + self.c * (rate_per_s / self.reference_rate_per_s).ln())
@@ -37,7 +37,7 @@ pub struct Material {
     pub density_kg_m3: f64,
     /// Young's modulus, Pa.
     pub youngs_modulus_pa: f64,
-    /// Poisson's ratio (not given in the paper; physics.md §4 defaults).
+    /// Poisson's ratio (not given in the paper; docs/physics.md §4 defaults).
     pub poisson_ratio: f64,
     /// Quasi-static yield stress σy, Pa.
     pub yield_stress_pa: f64,
@@ -46,7 +46,7 @@ pub struct Material {
 }
 
 impl Material {
-    /// Plane-strain modulus E/(1−ν²), Pa (one sphere's share of E*, physics.md §1).
+    /// Plane-strain modulus E/(1−ν²), Pa (one sphere's share of E*, docs/physics.md §1).
     pub fn plane_strain_modulus_pa(&self) -> f64 {
         self.youngs_modulus_pa / (1.0 - self.poisson_ratio * self.poisson_ratio)
     }

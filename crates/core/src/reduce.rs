@@ -1,11 +1,11 @@
-//! The laboratory's data reduction (physics.md §7; shared/reference/README.md, "Reduction"):
+//! The laboratory's data reduction (docs/physics.md §7; shared/reference/README.md, "Reduction"):
 //! from the strains recorded at the incident and transmission gauges to the forces on the two
 //! specimen faces, the sphere approach δ(t), its rate and the global strain rate. It works on
 //! simulated records (`shpb run` HDF5) and on real ones (the authors' raw CSV).
 //!
 //! # Sign conventions
 //!
-//! Bar strain ε is positive in tension (physics.md). The incident bar lies at x < 0 with its
+//! Bar strain ε is positive in tension (docs/physics.md). The incident bar lies at x < 0 with its
 //! specimen face at x = 0⁻, the transmission bar at x > 0; displacements u and velocities v are
 //! positive along +x (from the incident towards the transmission bar). For a wave running towards
 //! +x, v = −c0 ε; towards −x, v = +c0 ε. Hence, with εI, εR, εT the incident, reflected and
@@ -16,7 +16,7 @@
 //! * `v_back = −c0 εT`, `u_back = ∫ v_back dt` (transmission-bar face, positive when it is pushed
 //!   away);
 //! * sphere approach `δ = u_front − u_back = −c0 ∫ (εI − εR − εT) dt`, positive in compression
-//!   (physics.md §7 writes the same with the bar-axis signs left to the reader), and
+//!   (docs/physics.md §7 writes the same with the bar-axis signs left to the reader), and
 //!   `δ̇ = v_front − v_back`;
 //! * contact forces, positive in compression: `F_front = −E A (εI + εR)` (2-wave),
 //!   `F_back = −E A εT` (1-wave), `F_3wave = (F_front + F_back)/2`;
@@ -58,7 +58,7 @@
 //! Optional (on by default), as in the authors' `disp_corr.m`: every Fourier component of a
 //! wave is shifted in time by `τ(f) = Δx (1/c(f) − 1/c0)` (a spectrum factor `exp(−iωτ)`, i.e. a
 //! *delay* for τ > 0), where `c(f)` is the first-mode phase velocity of the Bancroft fit of
-//! physics.md §7, `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`, solved for the
+//! docs/physics.md §7, `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`, solved for the
 //! wavelength `Λ = c/f` at each frequency (a scalar monotone equation, bisection). The plain
 //! transit `Δx/c0` is the window offset of step 3; the correction adds only what dispersion
 //! changes. Signs: the incident wave is moved *forward* to the face (`Δx = +d_I`: its slow,
@@ -75,7 +75,7 @@ use crate::error::{Error, Result};
 use crate::gauge::{GaugeChannel, RawRecord};
 use crate::numeric::{bisect, cumulative_trapezoid, moving_average, phase_shift};
 
-/// Bancroft first-mode fit for ν = 0.31 (physics.md §7): A, B, C, D, E, F of
+/// Bancroft first-mode fit for ν = 0.31 (docs/physics.md §7): A, B, C, D, E, F of
 /// `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`.
 pub const BANCROFT_FIT: [f64; 6] = [0.57344, 0.42790, 18.668, 19.664, -6.6213, 2.3118];
 
@@ -194,24 +194,6 @@ pub struct ReductionInput {
     pub incident_strain: Vec<f64>,
     /// Transmission-gauge strain.
     pub transmission_strain: Vec<f64>,
-}
-
-impl ReductionInput {
-    /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`
-    /// of `shpb run`), if it recorded both channels.
-    pub fn from_noise_free_gauges(out: &crate::run::RunOutput) -> Option<ReductionInput> {
-        let strain = |name: &str| {
-            out.gauges
-                .iter()
-                .find(|g| g.name == name)
-                .map(|g| g.strain.clone())
-        };
-        Some(ReductionInput {
-            time_s: out.time_s.clone()?,
-            incident_strain: strain("incident")?,
-            transmission_strain: strain("transmission")?,
-        })
-    }
 }
 
 /// Manual window settings; each `None` keeps the automatic rule (module docs, "Windows").
@@ -373,7 +355,7 @@ pub struct ImpliedIncident {
     pub energy_j: f64,
 }
 
-/// Incident stress at the specimen face implied by force F and approach δ (physics.md §7 run
+/// Incident stress at the specimen face implied by force F and approach δ (docs/physics.md §7 run
 /// backwards): with the front force equal to the back force F (equilibrium), the transmission
 /// face moving at F/(ρ c0 A) and the incident face at that plus δ̇, the one-wave relations
 /// F = A(σI + σR), v = (σI − σR)/(ρ c0) give σI = F/A + ρ c0 δ̇ / 2. δ̇ is a central difference over

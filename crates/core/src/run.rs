@@ -2,6 +2,7 @@
 //! snapshots, scalar summary, the lab's reduction of simulated records, and warnings. Plain data:
 //! the writers of `shpb-output` turn it into HDF5, CSV and PNG.
 
+use crate::reduce::ReductionInput;
 use crate::solver::ContactSeries;
 
 /// A scalar result of a run (peak force, restitution, …) with its unit.
@@ -69,6 +70,26 @@ impl RunOutput {
             reduction: None,
             warnings: Vec::new(),
         }
+    }
+}
+
+
+// The reduction input of a run lives with the run, so that `reduce` does not depend on `run`.
+impl ReductionInput {
+    /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`
+    /// of `shpb run`), if it recorded both channels.
+    pub fn from_noise_free_gauges(out: &RunOutput) -> Option<ReductionInput> {
+        let strain = |name: &str| {
+            out.gauges
+                .iter()
+                .find(|g| g.name == name)
+                .map(|g| g.strain.clone())
+        };
+        Some(ReductionInput {
+            time_s: out.time_s.clone()?,
+            incident_strain: strain("incident")?,
+            transmission_strain: strain("transmission")?,
+        })
     }
 }
 

@@ -13,7 +13,7 @@ use crate::numeric::resample;
 use crate::specimen::SpherePair;
 
 /// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
-/// radius 9.525 mm; physics.md §5), kg/s.
+/// radius 9.525 mm; docs/physics.md §5), kg/s.
 pub const AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S: f64 =
     8110.0 * 4865.5 * std::f64::consts::PI * 9.525e-3 * 9.525e-3;
 

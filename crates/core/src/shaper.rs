@@ -1,5 +1,5 @@
 //! The copper pulse shaper between striker and incident bar (Frew, Forrestal & Chen,
-//! Exp. Mech. 42, 93 (2002); physics.md §6): a thin disc flattened plastically.
+//! Exp. Mech. 42, 93 (2002); docs/physics.md §6): a thin disc flattened plastically.
 
 /// Frew–Forrestal–Chen pulse shaper: true stress σ = σ0 εⁿ/(1 − εᵐ) at engineering strain ε,
 /// area A = A0/(1 − ε) (volume conserved), force F = σ A; elastic (modulus E) below the plastic

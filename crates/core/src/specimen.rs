@@ -1,5 +1,5 @@
 //! The specimen: two (possibly dissimilar) spheres and their effective contact properties
-//! (paper Sec. II: E*, r; physics.md §1).
+//! (paper Sec. II: E*, r; docs/physics.md §1).
 
 use crate::material::{JohnsonCook, Material};
 
@@ -10,7 +10,7 @@ pub struct Sphere {
     pub material: Material,
     /// Radius of curvature at the contact, m.
     pub radius_m: f64,
-    /// Mass, kg (default: the full sphere, a fair approximation for the truncated ones, physics.md §5).
+    /// Mass, kg (default: the full sphere, a fair approximation for the truncated ones, docs/physics.md §5).
     pub mass_kg: f64,
 }
 
@@ -61,7 +61,7 @@ impl SpherePair {
         }
     }
 
-    /// Effective contact properties of the pair (physics.md §1).
+    /// Effective contact properties of the pair (docs/physics.md §1).
     pub fn contact_properties(&self) -> ContactProperties {
         let (a, b) = (&self.sphere1, &self.sphere2);
         let e_star_pa = 1.0

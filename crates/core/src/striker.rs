@@ -1,6 +1,6 @@
 //! The striker and its gas gun: reservoir pressure → striker velocity by adiabatic expansion of
 //! the reservoir gas behind the striker over the barrel (Rohrbach et al., Am. J. Phys. 80, 24
-//! (2012); physics.md §6).
+//! (2012); docs/physics.md §6).
 
 use crate::error::{Error, Result};
 
@@ -108,7 +108,7 @@ pub fn most_pulse_energy_j(mass_kg: f64, velocity_m_s: f64, impulse_n_s: f64) ->
     0.5 * mass_kg * (velocity_m_s * velocity_m_s - after * after)
 }
 
-/// The simple gun curve v² = k (p − p_loss) (physics.md §6), equivalent to [`GasGun`] for fixed geometry.
+/// The simple gun curve v² = k (p − p_loss) (docs/physics.md §6), equivalent to [`GasGun`] for fixed geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearGun {
     /// k, m²/s² per Pa of gauge pressure.

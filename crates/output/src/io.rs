@@ -4,87 +4,16 @@
 use shpb_core::run::RunOutput;
 use shpb_core::solver::ContactSeries;
 use shpb_input::{Error, Result};
-use hdf5::types::VarLenUnicode;
-use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
-/// Refuses to overwrite `path` unless `force`.
-pub fn check_output(path: &Path, force: bool) -> Result<()> {
-    if path.exists() && !force {
-        return Err(Error::OutputExists(path.to_path_buf()));
-    }
-    Ok(())
-}
+pub use crate::atomic::{check_output, write_atomically, write_text_atomically};
+pub use crate::h5::{h5err, string_attr, vlu, write_dataset};
+use std::path::Path;
 
-/// Writes a file through `write` to a temporary name beside `path`, then renames it into place;
-/// on failure the temporary file is removed, so no half-written output is left.
-pub fn write_atomically(
-    path: &Path,
-    force: bool,
-    write: impl FnOnce(&Path) -> Result<()>,
-) -> Result<()> {
-    check_output(path, force)?;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| "out".into());
-    // The temporary name keeps the extension (plotters picks the image format from it).
-    let tmp: PathBuf = dir.join(format!(".tmp-{}-{name}", std::process::id()));
-    let result =
-        write(&tmp).and_then(|_| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
 
-/// Converts an HDF5 error into the crate's error naming `file`.
-pub fn h5err(file: &Path) -> impl Fn(hdf5::Error) -> Error + '_ {
-    move |e| Error::Hdf5 {
-        file: file.display().to_string(),
-        message: e.to_string(),
-    }
-}
 
-/// An HDF5 variable-length UTF-8 string.
-pub fn vlu(s: &str) -> VarLenUnicode {
-    VarLenUnicode::from_str(s)
-        .unwrap_or_else(|_| VarLenUnicode::from_str("").expect("empty string is valid"))
-}
 
-/// Writes a string attribute.
-pub fn string_attr(
-    loc: &hdf5::Location,
-    name: &str,
-    value: &str,
-    file: &Path,
-) -> Result<()> {
-    loc.new_attr::<VarLenUnicode>()
-        .shape(())
-        .create(name)
-        .and_then(|a| a.write_scalar(&vlu(value)))
-        .map_err(h5err(file))
-}
 
-/// Writes a 1-D f64 dataset with a `units` attribute.
-pub fn write_dataset(
-    group: &hdf5::Group,
-    name: &str,
-    data: &[f64],
-    units: &str,
-    file: &Path,
-) -> Result<()> {
-    let ds = group
-        .new_dataset_builder()
-        .with_data(data)
-        .create(name)
-        .map_err(h5err(file))?;
-    string_attr(&ds, "units", units, file)
-}
+
 
 /// The `/contact` datasets of a series: (name, data, units), absent ones skipped.
 pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static str)> {
@@ -189,12 +118,6 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
     })
 }
 
-/// Writes `text` to `path` atomically (refusing to overwrite without `force`).
-pub fn write_text_atomically(path: &Path, force: bool, text: &str) -> Result<()> {
-    write_atomically(path, force, |tmp| {
-        std::fs::write(tmp, text).map_err(|e| Error::io(path, e))
-    })
-}
 
 /// Writes a run as CSV with one header line (units in the column names): the contact series,
 /// or for bar scenes the time axis with each gauge's strain and voltage.

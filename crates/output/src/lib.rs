@@ -4,6 +4,8 @@
 
 #![warn(missing_docs)]
 
+pub mod atomic;
+pub mod h5;
 pub mod io;
 pub mod plot;
 pub mod reduction;

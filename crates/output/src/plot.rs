@@ -1,7 +1,7 @@
 //! PNG plots with plotters: force–displacement curves (as in the paper's Figs. 2–4).
 
 use shpb_input::{Error, Result};
-use crate::io::write_atomically;
+use crate::atomic::write_atomically;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use plotters::prelude::*;

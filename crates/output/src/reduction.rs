@@ -1,7 +1,8 @@
 //! The lab's reduction written out (`/reduction/*` in HDF5, or CSV), and the gauge strains of a
 //! run file read back for `shpb reduce`.
 
-use crate::io::{h5err, string_attr};
+use crate::atomic::{write_atomically, write_text_atomically};
+use crate::h5::{h5err, string_attr, write_dataset};
 use shpb_core::reduce::{Reduction, ReductionInput};
 use shpb_input::{Error, Result};
 use std::path::Path;
@@ -117,13 +118,13 @@ fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
 /// command line), `/reduction/<series>` with `units` attributes, `/summary` scalar attributes
 /// with a `units` list.
 pub fn write_reduction_hdf5(path: &Path, force: bool, scene: &str, r: &Reduction) -> Result<()> {
-    crate::io::write_atomically(path, force, |tmp| {
+    write_atomically(path, force, |tmp| {
         let f = hdf5::File::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
         string_attr(&f, "scene", scene, path)?;
         let g = f.create_group("reduction").map_err(h5err(path))?;
         for (name, data, units, _) in reduction_columns(r) {
-            crate::io::write_dataset(&g, name, data, units, path)?;
+            write_dataset(&g, name, data, units, path)?;
         }
         let s = f.create_group("summary").map_err(h5err(path))?;
         let items = summary_items(r);
@@ -155,6 +156,6 @@ pub fn write_reduction_csv(path: &Path, force: bool, r: &Reduction) -> Result<()
         text.push_str(&row.join(","));
         text.push('\n');
     }
-    crate::io::write_text_atomically(path, force, &text)
+    write_text_atomically(path, force, &text)
 }
 

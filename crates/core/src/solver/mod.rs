@@ -1,4 +1,4 @@
-//! Time integration of the two-sphere DEM scenes (paper Sec. III, DEM; physics.md §5).
+//! Time integration of the two-sphere DEM scenes (paper Sec. III, DEM; docs/physics.md §5).
 //!
 //! Scheme: velocity Verlet for the contact force, with linear dashpots (the bar media) treated by
 //! the trapezoidal rule so that they are unconditionally stable. The per-contact history is
@@ -540,7 +540,7 @@ impl ForceHistory {
     }
 }
 
-/// Inputs of the force-driven Fig. 4 DEM (physics.md §5).
+/// Inputs of the force-driven Fig. 4 DEM (docs/physics.md §5).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceDrivenSetup {
     /// Force applied to sphere 1.

@@ -1,5 +1,5 @@
 //! The bar apparatus in time: striker → (pulse shaper) → incident bar (→ transmission bar),
-//! all bars on one time step at Courant number 1 (physics.md §6).
+//! all bars on one time step at Courant number 1 (docs/physics.md §6).
 //!
 //! Couplings between bar ends are solved implicitly for the step's end velocities, so they add
 //! no stiffness to the explicit limit of the bars (which sit exactly at it at Courant 1):
