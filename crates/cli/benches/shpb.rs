@@ -7,19 +7,22 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use shpb::apparatus::Apparatus;
 use shpb::contact::{ContactHistory, LawKind};
 use shpb::fidelity::Fidelity;
+use shpb::gauges::reduce_record_file;
 use shpb::material::Material;
-use shpb::reduce::{ReductionOptions, reduce_record_file};
+use shpb::prelude::*;
+use shpb::reduce::ReductionOptions;
 use shpb::scene::Params;
 use shpb::specimen::SpherePair;
 use std::hint::black_box;
 use std::path::Path;
 
 fn scene(path: &str) -> Params {
-    Params::from_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("shipped scene")
+    Params::from_file(&Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join(path))
+        .expect("shipped scene")
 }
 
 fn benches(c: &mut Criterion) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
     // The reference preset (Love rod, 0.125 mm cells) takes seconds per run: `shpb bench` times it.
     for f in [Fidelity::Fast, Fidelity::Standard] {
         let test = Params::from_file_with(&root.join("scenes/shpb-ss440c-10psi.toml"), Some(f))

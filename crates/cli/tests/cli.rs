@@ -15,11 +15,16 @@ const BAD_INPUT: i32 = 2;
 /// Outputs requested by every failing run; none of them may exist afterwards.
 const OUTPUTS: [&str; 3] = ["out.h5", "out.csv", "out.png"];
 
+/// The repository root (this crate is `crates/cli`): `bars/`, `scenes/`, `validation/`.
+fn repo() -> String {
+    format!("{}/../..", env!("CARGO_MANIFEST_DIR"))
+}
+
 /// The measured SS440c 10 psi force history shipped with the repository.
 fn measured_force_csv() -> String {
     format!(
         "{}/validation/fig4-force-driven/data/ss440c_10psi_force10.csv",
-        env!("CARGO_MANIFEST_DIR")
+        repo()
     )
 }
 
@@ -621,10 +626,7 @@ fn datasets(group: &hdf5::Group, prefix: &str, out: &mut Vec<(String, hdf5::Data
 #[test]
 fn full_test_writes_the_documented_hdf5_layout() {
     let dir = TempDir::new().unwrap();
-    let scene = format!(
-        "{}/scenes/shpb-ss440c-10psi.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let scene = format!("{}/scenes/shpb-ss440c-10psi.toml", repo());
     let out = shpb(
         dir.path(),
         &["run", &scene, "-o", "out.h5", "--plot", "out.png"],
@@ -703,7 +705,7 @@ fn incident_tells_which_striker_a_record_was_shot_with() {
     // at the calibrated gun's 10 psi velocity can give (momentum and energy conservation), and
     // fits the 20 cm striker of bars/authors-20cm-striker.toml (validation/fig4-virtual-shpb).
     let tmp = TempDir::new().unwrap();
-    let root = env!("CARGO_MANIFEST_DIR");
+    let root = repo();
     let record = measured_force_csv();
     let run = |bars: &str| {
         let out = shpb(
@@ -767,7 +769,7 @@ fn incident_tells_which_striker_a_record_was_shot_with() {
 #[test]
 fn incident_refuses_bad_input_naming_file_and_key() {
     let tmp = TempDir::new().unwrap();
-    let bars = format!("{}/bars/authors.toml", env!("CARGO_MANIFEST_DIR"));
+    let bars = format!("{}/bars/authors.toml", repo());
     let csv = write(tmp.path(), "f.csv", "time_s,force_N\n0,1\n1e-6,2\n");
     let run = |args: &[&str]| {
         let mut all = vec!["incident"];
@@ -809,4 +811,157 @@ fn incident_refuses_bad_input_naming_file_and_key() {
         Some(BAD_INPUT),
         &["--bars", "nothere.toml"],
     );
+}
+
+/// Runs `shpb ARGS` in `dir` and asserts it succeeds; returns stdout.
+fn succeeds(dir: &Path, args: &[&str]) -> String {
+    let out = shpb(dir, args);
+    assert!(
+        out.status.success(),
+        "`shpb {}` failed ({:?}):\n{}",
+        args.join(" "),
+        out.status.code(),
+        text(&out.stderr)
+    );
+    text(&out.stdout)
+}
+
+#[test]
+fn gun_runs_outside_the_repository_with_the_built_in_setup() {
+    let tmp = TempDir::new().unwrap();
+    let out = succeeds(tmp.path(), &["gun", "--pressure", "10psi"]);
+    assert!(out.contains("striker velocity"), "{out}");
+    // The built-in set-up by name gives the same as the default.
+    let named = succeeds(
+        tmp.path(),
+        &["gun", "--pressure", "10psi", "--bars", "authors"],
+    );
+    assert_eq!(named, out);
+    // …and the same as the repository's file.
+    let file = format!("{}/bars/authors.toml", repo());
+    let from_file = succeeds(tmp.path(), &["gun", "--pressure", "10psi", "--bars", &file]);
+    assert_eq!(from_file, out);
+}
+
+#[test]
+fn list_names_every_builtin_material_setup_and_kind() {
+    let tmp = TempDir::new().unwrap();
+    let out = succeeds(tmp.path(), &["list"]);
+    for (name, _) in shpb_input::material::BUILTIN_MATERIALS {
+        assert!(out.contains(name), "material `{name}` missing:\n{out}");
+    }
+    for (name, _, description) in shpb_input::builtin::SETUPS {
+        assert!(out.contains(name), "set-up `{name}` missing:\n{out}");
+        assert!(
+            out.contains(description),
+            "set-up `{name}` undescribed:\n{out}"
+        );
+    }
+    for (name, help) in shpb_input::kinds::names_and_help() {
+        assert!(out.contains(name), "kind `{name}` missing:\n{out}");
+        assert!(out.contains(help), "kind `{name}` undescribed:\n{out}");
+    }
+}
+
+#[test]
+fn validate_runs_outside_the_repository_on_the_embedded_data() {
+    let tmp = TempDir::new().unwrap();
+    let case = "hertz-analytic";
+    assert!(shpb::validate::CASES.iter().any(|(n, _)| *n == case));
+    let out = succeeds(tmp.path(), &["validate", case]);
+    assert!(out.contains(case) && out.contains("checks pass"), "{out}");
+    // Nothing is left in the working directory…
+    assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 0);
+    // …and the same case on the repository's data gives the same table.
+    let repo = repo();
+    let with_data = succeeds(tmp.path(), &["validate", case, "--data", &repo]);
+    assert_eq!(with_data, out);
+    // --data without the reference data is refused, naming the option.
+    let out = shpb(tmp.path(), &["validate", case, "--data", "."]);
+    assert_refused(tmp.path(), &out, Some(BAD_INPUT), &["--data", "validation"]);
+}
+
+#[test]
+fn run_a_scene_naming_the_built_in_setup_outside_the_repository() {
+    let tmp = TempDir::new().unwrap();
+    let original =
+        std::fs::read_to_string(format!("{}/scenes/shpb-ss440c-10psi.toml", repo())).unwrap();
+    assert!(original.lines().any(|l| l.starts_with("bars =")));
+    let scene: String = original
+        .lines()
+        .map(|l| {
+            if l.starts_with("bars =") {
+                "bars = \"authors\"".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    write(tmp.path(), "scene.toml", &scene);
+    let out = succeeds(
+        tmp.path(),
+        &["run", "scene.toml", "--fidelity", "fast", "-o", "out.h5"],
+    );
+    assert!(out.contains("kind shpb"), "{out}");
+    assert!(tmp.path().join("out.h5").is_file());
+}
+
+#[test]
+fn reduce_a_record_with_the_built_in_setup_outside_the_repository() {
+    let tmp = TempDir::new().unwrap();
+    std::fs::copy(
+        format!(
+            "{}/validation/gauge-records/data/2013-05-22_sample1_ss440c.csv",
+            repo()
+        ),
+        tmp.path().join("record.csv"),
+    )
+    .unwrap();
+    let out = succeeds(
+        tmp.path(),
+        &[
+            "reduce",
+            "record.csv",
+            "--bars",
+            "authors",
+            "--csv",
+            "out.csv",
+        ],
+    );
+    assert!(out.contains("peak back force"), "{out}");
+    assert!(tmp.path().join("out.csv").is_file());
+    // The default set-up is the built-in one.
+    let default = succeeds(tmp.path(), &["reduce", "record.csv"]);
+    assert_eq!(default, out);
+}
+
+#[test]
+fn unknown_bars_is_refused_naming_the_option_and_the_builtin_setups() {
+    let tmp = TempDir::new().unwrap();
+    let record = measured_force_csv();
+    let raw = format!(
+        "{}/validation/gauge-records/data/2013-05-22_sample1_ss440c.csv",
+        repo()
+    );
+    let runs: [&[&str]; 4] = [
+        &["gun", "--pressure", "10psi"],
+        &["incident", &record],
+        &["reduce", &raw],
+        &["strain", &raw],
+    ];
+    for args in runs {
+        let mut all = args.to_vec();
+        all.extend_from_slice(&["--bars", "nonexistent"]);
+        let out = shpb(tmp.path(), &all);
+        let err = assert_refused(
+            tmp.path(),
+            &out,
+            Some(BAD_INPUT),
+            &["--bars", "nonexistent"],
+        );
+        for (name, _, _) in shpb_input::builtin::SETUPS {
+            assert!(err.contains(name), "`{name}` not offered:\n{err}");
+        }
+    }
 }

@@ -2,12 +2,12 @@
 //! unloading (physics.md §3), checked against independent hand evaluations and their own
 //! continuity and degenerate-case guarantees.
 
-use shpb::prelude::*;
 use proptest::prelude::*;
 use shpb::contact::{
     BurgoyneDaraio, ContactHistory, ContactLaw, Degenerate, LoadingCurve, Region, Region2Form,
 };
 use shpb::material::{JohnsonCook, Material};
+use shpb::prelude::*;
 use shpb::specimen::{Sphere, SpherePair};
 use std::f64::consts::PI;
 

@@ -2,9 +2,9 @@
 //! conservation, constant-rate compression, and the paper's force-driven Fig. 4 DEM against the
 //! authors' measurements (validation/fig4-force-driven/data, CC-BY 4.0).
 
-use shpb::prelude::*;
 use shpb::contact::{BurgoyneDaraio, ContactLaw, LawKind};
 use shpb::material::Material;
+use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams, compare_fig4};
 use shpb::solver::{self, CollisionSetup};
 use shpb::specimen::SpherePair;
@@ -127,7 +127,8 @@ fn constant_rate_force_rises_with_rate_and_is_static_at_reference_rate() {
 }
 
 fn fig4_files() -> Vec<std::path::PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/fig4-force-driven/data");
+    let dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("validation/fig4-force-driven/data");
     let mut v: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())

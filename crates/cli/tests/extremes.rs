@@ -8,11 +8,11 @@
 //! kept short where the physics allows (short bars, coarse DEM steps where only stability is at
 //! stake); each test says why that loses nothing.
 
-use shpb::prelude::*;
 use shpb::bar::{Bar, BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
 use shpb::contact::{BurgoyneDaraio, ContactLaw, Degenerate, LawKind};
 use shpb::error::Error;
 use shpb::material::Material;
+use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
 use shpb::solver::pulse::{ChainSetup, GaugeProbe, Joint, simulate_chain};
 use shpb::solver::{self, CollisionResult, CollisionSetup, ForceDrivenSetup, ForceHistory};
@@ -21,7 +21,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 fn rel(a: f64, b: f64) -> f64 {

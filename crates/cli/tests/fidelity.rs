@@ -2,15 +2,15 @@
 //! that agree with each other, explicit knobs that win over presets, and the observed order of
 //! the DEM collision (velocity Verlet with a trapezoidal dashpot: second order).
 
-use shpb::prelude::*;
 use shpb::convergence::{observed_order, richardson, study};
 use shpb::fidelity::Fidelity;
+use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")).join(path)
 }
 
 /// f(h) = f0 + c h² sampled at h, h/2, h/4 has order exactly 2 and extrapolates to f0.
@@ -97,7 +97,7 @@ fn collision_converges_at_second_order() {
 fn cli_fidelity_flag_and_convergence_errors() {
     let bin = env!("CARGO_BIN_EXE_shpb");
     let out = Command::new(bin)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .args(["run", "scenes/shpb-ss440c-10psi.toml", "--fidelity", "fast"])
         .output()
         .unwrap();
@@ -114,7 +114,7 @@ fn cli_fidelity_flag_and_convergence_errors() {
     // The summary prints 7 significant digits.
     assert!((dt * c0 / 4e-3 - 1.0).abs() < 1e-6, "Δt = {dt}");
     let out = Command::new(bin)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .args(["convergence", "scenes/quasistatic-fig2.toml"])
         .output()
         .unwrap();

@@ -3,12 +3,12 @@
 //! 2013-05-22 records, the digitiser's quantisation, clipping and noise, pulse metrics, and the
 //! gauge-file and record-file errors.
 
-use shpb::prelude::*;
 use shpb::Error;
 use shpb::gauge::{
     Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup, RawRecord,
     authors_stress_from_voltage, pulse_metrics, remove_baseline,
 };
+use shpb::prelude::*;
 use shpb::validate::gauge_records::SAMPLES;
 use std::path::{Path, PathBuf};
 
@@ -25,7 +25,7 @@ const KINDS: [BridgeKind; 3] = [
 ];
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 /// The eight raw records of 2013-05-22 (fixtures copied with credit), sample number and path.

@@ -7,16 +7,16 @@
 //! file runs in well under a second in release; proptest turns any panic inside a property into a
 //! failure and shrinks it.
 
-use shpb::prelude::*;
 use proptest::prelude::*;
+use shpb::csv::CsvTable;
 use shpb::error::Error;
 use shpb::gauge::RawRecord;
-use shpb::csv::CsvTable;
+use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 fn scenes_dir() -> PathBuf {

@@ -2,8 +2,8 @@
 //! `pulse` scene, against elementary wave theory, energy conservation and the gun's own curve;
 //! and the errors a user gets for bad set-up files and pressures.
 
-use shpb::prelude::*;
 use shpb::apparatus::Apparatus;
+use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
 use shpb::striker::{GasGun, PSI_PA};
 use shpb::units::parse_pressure;
@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 fn authors() -> Apparatus {
@@ -214,9 +214,7 @@ fn gun_command_prints_velocity_and_refuses_out_of_range() {
     assert!(ok.status.success());
     let text = String::from_utf8_lossy(&ok.stdout);
     let a = authors();
-    let v = a
-        .striker_velocity_m_s(10.0 * PSI_PA)
-        .unwrap();
+    let v = a.striker_velocity_m_s(10.0 * PSI_PA).unwrap();
     assert!(text.contains(&format!("{v:.4} m/s")), "{text}");
     for bad in ["45psi", "2psi", "-3psi", "10 psi!", "nan"] {
         let out = shpb(&["gun", "--pressure", bad]);

@@ -4,11 +4,11 @@
 //! calibration itself and the full comparison: examples/calibrate_pulse.rs,
 //! validation/pulse/REPORT.md.
 
-use shpb::prelude::*;
 use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb::bar::Dispersion;
 use shpb::gauge::{PulseMetrics, pulse_metrics};
 use shpb::numeric::resample;
+use shpb::prelude::*;
 use shpb::shaper::PulseShaper;
 use shpb::solver::pulse::simulate_chain;
 use shpb::striker::PSI_PA;
@@ -22,7 +22,7 @@ const TOL_RISE: f64 = 0.20;
 const TOL_DURATION: f64 = 0.20;
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 /// Metrics of the incident pulse of a record, read as the calibration reads it
@@ -76,9 +76,7 @@ fn shipped_gun_and_shaper_match_every_incident_record() {
     let sims: Vec<PulseMetrics> = PRESSURES_PSI
         .iter()
         .map(|&psi| {
-            let v = a
-                .striker_velocity_m_s(psi * PSI_PA)
-                .unwrap();
+            let v = a.striker_velocity_m_s(psi * PSI_PA).unwrap();
             let (t, s) = simulate(&a, v, shaper);
             pulse_metrics(&t, &s, false).expect("simulated pulse")
         })

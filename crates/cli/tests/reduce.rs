@@ -6,25 +6,25 @@
 //! reduction (peak back force within 15 % for at least 6 of 8 records; sample 1 at half);
 //! (e) `reduce_command` on a raw record and on a `shpb run` HDF5 file, its outputs and errors.
 
-use shpb::prelude::*;
 use shpb::Error;
 use shpb::apparatus::Apparatus;
 use shpb::cmd::reduce::reduce_command;
 use shpb::csv::CsvTable;
 use shpb::gauges::reduce_record_file;
 use shpb::io::write_hdf5;
-use shpb::run::{GaugeTrace, RunOutput};
+use shpb::prelude::*;
 use shpb::reduce::{
     BarProperties, ReductionInput, ReductionOptions, ReductionSetup, WindowOverride,
     bancroft_phase_velocity_m_s, bancroft_velocity_ratio, dispersion_delay_s, dispersion_shift,
     implied_incident, reduce,
 };
+use shpb::run::{GaugeTrace, RunOutput};
 use shpb::validate::gauge_records::SAMPLES;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
 fn authors() -> Apparatus {
@@ -554,7 +554,10 @@ fn implied_incident_pulse_of_an_unshaped_test_is_the_strikers_square_pulse() {
     // implied by the simulated contact force and approach alone must be that pulse: what lets
     // the Fig. 4 records tell how they were shot (validation/fig4-virtual-shpb/REPORT.md).
     let scene = root().join("validation/fig4-virtual-shpb/ss440c-10psi-20cm-striker.toml");
-    let none = [("dispersion".to_string(), shpb::scene::Value::String("none".into()))];
+    let none = [(
+        "dispersion".to_string(),
+        shpb::scene::Value::String("none".into()),
+    )];
     let out = shpb::scene::Params::from_file_overridden(&scene, &none)
         .unwrap()
         .run()

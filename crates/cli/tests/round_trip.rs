@@ -10,7 +10,7 @@ use std::path::PathBuf;
 #[test]
 fn reduction_of_simulated_records_recovers_the_true_contact() {
     for m in ["ss440c", "ss302", "al2017"] {
-        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
             .join(format!("validation/fig4-virtual-shpb/{m}-12p5psi.toml"));
         let params = Params::from_file(&path).unwrap();
         let SceneParams::Pulse { apparatus, .. } = &params.params else {

@@ -6,7 +6,7 @@ use shpb::scene::Params;
 use std::path::{Path, PathBuf};
 
 fn scene(name: &str) -> Params {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .join("validation/fig4-virtual-shpb")
         .join(name);
     Params::from_file(&p).unwrap()
@@ -85,7 +85,8 @@ fn spheres_load_and_unload_once_and_leave_a_permanent_flattening() {
 
 #[test]
 fn every_shipped_test_scene_runs() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("validation/fig4-virtual-shpb");
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("validation/fig4-virtual-shpb");
     let mut n = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let p = entry.unwrap().path();

@@ -8,7 +8,8 @@ use shpb::sweep::{overrides, parse_axis, parse_shard, product, run_points, shard
 use std::path::PathBuf;
 
 fn scene() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/shpb-ss440c-10psi.toml")
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("scenes/shpb-ss440c-10psi.toml")
 }
 
 fn axes() -> Vec<shpb::sweep::Axis> {

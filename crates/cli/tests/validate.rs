@@ -9,7 +9,7 @@ use std::sync::OnceLock;
 /// One context for the whole file, so the virtual SHPB runs are shared by two cases.
 fn context() -> &'static Context {
     static CTX: OnceLock<Context> = OnceLock::new();
-    CTX.get_or_init(|| Context::new(env!("CARGO_MANIFEST_DIR")))
+    CTX.get_or_init(|| Context::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../..")))
 }
 
 fn passes(case: &str) {

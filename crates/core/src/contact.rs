@@ -634,7 +634,11 @@ mod tests {
         };
         assert!(jump(&smooth) < 2e-3, "smooth jump {}", jump(&smooth));
         // docs/physics.md §1: the paper's form jumps by 13–17 % for the paper's materials.
-        assert!(jump(&published) > 0.10, "published jump {}", jump(&published));
+        assert!(
+            jump(&published) > 0.10,
+            "published jump {}",
+            jump(&published)
+        );
     }
 
     #[test]
@@ -650,7 +654,10 @@ mod tests {
             max_relative = 1e-12
         );
         let independent = BurgoyneDaraio::new(ss440c(), false);
-        assert_eq!(independent.loading_force(d, 1e4), independent.loading_force(d, 0.0));
+        assert_eq!(
+            independent.loading_force(d, 1e4),
+            independent.loading_force(d, 0.0)
+        );
     }
 
     #[test]

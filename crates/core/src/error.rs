@@ -172,7 +172,10 @@ mod tests {
     fn range_checks_name_the_quantity_and_reject_nan() {
         assert_eq!(in_range("x_m", 0.5, 0.0, 1.0, "m"), Ok(0.5));
         let e = in_range("x_m", f64::NAN, 0.0, 1.0, "m").unwrap_err();
-        assert!(e.to_string().starts_with("x_m: NaN is not a finite number"), "{e}");
+        assert!(
+            e.to_string().starts_with("x_m: NaN is not a finite number"),
+            "{e}"
+        );
         assert!(positive("r_m", 0.0, 1.0, "m").is_err());
         assert!(positive("r_m", 2.0, 1.0, "m").is_err());
         assert_eq!(positive("r_m", 1.0, 1.0, "m"), Ok(1.0));
@@ -180,7 +183,8 @@ mod tests {
         assert_eq!(bar.key("length_m"), "segments[0].length_m");
         let e = bar.positive("length_m", -1.0, 10.0, "m").unwrap_err();
         assert!(
-            e.to_string().starts_with("bar incident: `segments[0].length_m`: "),
+            e.to_string()
+                .starts_with("bar incident: `segments[0].length_m`: "),
             "{e}"
         );
     }

@@ -27,7 +27,6 @@
 //! polarity (compression → positive V, tension-positive σ) its second-order term would have the
 //! wrong sign for any Wheatstone bridge, which confirms the records' polarity.
 
-
 /// Which gauges the Wheatstone bridge has (module docs give each output formula).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BridgeKind {

@@ -1,6 +1,5 @@
 //! Sphere materials (paper Table I) with Johnson–Cook rate hardening (paper Eq. 2, plus sign).
 
-
 /// Johnson–Cook rate hardening of the yield stress, `σy* = σy (1 + C ln(ε̇/ε̇0))` (paper Eq. 2 with
 /// the sign corrected as in the authors' code, docs/physics.md §2).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,4 +50,3 @@ impl Material {
         self.youngs_modulus_pa / (1.0 - self.poisson_ratio * self.poisson_ratio)
     }
 }
-

@@ -926,4 +926,3 @@ pub fn record_strains(
         transmission_strain: tra.strains_from_voltages(&debias(&record.transmission_v, n)),
     })
 }
-

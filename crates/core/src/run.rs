@@ -73,7 +73,6 @@ impl RunOutput {
     }
 }
 
-
 // The reduction input of a run lives with the run, so that `reduce` does not depend on `run`.
 impl ReductionInput {
     /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`
@@ -92,4 +91,3 @@ impl ReductionInput {
         })
     }
 }
-

@@ -7,9 +7,9 @@ use crate::bar::Dispersion;
 use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
 use crate::error::Result;
 use crate::fidelity::Fidelity;
+use crate::numeric::resample;
 use crate::run::{RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
-use crate::numeric::resample;
 use crate::specimen::SpherePair;
 
 /// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
@@ -470,4 +470,3 @@ fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
     }
     v
 }
-

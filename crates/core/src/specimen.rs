@@ -88,4 +88,3 @@ impl SpherePair {
         m1 * m2 / (m1 + m2)
     }
 }
-

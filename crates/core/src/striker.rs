@@ -50,17 +50,8 @@ impl GasGun {
 
     /// Striker velocity at gauge pressure `p_gauge_pa` for a striker of mass `mass_kg` and bore
     /// `area_m2`; an error names the allowed pressure range if p is outside it or too low to fire.
-    pub fn velocity_m_s(
-        &self,
-        p_gauge_pa: f64,
-        mass_kg: f64,
-        area_m2: f64,
-    ) -> Result<f64> {
-        let allowed = check_range(
-            p_gauge_pa,
-            self.min_pressure_pa,
-            self.max_pressure_pa,
-        )?;
+    pub fn velocity_m_s(&self, p_gauge_pa: f64, mass_kg: f64, area_m2: f64) -> Result<f64> {
+        let allowed = check_range(p_gauge_pa, self.min_pressure_pa, self.max_pressure_pa)?;
         let ke = self.kinetic_energy_j(p_gauge_pa, area_m2);
         if ke <= 0.0 {
             return Err(Error::invalid(
@@ -77,11 +68,7 @@ impl GasGun {
 }
 
 /// Checks a gauge pressure against the gun's range; returns the range text for later errors.
-fn check_range(
-    p_gauge_pa: f64,
-    min_pa: f64,
-    max_pa: f64,
-) -> Result<String> {
+fn check_range(p_gauge_pa: f64, min_pa: f64, max_pa: f64) -> Result<String> {
     let allowed = format!(
         "{:.3} to {:.3} psi ({:.0} to {:.0} Pa gauge)",
         min_pa / PSI_PA,
@@ -141,17 +128,11 @@ impl Gun {
 
     /// Striker velocity at gauge pressure `p_gauge_pa` (striker mass and bore for the adiabatic model);
     /// an out-of-range pressure is an [`Error::Invalid`] naming the range.
-    pub fn striker_velocity_m_s(
-        &self,
-        p_gauge_pa: f64,
-        mass_kg: f64,
-        area_m2: f64,
-    ) -> Result<f64> {
+    pub fn striker_velocity_m_s(&self, p_gauge_pa: f64, mass_kg: f64, area_m2: f64) -> Result<f64> {
         match self {
             Gun::Adiabatic(g) => g.velocity_m_s(p_gauge_pa, mass_kg, area_m2),
             Gun::Linear(g) => {
-                let allowed =
-                    check_range(p_gauge_pa, g.min_pressure_pa, g.max_pressure_pa)?;
+                let allowed = check_range(p_gauge_pa, g.min_pressure_pa, g.max_pressure_pa)?;
                 let v2 = g.k_m2_per_s2_per_pa * (p_gauge_pa - g.loss_pressure_pa);
                 if v2 <= 0.0 {
                     return Err(Error::invalid(

@@ -25,7 +25,10 @@ pub const GAUGES: &[(&str, &str)] = &[(
 /// The text of the built-in set-up `name` (also accepted: `bars/<name>.toml`, `<name>.toml`, as
 /// the repository's copies are written in scenes).
 pub fn setup(name: &str) -> Option<&'static str> {
-    SETUPS.iter().find(|(n, _, _)| *n == name).map(|(_, t, _)| *t)
+    SETUPS
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .map(|(_, t, _)| *t)
 }
 
 /// The text of the built-in gauge file `name`.

@@ -6,7 +6,9 @@ use crate::error::{Error, Result, Validator};
 use serde::Deserialize;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup, RawRecord};
-use shpb_core::reduce::{Reduction, ReductionOptions, ReductionSetup, record_strains, reduce_named};
+use shpb_core::reduce::{
+    Reduction, ReductionOptions, ReductionSetup, record_strains, reduce_named,
+};
 use std::path::Path;
 
 /// One `[[channel]]` table of a gauge file, before validation.
@@ -237,4 +239,3 @@ pub fn reduce_record_file(
     )
     .map_err(Error::from)
 }
-

@@ -16,6 +16,7 @@ pub mod material;
 pub mod scene;
 pub mod setup;
 pub mod specimen;
+mod toml_file;
 pub mod units;
 
 pub use error::{Error, Result, Validator};

@@ -105,9 +105,7 @@ impl ApparatusFile for Apparatus {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file = path.display().to_string();
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        Apparatus::from_toml(&text, &file, &|g: &str| {
-            GaugeSetup::from_file(base.join(g))
-        })
+        Apparatus::from_toml(&text, &file, &|g: &str| GaugeSetup::from_file(base.join(g)))
     }
 
     fn resolve(reference: &str, base_dir: &Path) -> Result<Apparatus> {
@@ -139,7 +137,7 @@ impl ApparatusFile for Apparatus {
         gauges: &dyn Fn(&str) -> Result<GaugeSetup>,
     ) -> Result<Apparatus> {
         let file = file.to_string();
-        let raw: ApparatusToml = toml::from_str(&text).map_err(|e| Error::Parse {
+        let raw: ApparatusToml = toml::from_str(text).map_err(|e| Error::Parse {
             file: file.clone(),
             message: e.to_string(),
         })?;
@@ -330,4 +328,3 @@ impl ShaperOverride {
         shaper_from(&s, v).map(Some)
     }
 }
-

@@ -53,4 +53,3 @@ pub fn cli_pressure(text: &str) -> Result<f64> {
         allowed: PRESSURE_SYNTAX.into(),
     })
 }
-

@@ -20,12 +20,7 @@ pub fn vlu(s: &str) -> VarLenUnicode {
 }
 
 /// Writes a string attribute.
-pub fn string_attr(
-    loc: &hdf5::Location,
-    name: &str,
-    value: &str,
-    file: &Path,
-) -> Result<()> {
+pub fn string_attr(loc: &hdf5::Location, name: &str, value: &str, file: &Path) -> Result<()> {
     loc.new_attr::<VarLenUnicode>()
         .shape(())
         .create(name)

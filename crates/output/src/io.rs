@@ -9,12 +9,6 @@ pub use crate::atomic::{check_output, write_atomically, write_text_atomically};
 pub use crate::h5::{h5err, string_attr, vlu, write_dataset};
 use std::path::Path;
 
-
-
-
-
-
-
 /// The `/contact` datasets of a series: (name, data, units), absent ones skipped.
 pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static str)> {
     let mut cols = Vec::new();
@@ -118,7 +112,6 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
     })
 }
 
-
 /// Writes a run as CSV with one header line (units in the column names): the contact series,
 /// or for bar scenes the time axis with each gauge's strain and voltage.
 pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
@@ -157,4 +150,3 @@ pub fn csv_name(name: &str, unit: &str) -> String {
     };
     format!("{name}_{u}")
 }
-

@@ -1,10 +1,10 @@
 //! PNG plots with plotters: force–displacement curves (as in the paper's Figs. 2–4).
 
-use shpb_input::{Error, Result};
 use crate::atomic::write_atomically;
+use plotters::prelude::*;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
-use plotters::prelude::*;
+use shpb_input::{Error, Result};
 use std::path::Path;
 
 /// One curve of a plot: label, x values, y values, and whether to draw it dashed (measured data).
@@ -558,7 +558,6 @@ fn plot_test(
         &fields,
     )
 }
-
 
 /// One line of a [`loglog_plot`]: points (x, y > 0) and an RGB colour.
 #[derive(Debug, Clone)]

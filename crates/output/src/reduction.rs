@@ -158,4 +158,3 @@ pub fn write_reduction_csv(path: &Path, force: bool, r: &Reduction) -> Result<()
     }
     write_text_atomically(path, force, &text)
 }
-

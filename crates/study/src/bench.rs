@@ -2,11 +2,11 @@
 //! price of the physics knobs, and memory against bar length.
 
 use crate::convergence::{metrics, rms_difference, signal};
-use shpb_input::{Error, Result};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -94,7 +94,10 @@ fn row(label: &str, runtime_s: f64, out: &RunOutput, reference: &RunOutput) -> R
 /// per timing (the reference preset runs once). `progress` receives a line per step.
 pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Result<Bench> {
     let load = |f: Fidelity, extra: &[(&str, shpb_input::scene::Value)]| -> Result<Params> {
-        let mut set = vec![("fidelity".to_string(), shpb_input::scene::Value::String(f.name().into()))];
+        let mut set = vec![(
+            "fidelity".to_string(),
+            shpb_input::scene::Value::String(f.name().into()),
+        )];
         set.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
         Params::from_file_overridden(path, &set)
     };

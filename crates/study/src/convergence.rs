@@ -3,10 +3,10 @@
 //! time, and the observed order of convergence (Roache, *Verification and Validation in
 //! Computational Science and Engineering*, 1998: p = ln(e₂₁/e₃₂)/ln r for a refinement ratio r).
 
-use shpb_input::{Error, Result};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
 
@@ -258,7 +258,10 @@ pub fn study(path: &Path, mut progress: impl FnMut(usize, f64)) -> Result<Study>
     let mut runs = Vec::new();
     for (i, value) in knob.ladder().into_iter().enumerate() {
         progress(i, value);
-        let set = [(knob.key().to_string(), shpb_input::scene::Value::Float(value))];
+        let set = [(
+            knob.key().to_string(),
+            shpb_input::scene::Value::Float(value),
+        )];
         let params = Params::from_file_overridden(path, &set)?;
         let start = Instant::now();
         let out = params.run()?;

@@ -1,8 +1,8 @@
 //! The study file: a sweep's HDF5 (one row per run, inputs and results), read back by `merge`
 //! and `--resume`.
 
-use shpb_input::{Error, Result};
 use hdf5::types::VarLenUnicode;
+use shpb_input::{Error, Result};
 use shpb_output::io::{h5err, string_attr, vlu, write_atomically, write_dataset};
 use std::path::Path;
 /// Writes a sweep: root attributes `shpb_version`, `scene` (the scene text) and `sweep` (the

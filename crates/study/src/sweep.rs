@@ -2,11 +2,11 @@
 //! (rayon), with a summary row per run (peak force, displacement at peak, peak strain rate,
 //! equilibrium ratio, time to equilibrium) and deterministic shards.
 
-use shpb_input::{Error, Result};
+use rayon::prelude::*;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::Params;
 use shpb_input::prelude::*;
-use rayon::prelude::*;
+use shpb_input::{Error, Result};
 use std::path::Path;
 
 /// One swept parameter: the scene key and its values (TOML values as the scene takes them).

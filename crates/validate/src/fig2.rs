@@ -5,10 +5,10 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, max_of, pct, read_columns, rms};
 use shpb_core::contact::{FIT_REFERENCE_RADIUS_M, FittedParameters, LoadingCurve, Region2Form};
-use shpb_input::{Error, Result};
 use shpb_core::numeric::resample;
 use shpb_core::scene::Params;
 use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::fmt::Write as _;
 
 /// Yield stresses of the Fig. 2 FEM runs, MPa (`validation/fig2-quasistatic/sy<MPa>MPa.*`).

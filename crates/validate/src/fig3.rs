@@ -5,9 +5,9 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, max_of, read_columns, rms};
 use shpb_core::contact::BurgoyneDaraio;
-use shpb_input::Result;
 use shpb_core::numeric::resample;
 use shpb_core::scene::Params;
+use shpb_input::Result;
 use shpb_input::prelude::*;
 use std::fmt::Write as _;
 

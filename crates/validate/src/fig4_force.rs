@@ -4,11 +4,11 @@
 
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, pct, rms};
-use shpb_input::Result;
 use shpb_core::numeric::resample;
 use shpb_core::scene::{Params, SceneParams, compare_fig4};
-use shpb_input::prelude::*;
 use shpb_core::solver::{self, ForceHistory};
+use shpb_input::Result;
+use shpb_input::prelude::*;
 use std::fmt::Write as _;
 
 /// (label, scene stem in `validation/fig4-force-driven/`) of the eight Fig. 4 experiments.

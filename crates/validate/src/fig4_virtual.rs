@@ -7,12 +7,12 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::gauge_records::SAMPLES;
 use crate::{CaseResult, Check, Context, Unit, VirtualRun};
-use shpb_core::apparatus::Apparatus;
-use shpb_input::{Error, Result};
-use shpb_core::scene::{Params, SceneParams};
-use shpb_input::prelude::*;
-use shpb_core::solver;
 use rayon::prelude::*;
+use shpb_core::apparatus::Apparatus;
+use shpb_core::scene::{Params, SceneParams};
+use shpb_core::solver;
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::fmt::Write as _;
 
 /// (label, scene stem, stem of the Fig. 4 record of the same material and pressure in

@@ -1,9 +1,9 @@
 //! Multi-panel PNG figures of the validation report: model lines over reference data (dashed or
 //! markers), as in the paper's Figs. 2–4.
 
+use plotters::prelude::*;
 use shpb_input::{Error, Result};
 use shpb_output::io::write_atomically;
-use plotters::prelude::*;
 use std::path::Path;
 
 /// How a series is drawn; the number picks a colour of the palette (0 is the paper's dark red of

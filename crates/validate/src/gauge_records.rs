@@ -2,13 +2,13 @@
 //! raw records of 2013-05-22 (same material and gun pressure): incident, reflected and
 //! transmitted pulse peaks and the transmitted pulse's arrival (physics.md §6–7).
 
-use shpb_input::prelude::*;
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, pct};
 use shpb_core::apparatus::Apparatus;
-use shpb_input::{Error, Result};
 use shpb_core::gauge::{PulseMetrics, RawRecord, pulse_metrics};
 use shpb_core::reduce::record_strains;
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -6,10 +6,10 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit};
 use shpb_core::contact::{LoadingCurve, hertz_force};
-use shpb_input::{Error, Result};
 use shpb_core::scene::{Params, SceneParams};
-use shpb_input::prelude::*;
 use shpb_core::solver;
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
 use std::fmt::Write as _;
 
 /// Scenes of `validation/hertz-analytic/` with a label.

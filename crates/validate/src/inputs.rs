@@ -1,14 +1,14 @@
 //! The report's list of adjustable inputs that are not in the paper, with value and reason,
 //! read from the shipped files (`bars/authors.toml`, `bars/gauges-authors.toml`, `specimens/`).
 
-use shpb_input::prelude::*;
 use crate::Context;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::contact::Region2Form;
-use shpb_input::Result;
 use shpb_core::material::Material;
 use shpb_core::scene::AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S;
 use shpb_core::striker::{Gun, PSI_PA};
+use shpb_input::Result;
+use shpb_input::prelude::*;
 use std::fmt::Write as _;
 
 /// The markdown section "Adjustable inputs not in the paper".

@@ -16,8 +16,8 @@ mod hertz;
 mod inputs;
 mod restitution;
 
-use shpb_input::{Error, Result};
 use shpb_core::run::RunOutput;
+use shpb_input::{Error, Result};
 use shpb_output::io::check_output;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -221,12 +221,32 @@ pub struct VirtualRun {
     pub output: RunOutput,
 }
 
+/// The reference data built into the library (`build.rs`): the repository's `validation/`
+/// (`*.toml`, `*.csv`), `bars/*.toml` and `specimens/*.toml`, as (path relative to the
+/// repository root, contents).
+pub mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/embedded.rs"));
+}
+
 /// Where the cases find `validation/` and `bars/`, and runs shared between cases.
 #[derive(Debug)]
 pub struct Context {
-    /// Repository root (holds `validation/`, `bars/`).
+    /// Repository root (holds `validation/`, `bars/`): a checkout, or the temporary directory the
+    /// embedded data was written to.
     pub root: PathBuf,
     virtual_runs: Mutex<Option<Arc<Vec<VirtualRun>>>>,
+    /// The temporary directory of [`Context::embedded`], removed with the context.
+    temporary: Option<TemporaryRoot>,
+}
+
+/// A directory removed (with its contents) when dropped.
+#[derive(Debug)]
+struct TemporaryRoot(PathBuf);
+
+impl Drop for TemporaryRoot {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }
 
 impl Context {
@@ -235,31 +255,64 @@ impl Context {
         Context {
             root: root.into(),
             virtual_runs: Mutex::new(None),
+            temporary: None,
         }
     }
 
-    /// The repository root: the current directory if it holds `validation/` and `bars/`, else the
-    /// source tree this binary was built from; an input error if neither does.
-    pub fn locate() -> Result<Context> {
-        let has = |d: &Path| d.join("validation").is_dir() && d.join("bars").is_dir();
-        let cwd = std::env::current_dir().map_err(|e| Error::io(Path::new("."), e))?;
-        if has(&cwd) {
-            return Ok(Context::new(cwd));
+    /// A context for the reference data of `shpb validate --data DIR`: `dir` must hold
+    /// `validation/` and `bars/` (a checkout of the repository); an input error naming `--data`
+    /// otherwise.
+    pub fn from_dir(dir: impl Into<PathBuf>) -> Result<Context> {
+        let dir = dir.into();
+        let missing: Vec<&str> = ["validation", "bars"]
+            .into_iter()
+            .filter(|d| !dir.join(d).is_dir())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::Input {
+                file: "command line".into(),
+                key: "--data".into(),
+                problem: format!(
+                    "no {} folder{} in {}",
+                    missing
+                        .iter()
+                        .map(|d| format!("`{d}/`"))
+                        .collect::<Vec<_>>()
+                        .join(" and "),
+                    if missing.len() > 1 { "s" } else { "" },
+                    dir.display()
+                ),
+                allowed: "a directory holding `validation/` and `bars/` (the shpb repository \
+                          root), or no --data for the reference data built into shpb"
+                    .into(),
+            });
         }
-        let built = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-        if has(&built) {
-            return Ok(Context::new(built));
+        Ok(Context::new(dir))
+    }
+
+    /// A context for the reference data built into the program ([`embedded::FILES`]), written
+    /// to a fresh temporary directory (`shpb-validate-<pid>-<nanos>` in the system's temporary
+    /// directory) that is removed when the context is dropped.
+    pub fn embedded() -> Result<Context> {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
+        let dir =
+            std::env::temp_dir().join(format!("shpb-validate-{}-{nanos}", std::process::id()));
+        std::fs::create_dir(&dir).map_err(|e| Error::io(&dir, e))?;
+        // Owned from here on: an error below removes what was written.
+        let temporary = TemporaryRoot(dir.clone());
+        for (relative, bytes) in embedded::FILES {
+            let path = dir.join(relative);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
+            }
+            std::fs::write(&path, bytes).map_err(|e| Error::io(&path, e))?;
         }
-        Err(Error::Input {
-            file: "command line".into(),
-            key: "validate".into(),
-            problem: format!(
-                "no `validation/` and `bars/` folders in {} (nor in {})",
-                cwd.display(),
-                built.display()
-            ),
-            allowed: "run `shpb validate` from the shpb repository root".into(),
-        })
+        let mut ctx = Context::new(dir);
+        ctx.temporary = Some(temporary);
+        Ok(ctx)
     }
 
     /// A path below the repository root.
@@ -508,16 +561,32 @@ pub fn write_report(dir: &Path, force: bool, results: &[CaseResult], ctx: &Conte
     shpb_output::io::write_text_atomically(&path, force, &md)
 }
 
-/// `shpb validate [CASE…] [--report DIR] [--force]`: runs the cases, prints the table, writes
-/// the report when asked; an error when a check fails (exit code 1) or a case name is unknown (2).
+/// `shpb validate [CASE…] [--report DIR] [--force]` with the reference data built into the
+/// program: see [`command_with_data`].
 pub fn command(names: &[String], report: Option<&Path>, force: bool) -> Result<()> {
+    command_with_data(names, None, report, force)
+}
+
+/// `shpb validate [CASE…] [--data DIR] [--report DIR] [--force]`: runs the cases on the
+/// reference data of `data` ([`Context::from_dir`]) or, without it, on the data built into the
+/// program ([`Context::embedded`]), prints the table, writes the report when asked; an error
+/// when a check fails (exit code 1) or a case name or `--data` is wrong (2).
+pub fn command_with_data(
+    names: &[String],
+    data: Option<&Path>,
+    report: Option<&Path>,
+    force: bool,
+) -> Result<()> {
     let cases = select_cases(names)?;
     if let Some(dir) = report {
         for p in report_files(dir, &cases) {
             check_output(&p, force)?;
         }
     }
-    let ctx = Context::locate()?;
+    let ctx = match data {
+        Some(dir) => Context::from_dir(dir)?,
+        None => Context::embedded()?,
+    };
     let mut results = Vec::new();
     for name in &cases {
         results.push(run_case(name, &ctx)?);

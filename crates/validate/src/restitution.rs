@@ -2,14 +2,14 @@
 //! the elastic Hertz law; for the paper's law (Eq. 1 loading, Thornton unloading, physics.md §3)
 //! at most 1, falling with impact speed, with the energy lost equal to the contact's ∮F dδ.
 
-use shpb_input::prelude::*;
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit};
 use shpb_core::contact::{ContactLaw, LawKind, Region2Form};
-use shpb_input::Result;
 use shpb_core::material::Material;
 use shpb_core::solver::{self, CollisionSetup};
 use shpb_core::specimen::SpherePair;
+use shpb_input::Result;
+use shpb_input::prelude::*;
 use std::fmt::Write as _;
 
 /// Impact speeds of the plastic sweep, m/s.

@@ -1,3 +1,15 @@
-//! The subcommands of `shpb`, one file each.
+//! The subcommands of `shpb`, one file each, and the helpers they share ([`common`]).
 
+pub mod bench;
+pub mod common;
+pub mod convergence;
+pub mod curve;
+pub mod gun;
+pub mod incident;
+pub mod list;
+pub mod merge;
 pub mod reduce;
+pub mod run;
+pub mod strain;
+pub mod sweep;
+pub mod validate;

@@ -1,44 +1,19 @@
 //! `shpb reduce`: the lab's reduction of a raw record or of a run file.
 
-use shpb_core::apparatus::Apparatus;
+use super::common::{input_err, load_apparatus, require_bars, say};
 use shpb_core::reduce::{PAPER_SPHERE_RADII_M, ReductionOptions, ReductionSetup, reduce_named};
+use shpb_input::Result;
 use shpb_input::gauges::reduce_record_file;
-use shpb_input::prelude::*;
-use shpb_input::{Error, Result};
-use shpb_output::reduction::{is_hdf5, read_hdf5_strains, write_reduction_csv, write_reduction_hdf5};
-use std::io::Write;
+use shpb_output::reduction::{
+    is_hdf5, read_hdf5_strains, write_reduction_csv, write_reduction_hdf5,
+};
 use std::path::Path;
 
-fn input_err(
-    file: &str,
-    key: &str,
-    problem: impl Into<String>,
-    allowed: impl Into<String>,
-) -> Error {
-    Error::Input {
-        file: file.to_string(),
-        key: key.to_string(),
-        problem: problem.into(),
-        allowed: allowed.into(),
-    }
-}
-
-/// Prints a line on stdout; a closed pipe is not an error.
-fn say(line: &str) -> Result<()> {
-    let stdout = std::io::stdout();
-    let mut w = stdout.lock();
-    match writeln!(w, "{line}") {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(Error::io(Path::new("stdout"), e))
-        }
-        _ => Ok(()),
-    }
-}
-
-/// `shpb reduce RECORD --bars BARS [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
+/// `shpb reduce RECORD --bars SET-UP [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
 /// reduces a raw record (the authors' CSV) or an HDF5 file of `shpb run` (recognised by its
-/// signature) with the set-up's bars and gauges, writes `/reduction/*` (HDF5) and/or CSV, and
-/// prints a summary. The strain rate uses the paper's spheres (r1 + r2 = 6.35 mm).
+/// signature) with the set-up's bars and gauges (`bars`: a built-in set-up name or a set-up
+/// file), writes `/reduction/*` (HDF5) and/or CSV, and prints a summary. The strain rate uses
+/// the paper's spheres (r1 + r2 = 6.35 mm).
 pub fn reduce_command(
     record: &Path,
     bars: &Path,
@@ -50,14 +25,7 @@ pub fn reduce_command(
     for p in [output, csv].into_iter().flatten() {
         shpb_output::io::check_output(p, force)?;
     }
-    if !bars.is_file() {
-        return Err(input_err(
-            "command line",
-            "--bars",
-            format!("cannot read {}: no such file", bars.display()),
-            "a bar set-up .toml file such as bars/authors.toml",
-        ));
-    }
+    require_bars(bars)?;
     if !record.is_file() {
         return Err(input_err(
             "command line",
@@ -66,7 +34,7 @@ pub fn reduce_command(
             "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
         ));
     }
-    let apparatus = Apparatus::from_file(bars)?;
+    let apparatus = load_apparatus(bars)?;
     let options = ReductionOptions {
         dispersion_correction: !no_dispersion,
         specimen_radii_m: Some(PAPER_SPHERE_RADII_M),

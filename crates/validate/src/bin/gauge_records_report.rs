@@ -1,35 +1,46 @@
 //! Regenerates `validation/gauge-records/REPORT.md` and `validation/gauge-records/*.png`: the
-//! reduction (src/reduce.rs) of the eight 2013-05-22 records against the authors' own
-//! reductions, the bridge configuration that explains the records, and an analysis of the
-//! displacement differences (sign, window alignment, integration start).
-//! Run with `cargo run --release --example gauge_records_report`.
+//! reduction (crates/core/src/reduce.rs) of the eight 2013-05-22 records against the authors'
+//! own reductions, the bridge configuration that explains the records, and an analysis of the
+//! displacement differences (sign, window alignment, integration start). Run from the repository
+//! root with `cargo run --release -p shpb-validate --bin gauge_records_report`.
 
-use shpb::apparatus::Apparatus;
-use shpb::gauge::{BridgeKind, RawRecord};
-use shpb::io::CsvTable;
-use shpb::plot::{Axes, Curve, xy_plot};
-use shpb::reduce::{
+#![warn(missing_docs)]
+
+mod common;
+
+use shpb_core::apparatus::Apparatus;
+use shpb_core::gauge::{BridgeKind, RawRecord};
+use shpb_core::numeric::argmax;
+use shpb_core::reduce::{
     Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
-    reduce_record_file,
 };
-use shpb::validate::gauge_records::SAMPLES;
+use shpb_input::csv::CsvTable;
+use shpb_input::gauges::reduce_record_file;
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
+use shpb_output::plot::{Axes, Curve, xy_plot};
+use shpb_validate::gauge_records::SAMPLES;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The acceptance tolerance on the peak back force.
 const TOLERANCE: f64 = 0.15;
 
 /// The authors' reduction of one record.
 struct Authors {
+    /// Displacement, m.
     x: Vec<f64>,
+    /// Back force, N.
     f: Vec<f64>,
+    /// Index of the largest force.
     k_peak: usize,
     /// Largest value of the 11-sample running median (spike-free peak).
     f_peak_median: f64,
 }
 
 impl Authors {
-    fn read(path: &Path) -> shpb::Result<Authors> {
+    /// Reads an `_authors_reduction.csv`.
+    fn read(path: &Path) -> Result<Authors> {
         let t = CsvTable::read(path)?;
         let x = t.column("displacement_m")?.to_vec();
         let f = t.column("force_N")?.to_vec();
@@ -50,18 +61,14 @@ impl Authors {
             f_peak_median,
         })
     }
+    /// Their peak force, N.
     fn f_peak(&self) -> f64 {
         self.f[self.k_peak]
     }
+    /// Their displacement at peak force, m.
     fn x_peak(&self) -> f64 {
         self.x[self.k_peak]
     }
-}
-
-fn argmax(v: &[f64]) -> usize {
-    (0..v.len())
-        .max_by(|&a, &b| v[a].total_cmp(&v[b]))
-        .unwrap_or(0)
 }
 
 /// How the authors' reduction sits on the record, found by least squares (module docs of the
@@ -69,18 +76,26 @@ fn argmax(v: &[f64]) -> usize {
 /// incident and reflected window starts `p`, `q` and the sign of the transmission term from their
 /// displacement rate.
 struct AuthorsFit {
+    /// Transmitted window start, record index.
     m: usize,
+    /// Their strain scale relative to ours.
     scale: f64,
+    /// RMS residual of the force fit, relative to their peak.
     force_rms: f64,
+    /// Incident window start, record index.
     p: usize,
+    /// Reflected window start, record index.
     q: usize,
     /// +1: their δ is u_front + u_back; −1: u_front − u_back.
     sign: f64,
+    /// RMS residual of the displacement-rate fit with that sign, relative to its largest rate.
     rate_rms: f64,
     /// The other sign's best residual.
     rate_rms_other: f64,
 }
 
+/// Fits the authors' reduction `a` with our strains `eps_i`, `eps_t` (see [`AuthorsFit`]); `ea`
+/// is the transmission bar's E A, `c0` its wave speed, `dt` the sample interval.
 fn fit_authors(eps_i: &[f64], eps_t: &[f64], ea: f64, c0: f64, dt: f64, a: &Authors) -> AuthorsFit {
     let n = eps_t.len();
     let l = a.f.len();
@@ -179,25 +194,40 @@ fn literal(a: &Apparatus) -> Apparatus {
     b
 }
 
+/// Everything the report says about one record.
 struct Row {
+    /// Sample number.
     n: usize,
+    /// Specimen material, as labelled.
     material: &'static str,
+    /// Gun pressure, psi.
     psi: f64,
+    /// Our reduction (defaults).
     ours: Reduction,
+    /// Our reduction without dispersion correction.
     ours_nodisp: Reduction,
+    /// Peak back force read with the authors' formula literally, N.
     literal_peak: f64,
+    /// The authors' reduction.
     authors: Authors,
+    /// How the authors' reduction sits on the record.
     fit: AuthorsFit,
-    /// δ at peak force of our reduction with one of the authors' conventions at a time.
+    /// δ at peak force of our reduction with one of the authors' conventions at a time: their
+    /// sign, their window delays, their integration start, their strain scale.
     with_sign: f64,
+    /// (See `with_sign`.)
     with_alignment: f64,
+    /// (See `with_sign`.)
     with_start: f64,
+    /// (See `with_sign`.)
     with_scale: f64,
     /// All of their conventions: δ at their peak-force index, and the curve.
     all_at_their_peak: f64,
+    /// (δ, F) of our reduction with all of their conventions.
     all_curve: (Vec<f64>, Vec<f64>),
     /// u_front ± u_back at the end of their window with all their conventions (sign +, −).
     end_plus: f64,
+    /// (See `end_plus`.)
     end_minus: f64,
     /// Our reduction with the reflected window on the record's reflected foot.
     record_aligned: Reduction,
@@ -205,8 +235,8 @@ struct Row {
     their_start_s: f64,
 }
 
-fn main() -> shpb::Result<()> {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+fn main() -> Result<()> {
+    let root = common::repo_root();
     let out_dir = root.join("validation/gauge-records");
     let bars = root.join("bars/authors.toml");
     let app = Apparatus::from_file(&bars)?;
@@ -249,7 +279,7 @@ fn main() -> shpb::Result<()> {
         let their_start = t[fit.p];
         let their_r = (fit.q - fit.p) as f64 * dt;
         let their_t = (fit.m - fit.p) as f64 * dt;
-        let with = |w: WindowOverride| -> shpb::Result<Reduction> {
+        let with = |w: WindowOverride| -> Result<Reduction> {
             reduce(
                 &input,
                 &setup,
@@ -258,6 +288,7 @@ fn main() -> shpb::Result<()> {
                     ..default
                 },
             )
+            .map_err(Error::from)
         };
         let at_peak = |r: &Reduction| r.displacement_m[r.peak_index];
         let with_sign = ours.front_displacement_m[ours.peak_index]
@@ -368,16 +399,18 @@ fn main() -> shpb::Result<()> {
 
     let md = report(&rows, &app)?;
     let path = out_dir.join("REPORT.md");
-    std::fs::write(&path, md).map_err(|e| shpb::Error::io(&path, e))?;
+    std::fs::write(&path, md).map_err(|e| Error::io(&path, e))?;
     println!("wrote {} and {} plots", path.display(), rows.len());
     Ok(())
 }
 
+/// A time or a displacement in µs or µm, one decimal.
 fn us(x: f64) -> String {
     format!("{:.1}", x * 1e6)
 }
 
-fn report(rows: &[Row], app: &Apparatus) -> shpb::Result<String> {
+/// The text of REPORT.md.
+fn report(rows: &[Row], app: &Apparatus) -> Result<String> {
     let mut md = String::new();
     let w = &mut md;
     let inc = app.gauges.channel("incident").expect("incident channel");
@@ -399,8 +432,8 @@ fn report(rows: &[Row], app: &Apparatus) -> shpb::Result<String> {
     );
     let _ = writeln!(
         w,
-        "Generated by `cargo run --release --example gauge_records_report` \
-         (examples/gauge_records_report.rs); do not edit by hand. Records and the authors' reductions: \
+        "Generated by `cargo run --release -p shpb-validate --bin gauge_records_report` \
+         (crates/validate/src/bin/gauge_records_report.rs); do not edit by hand. Records and the authors' reductions: \
          `validation/gauge-records/data/` (Daraio-lab/Burgoyne_PRE_2014, CC-BY 4.0). The same \
          reduction is `shpb reduce RECORD --bars bars/authors.toml -o OUT.h5`.\n"
     );
@@ -877,6 +910,7 @@ fn onset(x: &[f64], f: &[f64]) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// Mean of the values (0 for none).
 fn mean(it: impl Iterator<Item = f64>) -> f64 {
     let v: Vec<f64> = it.collect();
     v.iter().sum::<f64>() / v.len().max(1) as f64

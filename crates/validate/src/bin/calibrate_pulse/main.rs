@@ -1,31 +1,42 @@
 //! Calibrates the gas gun and the copper pulse shaper of `bars/authors.toml` against the incident
 //! gauge records of 2013-05-22 (samples 1–8) and writes `validation/pulse/REPORT.md` and one
-//! overlay plot per sample, `validation/pulse/sample<N>.png`:
-//! `cargo run --release --example calibrate_pulse` (≈ 2.5 min on two cores);
-//! `cargo run --release --example calibrate_pulse -- --shipped` evaluates the shipped values only.
+//! overlay plot per sample, `validation/pulse/sample<N>.png`. Run from the repository root:
+//! `cargo run --release -p shpb-validate --bin calibrate_pulse` (≈ 2.5 min on two cores);
+//! `cargo run --release -p shpb-validate --bin calibrate_pulse -- --shipped` evaluates the
+//! shipped values only.
 //!
 //! * **Records.** The incident channel is converted to bar stress with the shipped gauge channel
 //!   (exact bridge inverse, baseline = mean of the first 900 samples), compression positive.
 //!   Metrics of the first pulse, −10 to 250 µs after the trigger: peak, 10–90 % rise, duration at 10 % of peak
-//!   (`shpb::gauge::pulse_metrics`, raw samples, no filtering), and the pulse's energy.
+//!   (`shpb_core::gauge::pulse_metrics`, raw samples, no filtering), and the pulse's energy.
 //! * **Model.** `Apparatus::pulse_chain`: striker → Frew–Forrestal–Chen shaper → incident bar →
 //!   transmission bar pressed against it, 1 mm cells, 2 mm gauge grid, no dispersion (what
 //!   `run_pulse` does); the noise-free gauge strain at 10 MHz, σ = −E ε.
-//! * **Fit.** Nelder–Mead (written here) on Σ over records of (relative error / tolerance)² of
+//! * **Fit.** Nelder–Mead ([`nelder_mead`]) on Σ over records of (relative error / tolerance)² of
 //!   peak (15 %), rise (20 %), duration (20 %) and pulse energy (20 %). Stage 1 frees one striker
 //!   velocity per pressure (to test the gun law); stage 2 ties the velocities to
 //!   v² = k (p − p_loss) and gives the shipped values. Comparison fits show what that rests on.
 
+#![warn(missing_docs)]
+
+#[path = "../common/mod.rs"]
+mod common;
+mod nelder_mead;
+
+use nelder_mead::nelder_mead;
 use rayon::prelude::*;
-use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
-use shpb::bar::Dispersion;
-use shpb::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
-use shpb::plot::{Axes, Curve, xy_plot};
-use shpb::scene::resample;
-use shpb::shaper::PulseShaper;
-use shpb::solver::pulse::simulate_chain;
-use shpb::striker::{Gun, PSI_PA};
-use shpb::validate::gauge_records::{
+use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
+use shpb_core::bar::Dispersion;
+use shpb_core::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
+use shpb_core::numeric::{bisect, moving_average, resample};
+use shpb_core::shaper::PulseShaper;
+use shpb_core::solver::pulse::simulate_chain;
+use shpb_core::striker::Gun;
+use shpb_input::Validator;
+use shpb_input::prelude::*;
+use shpb_input::units::PSI_PA;
+use shpb_output::plot::{Axes, Curve, xy_plot};
+use shpb_validate::gauge_records::{
     BASELINE_SAMPLES, INCIDENT_WINDOW_S as WINDOW_S, SAMPLES, incident_pulse,
 };
 use std::fmt::Write as _;
@@ -35,15 +46,18 @@ use std::path::PathBuf;
 const PRESSURES_PSI: [f64; 3] = [10.0, 12.5, 15.0];
 /// Tolerances of the issue: peak, rise 10–90 %, duration at 10 %.
 const TOL: [f64; 3] = [0.15, 0.20, 0.20];
+/// Names of the three metrics, in the order of [`TOL`].
 const METRIC_NAMES: [&str; 3] = ["peak", "rise 10–90 %", "duration at 10 %"];
 /// Tolerance (weight) of the pulse energy in the objective: that of the issue's shape metrics.
 const ENERGY_TOL: f64 = 0.20;
-/// Cell size and gauge grid of the calibration runs (the `pulse` scene's defaults), m.
+/// Cell size of the calibration runs (the `pulse` scene's default), m.
 const CELL_M: f64 = 1e-3;
+/// Gauge grid of the calibration runs (the `pulse` scene's default), m.
 const GAUGE_LENGTH_M: f64 = 2e-3;
 
+/// The repository root (see [`common::repo_root`]).
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    common::repo_root()
 }
 
 /// One record's incident pulse: times (s), compression-positive stress (Pa), metrics.
@@ -222,82 +236,6 @@ fn score(records: &[Record], sims: &[Simulated]) -> Score {
 
 fn score_of(a: &Apparatus, records: &[Record], m: &Model) -> Score {
     score(records, &run_model(a, m))
-}
-
-/// Nelder–Mead simplex minimisation (Nelder & Mead, Comput. J. 7, 308 (1965); coefficients
-/// reflection 1, expansion 2, contraction ½, shrink ½). Returns the best point, its value and the
-/// evaluations used. Stops after `max_evals` or when the simplex's values agree to `ftol`.
-fn nelder_mead(
-    f: &mut dyn FnMut(&[f64]) -> f64,
-    x0: &[f64],
-    step: &[f64],
-    max_evals: usize,
-    ftol: f64,
-) -> (Vec<f64>, f64, usize) {
-    let n = x0.len();
-    let mut pts: Vec<Vec<f64>> = vec![x0.to_vec()];
-    for i in 0..n {
-        let mut p = x0.to_vec();
-        p[i] += step[i];
-        pts.push(p);
-    }
-    let mut vals: Vec<f64> = pts.iter().map(|p| f(p)).collect();
-    let mut evals = n + 1;
-    let along = |c: &[f64], w: &[f64], t: f64| -> Vec<f64> {
-        c.iter().zip(w).map(|(ci, wi)| ci + t * (wi - ci)).collect()
-    };
-    while evals < max_evals {
-        let mut order: Vec<usize> = (0..=n).collect();
-        order.sort_by(|&i, &j| vals[i].total_cmp(&vals[j]));
-        pts = order.iter().map(|&i| pts[i].clone()).collect();
-        vals = order.iter().map(|&i| vals[i]).collect();
-        if (vals[n] - vals[0]).abs() <= ftol * (1.0 + vals[0].abs()) {
-            break;
-        }
-        let centroid: Vec<f64> = (0..n)
-            .map(|d| pts[..n].iter().map(|p| p[d]).sum::<f64>() / n as f64)
-            .collect();
-        let xr = along(&centroid, &pts[n], -1.0);
-        let fr = f(&xr);
-        evals += 1;
-        if fr < vals[0] {
-            let xe = along(&centroid, &pts[n], -2.0);
-            let fe = f(&xe);
-            evals += 1;
-            if fe < fr {
-                (pts[n], vals[n]) = (xe, fe);
-            } else {
-                (pts[n], vals[n]) = (xr, fr);
-            }
-        } else if fr < vals[n - 1] {
-            (pts[n], vals[n]) = (xr, fr);
-        } else {
-            // Outside contraction if the reflection improved on the worst, inside otherwise.
-            let (xc, fc) = if fr < vals[n] {
-                let x = along(&centroid, &pts[n], -0.5);
-                let v = f(&x);
-                (x, v)
-            } else {
-                let x = along(&centroid, &pts[n], 0.5);
-                let v = f(&x);
-                (x, v)
-            };
-            evals += 1;
-            if fc < vals[n].min(fr) {
-                (pts[n], vals[n]) = (xc, fc);
-            } else {
-                for i in 1..=n {
-                    pts[i] = along(&pts[0], &pts[i], 0.5);
-                    vals[i] = f(&pts[i]);
-                }
-                evals += n;
-            }
-        }
-    }
-    let best = (0..=n)
-        .min_by(|&i, &j| vals[i].total_cmp(&vals[j]))
-        .unwrap_or(0);
-    (pts[best].clone(), vals[best], evals)
 }
 
 /// A free shaper parameter.
@@ -493,38 +431,36 @@ fn rounded(m: &Model) -> (Model, f64, f64) {
     (r, k, loss)
 }
 
-/// Root of a function increasing on [lo, hi] by bisection.
-fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) < 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+/// Root of a function increasing on [lo, hi]: the midpoint of the bracket after 100 halvings
+/// (no early stop), keeping the upper half where `f(mid) < 0`.
+fn root_of_increasing(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
+    let (lo, hi) = bisect(lo, hi, 100, |_, _| false, |x| f(x) < 0.0);
     0.5 * (lo + hi)
 }
 
 /// The shaper's strain where its elastic line meets the flow curve (E ε = σ_flow(ε)), and its
 /// largest strain: where the loading force σ(ε) A0/(1 − ε) reaches the peak force in the bar.
 fn shaper_strains(s: &PulseShaper, peak_force_n: f64) -> (f64, f64) {
-    let yield_strain = bisect(
+    let yield_strain = root_of_increasing(
         |e| s.youngs_modulus_pa * e - s.flow_stress_pa(e),
         1e-9,
         0.99,
     );
     let force =
         |e: f64| (s.youngs_modulus_pa * e).min(s.flow_stress_pa(e)) * s.area_m2() / (1.0 - e);
-    (yield_strain, bisect(|e| force(e) - peak_force_n, 0.0, 0.99))
+    (
+        yield_strain,
+        root_of_increasing(|e| force(e) - peak_force_n, 0.0, 0.99),
+    )
 }
 
 /// The shipped model: the gun's velocities at the three pressures and the shaper of the file.
 fn shipped_model(a: &Apparatus) -> Model {
-    let v = shpb::error::Validator::new(a.source.clone());
+    let v = Validator::new(a.source.clone());
     Model {
         velocity_m_s: PRESSURES_PSI.map(|psi| {
-            a.striker_velocity_m_s(psi * PSI_PA, &v, "pressure")
+            a.striker_velocity_m_s(psi * PSI_PA)
+                .map_err(v.core("pressure"))
                 .expect("shipped gun covers 10-15 psi")
         }),
         shaper: a.shaper.expect("shipped shaper"),
@@ -549,20 +485,10 @@ fn us(x: f64) -> String {
     format!("{:.1}", x * 1e6)
 }
 
-/// Centred moving average over 2·`half` + 1 samples.
-fn smooth(y: &[f64], half: usize) -> Vec<f64> {
-    (0..y.len())
-        .map(|i| {
-            let (lo, hi) = (i.saturating_sub(half), (i + half + 1).min(y.len()));
-            y[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
-        })
-        .collect()
-}
-
 /// Shape diagnostics of a pulse, on a 1.1 µs moving average (11 samples) so that the records'
 /// noise does not decide them: (time at ≥ 90 % of peak, fall from 90 % to 10 %), s.
 fn plateau_and_fall(t: &[f64], y: &[f64]) -> (f64, f64) {
-    let ys = smooth(y, 5);
+    let ys = moving_average(y, 5);
     let Some((k, &p)) = ys.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) else {
         return (f64::NAN, f64::NAN);
     };
@@ -799,7 +725,7 @@ fn main() {
     let _ = writeln!(
         w,
         "# Incident pulse calibration: gas gun and copper pulse shaper\n\n\
-         Generated by `cargo run --release --example calibrate_pulse` (examples/calibrate_pulse.rs, ≈ 2.5 min on two cores); do not \
+         Generated by `cargo run --release -p shpb-validate --bin calibrate_pulse` (crates/validate/src/bin/calibrate_pulse/, ≈ 2.5 min on two cores); do not \
          edit by hand. `-- --shipped` evaluates bars/authors.toml without fitting.{}\n",
         if only_shipped {
             " **This report comes from such a run.**"
@@ -964,7 +890,7 @@ fn main() {
     if !rows.is_empty() {
         let _ = writeln!(
             w,
-            "## How it was fitted\n\nNelder–Mead simplex (written in the example; restarted from the best point with a \
+            "## How it was fitted\n\nNelder–Mead simplex (calibrate_pulse/nelder_mead.rs; restarted from the best point with a \
              smaller simplex until it stops improving) on the logarithms of the free parameters, bounded by a penalty \
              (diameter 1–19 mm, thickness 0.2–8 mm, σ0 0.05–3 GPa, E 0.5–130 GPa, n 0.1–0.8, m 1.5–10, \
              0 ≤ p_loss < the gun's smallest pressure, velocities 0.5–100 m/s). The three pressures are simulated in \

@@ -1,0 +1,267 @@
+//! `kind = "force-driven"`: the paper's Fig. 4 DEM, a measured force history (CSV) drives sphere 1
+//! and sphere 2 rests on a medium of impedance Z.
+
+use super::{
+    Key, LAW, LawKindToml, OUTPUT_EVERY, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind,
+    check_every, one,
+};
+use crate::csv::CsvTable;
+use crate::error::{Error, Result, Validator};
+use crate::specimen::SpecimenSpec;
+use crate::toml_file::parse_as;
+use serde::Deserialize;
+use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::fidelity::Fidelity;
+use shpb_core::scene::{AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S, SceneParams};
+use shpb_core::solver::{self, ForceDrivenSetup, ForceHistory};
+use std::path::Path;
+
+/// The registry entry.
+pub(super) const KIND: SceneKind = SceneKind {
+    name: "force-driven",
+    help: "paper Fig. 4 DEM: a CSV force history drives sphere 1, sphere 2 rests on a medium of impedance Z",
+    keys: &[
+        SPECIMEN,
+        LAW,
+        REGION2,
+        Key {
+            key: "force_csv",
+            unit: "",
+            default: "required",
+            meaning: "CSV of the drive (time and force columns, optional displacement_m: the measured approach the model is compared with), relative to the scene file",
+        },
+        Key {
+            key: "time_column",
+            unit: "",
+            default: "time_s",
+            meaning: "name of the CSV's time column (s)",
+        },
+        Key {
+            key: "force_column",
+            unit: "",
+            default: "force_N",
+            meaning: "name of the CSV's force column (N)",
+        },
+        Key {
+            key: "medium_impedance_kg_s",
+            unit: "kg/s",
+            default: "1.12e4 (the authors' transmission bar)",
+            meaning: "impedance Z = ρc0A of the medium sphere 2 rests on, 0 to 1e9",
+        },
+        Key {
+            key: "time_step_s",
+            unit: "s",
+            default: "from steps_per_period",
+            meaning: "time step; at most the stability limit 1/ω of the contact at the peak drive force",
+        },
+        Key {
+            key: "steps_per_period",
+            unit: "",
+            default: "fidelity: 200, 2000, 20000",
+            meaning: "time steps per contact period, 10 to 1e8",
+        },
+        Key {
+            key: "end_time_s",
+            unit: "s",
+            default: "the CSV's last time",
+            meaning: "end of the run: greater than 0, at most 1 s and 5e8 time steps",
+        },
+        OUTPUT_EVERY,
+    ],
+    example: "kind = \"force-driven\"\nforce_csv = \"validation/fig4-force-driven/data/ss440c_10psi_force10.csv\"\nspecimen = { pair = \"ss440c\" }\n",
+    example_dir: Some("."),
+    parse,
+};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ForceDrivenFile {
+    #[allow(dead_code)]
+    kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
+    specimen: SpecimenSpec,
+    #[serde(default, with = "LawKindToml")]
+    law: LawKind,
+    #[serde(default, with = "Region2Toml")]
+    region2: Region2Form,
+    force_csv: String,
+    #[serde(default = "default_time_column")]
+    time_column: String,
+    #[serde(default = "default_force_column")]
+    force_column: String,
+    #[serde(default = "default_impedance")]
+    medium_impedance_kg_s: f64,
+    time_step_s: Option<f64>,
+    steps_per_period: Option<f64>,
+    end_time_s: Option<f64>,
+    #[serde(default = "one")]
+    output_every: usize,
+}
+
+fn default_time_column() -> String {
+    "time_s".into()
+}
+
+fn default_force_column() -> String {
+    "force_N".into()
+}
+
+fn default_impedance() -> f64 {
+    AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S
+}
+
+fn parse(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    fidelity: Fidelity,
+    v: &Validator,
+) -> Result<Parsed> {
+    let sv = v.table("specimen");
+    let f: ForceDrivenFile = parse_as(text, file)?;
+    let pair = f.specimen.build(base_dir, &sv)?;
+    let csv_path = base_dir.join(&f.force_csv);
+    let table = CsvTable::read(&csv_path).map_err(|e| match e {
+        Error::Io { source, .. } => v.error(
+            "force_csv",
+            format!("cannot read {}: {source}", csv_path.display()),
+            "a readable CSV file, absolute or relative to the scene file's directory",
+        ),
+        other => other,
+    })?;
+    let t = table.time_column(&f.time_column)?.to_vec();
+    let force = table.column(&f.force_column)?.to_vec();
+    let measured_displacement_m = table.optional_column("displacement_m").map(<[f64]>::to_vec);
+    let drive = ForceHistory {
+        time_s: t,
+        force_n: force,
+    };
+    let z = v.in_range(
+        "medium_impedance_kg_s",
+        f.medium_impedance_kg_s,
+        0.0,
+        1e9,
+        "kg/s",
+    )?;
+    let n = v.in_range(
+        "steps_per_period",
+        f.steps_per_period.unwrap_or(fidelity.dem_steps()),
+        10.0,
+        1e8,
+        "",
+    )?;
+    let peak = drive.peak_n().max(1e-3);
+    let limit = solver::stability_limit(&pair, peak);
+    let dt = match f.time_step_s {
+        Some(dt) => v.positive("time_step_s", dt, limit, "s (the stability limit 1/ω of this contact at the peak drive force, solver::stability_limit)")?,
+        None => solver::default_time_step(&pair, peak, z, n),
+    };
+    let last = *drive
+        .time_s
+        .last()
+        .expect("time column has at least two samples");
+    let end = match f.end_time_s {
+        Some(e) => v.positive("end_time_s", e, 1.0, "s")?,
+        None => last,
+    };
+    if end / dt > 5e8 {
+        return Err(v.error(
+            "end_time_s",
+            format!("{end:e} s needs {:.1e} steps of {dt:e} s", end / dt),
+            "at most 5e8 steps",
+        ));
+    }
+    let setup = ForceDrivenSetup {
+        drive,
+        medium_impedance_kg_s: z,
+        dt_s: dt,
+        end_time_s: end,
+        output_every: check_every(v, f.output_every)?,
+    };
+    Ok((
+        pair,
+        f.law,
+        f.region2,
+        SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m,
+        },
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn repo() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    }
+
+    #[test]
+    fn registry_entry() {
+        super::super::check_kind(&KIND, &[]);
+        let steps = Fidelity::ALL.map(|f| f.dem_steps().to_string()).join(", ");
+        assert_eq!(KIND.keys[8].default, format!("fidelity: {steps}"));
+        assert!(
+            KIND.keys[6]
+                .default
+                .starts_with(&format!("{:.2e} ", default_impedance()))
+        );
+        assert_eq!(KIND.keys[4].default, default_time_column());
+        assert_eq!(KIND.keys[5].default, default_force_column());
+    }
+
+    #[test]
+    fn example_reads_the_whole_csv() {
+        let v = Validator::new("example.toml");
+        let (_, _, _, p) = parse(
+            KIND.example,
+            "example.toml",
+            &repo(),
+            Fidelity::Standard,
+            &v,
+        )
+        .unwrap();
+        let SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m,
+        } = p
+        else {
+            panic!("not force-driven: {p:?}")
+        };
+        let csv = CsvTable::read(
+            &repo().join("validation/fig4-force-driven/data/ss440c_10psi_force10.csv"),
+        )
+        .unwrap();
+        assert_eq!(setup.drive.time_s, csv.time_column("time_s").unwrap());
+        assert_eq!(setup.drive.force_n, csv.column("force_N").unwrap());
+        assert_eq!(
+            measured_displacement_m.as_deref(),
+            csv.optional_column("displacement_m")
+        );
+        assert_eq!(setup.end_time_s, *setup.drive.time_s.last().unwrap());
+        assert_eq!(
+            setup.medium_impedance_kg_s,
+            AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S
+        );
+    }
+
+    #[test]
+    fn a_missing_csv_names_the_key() {
+        let v = Validator::new("f.toml");
+        let e = parse(
+            KIND.example,
+            "f.toml",
+            Path::new("/nonexistent"),
+            Fidelity::Fast,
+            &v,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("f.toml: `force_csv`: cannot read /nonexistent/validation/"),
+            "{e}"
+        );
+    }
+}

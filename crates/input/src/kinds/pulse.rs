@@ -1,0 +1,355 @@
+//! `kind = "pulse"`: striker, shaper and bars without a specimen (the gauge signals of the bar
+//! set-up). Also the parser of [`super::shpb`], which is the same scene with spheres between the
+//! bars: [`parse_bars`] with `is_test`.
+
+use super::{Key, LawKindToml, Parsed, Region2Toml, SceneKind};
+use crate::error::{Result, Validator};
+use crate::material::MaterialFile;
+use crate::setup::{ApparatusFile, ShaperOverride};
+use crate::specimen::SpecimenSpec;
+use crate::toml_file::parse_as;
+use serde::Deserialize;
+use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
+use shpb_core::bar::Dispersion;
+use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::fidelity::Fidelity;
+use shpb_core::scene::SceneParams;
+use shpb_core::specimen::SpherePair;
+use std::path::Path;
+
+/// The registry entry.
+pub(super) const KIND: SceneKind = SceneKind {
+    name: "pulse",
+    help: "striker, shaper and bars without specimen: the gauge signals of the bar set-up",
+    keys: &[
+        BARS,
+        PRESSURE,
+        SHAPER,
+        CELL_SIZE,
+        Key {
+            key: "incident_end",
+            unit: "",
+            default: "transmission",
+            meaning: "what the incident bar's end meets: transmission (the transmission bar pressed against it), free or absorbing",
+        },
+        DISPERSION,
+        END_TIME,
+        GAUGE_LENGTH,
+    ],
+    example: "kind = \"pulse\"\nbars = \"authors\"\npressure = \"10psi\"\n",
+    example_dir: None,
+    parse,
+};
+
+/// `bars = "..."` (pulse and shpb).
+pub(super) const BARS: Key = Key {
+    key: "bars",
+    unit: "",
+    default: "required",
+    meaning: "the bar set-up: a built-in one (authors, authors-20cm-striker) or a set-up .toml file, relative to the scene file",
+};
+
+/// `pressure = "..."` (pulse and shpb).
+pub(super) const PRESSURE: Key = Key {
+    key: "pressure",
+    unit: "psi, Pa, kPa, MPa or bar",
+    default: "required",
+    meaning: "gas-gun gauge pressure with its unit, e.g. \"10psi\" (within the set-up gun's range)",
+};
+
+/// `[shaper]` (pulse and shpb).
+pub(super) const SHAPER: Key = Key {
+    key: "shaper",
+    unit: "",
+    default: "the set-up's shaper",
+    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), diameter_m, thickness_m, sigma0_pa, n, m, youngs_modulus_pa",
+};
+
+/// `cell_size_m` (pulse and shpb).
+pub(super) const CELL_SIZE: Key = Key {
+    key: "cell_size_m",
+    unit: "m",
+    default: "fidelity: 4e-3, 1e-3, 1.25e-4",
+    meaning: "cell size of the bar grid (Δt = Δx/c0, Courant 1), 1e-5 to 0.05",
+};
+
+/// `dispersion` (pulse and shpb).
+pub(super) const DISPERSION: Key = Key {
+    key: "dispersion",
+    unit: "",
+    default: "fidelity: none, none, love-rod",
+    meaning: "bar theory: none (elementary) or love-rod (lateral inertia)",
+};
+
+/// `end_time_s` (pulse and shpb).
+pub(super) const END_TIME: Key = Key {
+    key: "end_time_s",
+    unit: "s",
+    default: "until the incident pulse has passed its gauge, reflected and passed it again",
+    meaning: "end of the run: greater than 0, at most 0.1 s",
+};
+
+/// `gauge_length_m` (pulse and shpb).
+pub(super) const GAUGE_LENGTH: Key = Key {
+    key: "gauge_length_m",
+    unit: "m",
+    default: "2e-3",
+    meaning: "grid length of the strain gauges (they read the mean strain over it), 0 to 0.05",
+};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PulseFile {
+    #[allow(dead_code)]
+    kind: String,
+    #[allow(dead_code)]
+    fidelity: Option<String>,
+    specimen: Option<SpecimenSpec>,
+    #[serde(default, with = "LawKindToml")]
+    law: LawKind,
+    #[serde(default, with = "Region2Toml")]
+    region2: Region2Form,
+    bars: String,
+    pressure: String,
+    #[serde(default)]
+    shaper: ShaperOverride,
+    cell_size_m: Option<f64>,
+    #[serde(default = "default_incident_end")]
+    incident_end: String,
+    dispersion: Option<String>,
+    end_time_s: Option<f64>,
+    #[serde(default = "default_gauge_length")]
+    gauge_length_m: f64,
+}
+
+fn default_gauge_length() -> f64 {
+    2e-3
+}
+
+fn default_incident_end() -> String {
+    "transmission".into()
+}
+
+fn parse(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    fidelity: Fidelity,
+    v: &Validator,
+) -> Result<Parsed> {
+    parse_bars(text, file, base_dir, fidelity, v, false)
+}
+
+/// The parser of `pulse` (`is_test` false: no specimen allowed, `incident_end` chosen) and of
+/// `shpb` (`is_test` true: a specimen required, the incident bar ends at it, x–t snapshots).
+pub(super) fn parse_bars(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    fidelity: Fidelity,
+    v: &Validator,
+    is_test: bool,
+) -> Result<Parsed> {
+    let sv = v.table("specimen");
+    let f: PulseFile = parse_as(text, file)?;
+    let specimen = match (&f.specimen, is_test) {
+        (Some(spec), true) => Some(shpb_core::apparatus::SpecimenSetup {
+            pair: spec.build(base_dir, &sv)?,
+            law: f.law,
+            region2: f.region2,
+        }),
+        (None, true) => {
+            return Err(v.error(
+                "specimen",
+                "missing",
+                "a [specimen] table (pair = \"ss440c\", or sphere1/sphere2)",
+            ));
+        }
+        (Some(_), false) => {
+            return Err(v.error(
+                "specimen",
+                "a pulse scene has no specimen",
+                "kind = \"shpb\" for a test with spheres",
+            ));
+        }
+        (None, false) => None,
+    };
+    let set_up = base_dir.join(&f.bars);
+    if crate::builtin::setup(&f.bars).is_none() && !set_up.is_file() {
+        return Err(v.error(
+            "bars",
+            format!("cannot read {}: no such file", set_up.display()),
+            format!(
+                "a built-in set-up ({}) or a bar set-up .toml file, relative to the scene file",
+                crate::builtin::setup_names()
+            ),
+        ));
+    }
+    let apparatus = Apparatus::resolve(&f.bars, base_dir)?;
+    let pressure_pa = crate::units::pressure_from_text(&f.pressure, v, "pressure")?;
+    let velocity = apparatus
+        .striker_velocity_m_s(pressure_pa)
+        .map_err(v.core("pressure"))?;
+    let shaper = f.shaper.apply(apparatus.shaper, &v.table("shaper"))?;
+    let end = match f.incident_end.as_str() {
+        _ if is_test => IncidentEnd::Specimen,
+        "transmission" => IncidentEnd::Transmission,
+        "free" => IncidentEnd::Free,
+        "absorbing" => IncidentEnd::Absorbing,
+        other => {
+            return Err(v.error(
+                "incident_end",
+                format!("unknown end `{other}`"),
+                "transmission, free, absorbing",
+            ));
+        }
+    };
+    let knobs = fidelity.bar_knobs();
+    let dispersion = match f.dispersion.as_deref() {
+        None => knobs.dispersion,
+        Some("none") => Dispersion::None,
+        Some("love-rod") => Dispersion::LoveRod,
+        Some(other) => {
+            return Err(v.error(
+                "dispersion",
+                format!("unknown model `{other}`"),
+                "none, love-rod",
+            ));
+        }
+    };
+    let cell = v.in_range(
+        "cell_size_m",
+        f.cell_size_m.unwrap_or(knobs.cell_size_m),
+        1e-5,
+        0.05,
+        "m",
+    )?;
+    let c0 = apparatus.material.wave_speed_m_s();
+    let gauge_d = apparatus
+        .gauges
+        .channels
+        .iter()
+        .map(|c| c.distance_from_specimen_m)
+        .fold(0.0, f64::max);
+    // Default: the incident pulse passes its gauge, reflects and passes it again.
+    let default_end = (apparatus.incident.length_m + gauge_d) / c0
+        + 4.0 * apparatus.striker.length_m / c0
+        + 200e-6;
+    let end_time_s = match f.end_time_s {
+        Some(e) => v.positive("end_time_s", e, 0.1, "s")?,
+        None => default_end,
+    };
+    let gauge_length_m = v.in_range("gauge_length_m", f.gauge_length_m, 0.0, 0.05, "m")?;
+    let options = PulseOptions {
+        specimen: specimen.clone(),
+        striker_velocity_m_s: velocity,
+        shaper,
+        end,
+        cell_size_m: cell,
+        dispersion,
+        end_time_s,
+        gauge_length_m,
+        snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
+    };
+    // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
+    for spec in &apparatus.pulse_chain(&options).bars {
+        shpb_core::bar::Bar::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
+    }
+    // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads.
+    let pair = match specimen {
+        Some(sp) => sp.pair,
+        None => {
+            SpherePair::paper(shpb_core::material::Material::builtin("ss440c").expect("built-in"))
+        }
+    };
+    Ok((
+        pair,
+        f.law,
+        f.region2,
+        SceneParams::Pulse {
+            apparatus: Box::new(apparatus),
+            pressure_pa,
+            options: Box::new(options),
+        },
+    ))
+}
+
+/// Checks of the key documentation shared by pulse and shpb.
+#[cfg(test)]
+pub(super) fn check_bar_key_docs() {
+    let fmt = |f: Fidelity| {
+        let k = f.bar_knobs();
+        (
+            format!("{:e}", k.cell_size_m),
+            match k.dispersion {
+                Dispersion::None => "none",
+                Dispersion::LoveRod => "love-rod",
+            },
+        )
+    };
+    let (cells, dispersions): (Vec<String>, Vec<&str>) = Fidelity::ALL.map(fmt).into_iter().unzip();
+    assert_eq!(CELL_SIZE.default, format!("fidelity: {}", cells.join(", ")));
+    assert_eq!(
+        DISPERSION.default,
+        format!("fidelity: {}", dispersions.join(", "))
+    );
+    assert_eq!(
+        GAUGE_LENGTH.default,
+        format!("{:e}", default_gauge_length())
+    );
+    for (name, _, _) in crate::builtin::SETUPS {
+        assert!(BARS.meaning.contains(name), "bars doc lacks {name}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registry_entry() {
+        // A pulse scene accepts but refuses `specimen`, and has no use for `law` and `region2`.
+        super::super::check_kind(&KIND, &["specimen", "law", "region2"]);
+        check_bar_key_docs();
+        assert_eq!(KIND.keys[4].default, default_incident_end());
+    }
+
+    #[test]
+    fn example_values() {
+        let v = Validator::new("example.toml");
+        let (_, _, _, p) = parse(
+            KIND.example,
+            "example.toml",
+            Path::new("/nowhere"),
+            Fidelity::Standard,
+            &v,
+        )
+        .unwrap();
+        let SceneParams::Pulse {
+            pressure_pa,
+            options,
+            apparatus,
+        } = p
+        else {
+            panic!("not a pulse: {p:?}")
+        };
+        assert_eq!(pressure_pa, 10.0 * crate::units::PSI_PA);
+        assert_eq!(options.end, IncidentEnd::Transmission);
+        assert_eq!(options.specimen, None);
+        assert_eq!(options.snapshot_interval_s, None);
+        assert_eq!(options.cell_size_m, 1e-3);
+        assert_eq!(options.gauge_length_m, 2e-3);
+        assert_eq!(options.shaper, apparatus.shaper);
+    }
+
+    #[test]
+    fn a_specimen_is_refused() {
+        let v = Validator::new("p.toml");
+        let text = format!("{}specimen = {{ pair = \"ss440c\" }}\n", KIND.example);
+        let e = parse(&text, "p.toml", Path::new("."), Fidelity::Standard, &v).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p.toml: `specimen`: a pulse scene has no specimen; allowed: kind = \"shpb\" for a test with spheres"
+        );
+    }
+}

@@ -1,0 +1,92 @@
+//! `kind = "shpb"`: the whole virtual test, a pulse scene ([`super::pulse`]) with two spheres
+//! between the bars, gauges and the lab's reduction.
+
+use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
+use super::{LAW, Parsed, REGION2, SPECIMEN, SceneKind};
+use crate::error::{Result, Validator};
+use shpb_core::fidelity::Fidelity;
+use std::path::Path;
+
+/// The registry entry.
+pub(super) const KIND: SceneKind = SceneKind {
+    name: "shpb",
+    help: "the whole virtual test: gun, striker, shaper, bars, two spheres, gauges and the lab's reduction",
+    keys: &[
+        SPECIMEN,
+        LAW,
+        REGION2,
+        BARS,
+        PRESSURE,
+        SHAPER,
+        CELL_SIZE,
+        DISPERSION,
+        END_TIME,
+        GAUGE_LENGTH,
+    ],
+    example: "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nspecimen = { pair = \"ss440c\" }\n",
+    example_dir: None,
+    parse,
+};
+
+fn parse(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    fidelity: Fidelity,
+    v: &Validator,
+) -> Result<Parsed> {
+    pulse::parse_bars(text, file, base_dir, fidelity, v, true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shpb_core::apparatus::IncidentEnd;
+    use shpb_core::scene::SceneParams;
+
+    #[test]
+    fn registry_entry() {
+        // `incident_end` is accepted (a pulse scene's key) but a test's incident bar always ends
+        // at the specimen.
+        super::super::check_kind(&KIND, &["incident_end"]);
+        pulse::check_bar_key_docs();
+    }
+
+    #[test]
+    fn example_values() {
+        let v = Validator::new("example.toml");
+        let (pair, law, region2, p) = parse(
+            KIND.example,
+            "example.toml",
+            Path::new("/nowhere"),
+            Fidelity::Fast,
+            &v,
+        )
+        .unwrap();
+        let SceneParams::Pulse { options, .. } = p else {
+            panic!("not a bar scene: {p:?}")
+        };
+        assert_eq!(options.end, IncidentEnd::Specimen);
+        let specimen = options.specimen.expect("a specimen");
+        assert_eq!(
+            (specimen.pair, specimen.law, specimen.region2),
+            (pair, law, region2)
+        );
+        assert_eq!(options.cell_size_m, 4e-3);
+        assert_eq!(
+            options.snapshot_interval_s,
+            Some(Fidelity::Fast.bar_knobs().snapshot_interval_s)
+        );
+    }
+
+    #[test]
+    fn a_specimen_is_required() {
+        let v = Validator::new("s.toml");
+        let text = "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n";
+        let e = parse(text, "s.toml", Path::new("."), Fidelity::Standard, &v).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "s.toml: `specimen`: missing; allowed: a [specimen] table (pair = \"ss440c\", or sphere1/sphere2)"
+        );
+    }
+}
