@@ -221,38 +221,14 @@ impl Validator {
         }
     }
 
-    /// Checks `lo <= value <= hi` (both finite bounds inclusive) and that value is finite.
+    /// Checks `lo <= value <= hi` (both finite bounds inclusive) and that value is finite
+    /// (the core's check, reported for `key` of this file).
     pub fn in_range(&self, key: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<f64> {
-        if !value.is_finite() {
-            return Err(self.error(
-                key,
-                format!("{value} is not a finite number"),
-                format!("{lo:e} to {hi:e} {unit}"),
-            ));
-        }
-        if value < lo || value > hi {
-            return Err(self.error(
-                key,
-                format!("{value:e} {unit} is out of range"),
-                format!("{lo:e} to {hi:e} {unit}"),
-            ));
-        }
-        Ok(value)
+        shpb_core::error::in_range(key, value, lo, hi, unit).map_err(self.core(key))
     }
 
-    /// Checks `0 < value <= hi` and finite.
+    /// Checks `0 < value <= hi` and finite (the core's check, reported for `key` of this file).
     pub fn positive(&self, key: &str, value: f64, hi: f64, unit: &str) -> Result<f64> {
-        if !value.is_finite() || value <= 0.0 || value > hi {
-            return Err(self.error(
-                key,
-                if value.is_finite() {
-                    format!("{value:e} {unit} is out of range")
-                } else {
-                    format!("{value} is not a finite number")
-                },
-                format!("greater than 0 and at most {hi:e} {unit}"),
-            ));
-        }
-        Ok(value)
+        shpb_core::error::positive(key, value, hi, unit).map_err(self.core(key))
     }
 }
