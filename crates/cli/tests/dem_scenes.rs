@@ -2,7 +2,7 @@
 //! conservation, constant-rate compression, and the paper's force-driven Fig. 4 DEM against the
 //! authors' measurements (validation/fig4-force-driven/data, CC-BY 4.0).
 
-use shpb::contact::{BurgoyneDaraio, ContactLaw, LawKind};
+use shpb::contact::{BurgoyneDaraio, Contact, LawKind, Stateful};
 use shpb::material::Material;
 use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams, compare_fig4};
@@ -16,7 +16,7 @@ fn rel(a: f64, b: f64) -> f64 {
 
 fn collide(
     pair: &SpherePair,
-    law: &dyn ContactLaw,
+    law: &dyn Contact,
     speed: f64,
     steps_per_contact: f64,
 ) -> solver::CollisionResult {
@@ -37,7 +37,7 @@ fn elastic_collision_matches_hertz_theory() {
     let mut m = Material::builtin("ss440c").unwrap();
     m.yield_stress_pa = 1e15; // never yields: the law is Hertz
     let pair = SpherePair::paper(m);
-    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
     let p = pair.contact_properties();
     for speed in [0.01, 1.0, 50.0] {
         // The scene default of 2000 steps per Hertz contact time.
@@ -101,7 +101,7 @@ fn plastic_restitution_falls_with_impact_speed_and_energy_balances() {
 #[test]
 fn constant_rate_force_rises_with_rate_and_is_static_at_reference_rate() {
     let pair = SpherePair::paper(Material::builtin("ss440c").unwrap());
-    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
     let delta = 0.25e-3;
     let rates: Vec<f64> = (0..=14)
         .map(|k| 1e-3 * 10f64.powf(k as f64 * 0.5))
@@ -120,7 +120,7 @@ fn constant_rate_force_rises_with_rate_and_is_static_at_reference_rate() {
     for (d, f) in s.displacement_m.iter().zip(&s.force_n) {
         assert_eq!(
             *f,
-            law.static_curve().force(*d),
+            law.law.static_curve().force(*d),
             "at the reference rate the law is static"
         );
     }
@@ -253,7 +253,7 @@ fn force_driven_converges_in_time_step() {
 fn collision_restitution_converges_in_time_step() {
     // From 250 to 8000 steps per Hertz contact time the restitution of a plastic impact moves by < 1e-5.
     let pair = SpherePair::paper(Material::builtin("ss440c").unwrap());
-    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
     let reference = collide(&pair, &law, 5.0, 8000.0).restitution;
     for n in [250.0, 1000.0, 2000.0] {
         let e = collide(&pair, &law, 5.0, n).restitution;

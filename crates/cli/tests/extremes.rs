@@ -9,13 +9,13 @@
 //! stake); each test says why that loses nothing.
 
 use shpb::bar::{Bar, BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
-use shpb::contact::{BurgoyneDaraio, ContactLaw, Degenerate, LawKind};
+use shpb::contact::{BurgoyneDaraio, Contact, Degenerate, LawKind, Stateful};
 use shpb::error::Error;
 use shpb::material::Material;
 use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
-use shpb::solver::pulse::{ChainSetup, GaugeProbe, Joint, simulate_chain};
 use shpb::solver::{self, CollisionResult, CollisionSetup, ForceDrivenSetup, ForceHistory};
+use shpb::solver::{ChainSetup, GaugeProbe, Joint, simulate_chain};
 use shpb::specimen::{Sphere, SpherePair};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -56,7 +56,7 @@ fn hertz_tc(pair: &SpherePair, speed: f64) -> f64 {
 }
 
 /// Sphere 1 hits sphere 2 (at rest) at `speed`, `steps` time steps per Hertz contact duration.
-fn collide(law: &dyn ContactLaw, pair: &SpherePair, speed: f64, steps: f64) -> CollisionResult {
+fn collide(law: &dyn Contact, pair: &SpherePair, speed: f64, steps: f64) -> CollisionResult {
     let tc = hertz_tc(pair, speed);
     let setup = CollisionSetup {
         velocity1_m_s: speed,
@@ -174,7 +174,7 @@ fn summary_finite(out: &shpb::run::RunOutput, what: &str) {
 #[test]
 fn impact_speeds_from_1e_3_to_500_m_s_are_finite_and_create_no_energy() {
     let pair = ss440c_pair();
-    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
     let sum_r = pair.sphere1.radius_m + pair.sphere2.radius_m;
     let mut plastic_e = Vec::new();
     for speed in [1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 500.0] {
@@ -194,7 +194,7 @@ fn impact_speeds_from_1e_3_to_500_m_s_are_finite_and_create_no_energy() {
             plastic_e.push(r.restitution);
         }
         if speed == 1e-3 {
-            assert!(r.peak_force_n < 1e-2 * law.static_curve().force_y_n);
+            assert!(r.peak_force_n < 1e-2 * law.law.static_curve().force_y_n);
             assert_hertz(&r, &pair, speed, &what);
         }
     }
@@ -234,7 +234,7 @@ fn yield_stress_from_1_mpa_to_100_gpa_spans_plastic_to_pure_hertz() {
     let mut last_e = 0.0;
     for sigma_y in [1e6, 1e7, 1e8, 1e9, 1e10, 1e11] {
         let pair = SpherePair::paper(ss440c_with_yield(sigma_y));
-        let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+        let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
         let what = format!("σy = {sigma_y:e} Pa");
         let r = collide(&law, &pair, speed, 2000.0);
         assert_sound(&r, 1e-6, &what);
@@ -242,7 +242,7 @@ fn yield_stress_from_1_mpa_to_100_gpa_spans_plastic_to_pure_hertz() {
             "{what}: e = {:.4}, dissipated {:.3} of the energy, degenerate {:?}",
             r.restitution,
             r.dissipated_j / r.kinetic_energy_before_j,
-            law.static_curve().degenerate
+            law.law.static_curve().degenerate
         );
         assert!(r.restitution >= last_e - 1e-9, "{what}: e fell");
         last_e = r.restitution;
@@ -264,7 +264,7 @@ fn yield_stress_from_1_mpa_to_100_gpa_spans_plastic_to_pure_hertz() {
             );
         }
         if sigma_y == 1e11 {
-            assert_eq!(law.static_curve().degenerate, Degenerate::HertzOnly);
+            assert_eq!(law.law.static_curve().degenerate, Degenerate::HertzOnly);
             assert_hertz(&r, &pair, speed, &what);
         }
     }
@@ -283,7 +283,7 @@ fn yield_stress_from_1_mpa_to_100_gpa_spans_plastic_to_pure_hertz() {
 fn strain_rates_from_1e_6_to_1e6_per_s_use_the_static_yield_stress_up_to_the_reference_rate() {
     let pair = ss440c_pair();
     let props = pair.contact_properties();
-    let law = BurgoyneDaraio::new(props, true);
+    let law = Stateful::new(BurgoyneDaraio::new(props, true));
     let (sigma_y, c, rate0) = (
         props.yield_stress_pa,
         props.rate.c,
@@ -313,7 +313,11 @@ fn strain_rates_from_1e_6_to_1e6_per_s_use_the_static_yield_stress_up_to_the_ref
         );
         if rate <= rate0 {
             for (d, f) in s.displacement_m.iter().zip(&s.force_n) {
-                assert_eq!(*f, law.static_curve().force(*d), "ε̇ = {rate:e}, δ = {d:e}");
+                assert_eq!(
+                    *f,
+                    law.law.static_curve().force(*d),
+                    "ε̇ = {rate:e}, δ = {d:e}"
+                );
             }
         }
         let f = *s.force_n.last().unwrap();
@@ -371,12 +375,12 @@ fn very_soft_on_very_stiff_spheres_with_modulus_ratio_1000() {
     for speed in [1e-3, 0.1, 1.0, 10.0, 100.0] {
         let mut e = Vec::new();
         for pair in [&soft_on_stiff, &stiff_on_soft] {
-            let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+            let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
             let res = collide(&law, pair, speed, 2000.0);
             let what = format!("v = {speed} m/s, sphere 1 {}", pair.sphere1.material.name);
             assert_sound(&res, 1e-6, &what);
             if speed == 1e-3 {
-                assert!(res.peak_force_n < 1e-2 * law.static_curve().force_y_n);
+                assert!(res.peak_force_n < 1e-2 * law.law.static_curve().force_y_n);
                 assert_hertz(&res, pair, speed, &what);
             }
             e.push(res.restitution);
@@ -550,7 +554,7 @@ fn bar_time_step_at_0_99_runs_and_at_1_01_is_refused() {
     assert!(problem.contains("stability limit"), "{problem}");
     assert!(allowed.contains(&format!("{limit:e}")), "{allowed}");
     let chain = ChainSetup {
-        bars: vec![s],
+        bodies: vec![s.into()],
         joints: vec![],
         striker_velocity_m_s: 1.0,
         dt_s: 1.01 * limit,
@@ -602,7 +606,7 @@ fn bars_from_1_to_50_nodes_per_mm_carry_the_elementary_pulse() {
             striker.dispersion = dispersion;
             incident.dispersion = dispersion;
             let setup = ChainSetup {
-                bars: vec![striker, incident],
+                bodies: vec![striker.into(), incident.into()],
                 joints: vec![Joint::Butt],
                 striker_velocity_m_s: v,
                 dt_s: dt,
@@ -859,7 +863,7 @@ fn an_impact_past_the_stability_limit_stops_naming_step_time_and_quantity() {
 #[test]
 fn non_finite_input_and_over_limit_drives_stop_with_unstable_errors() {
     let pair = ss440c_pair();
-    let law = BurgoyneDaraio::new(pair.contact_properties(), true);
+    let law = Stateful::new(BurgoyneDaraio::new(pair.contact_properties(), true));
     let t: Vec<f64> = (0..=200).map(|k| k as f64 * 1e-6).collect();
     let mut f: Vec<f64> = t
         .iter()
@@ -911,14 +915,15 @@ fn non_finite_input_and_over_limit_drives_stop_with_unstable_errors() {
     let m = maraging();
     let dt = 1e-3 / m.wave_speed_m_s();
     let chain = ChainSetup {
-        bars: vec![
-            bar_spec("striker", &[0.1], EndCondition::Free, EndCondition::Free),
+        bodies: vec![
+            bar_spec("striker", &[0.1], EndCondition::Free, EndCondition::Free).into(),
             bar_spec(
                 "incident",
                 &[0.5],
                 EndCondition::Free,
                 EndCondition::Absorbing,
-            ),
+            )
+            .into(),
         ],
         joints: vec![Joint::Butt],
         striker_velocity_m_s: f64::NAN,

@@ -1,16 +1,13 @@
 //! The shipped gun and pulse shaper (bars/authors.toml) against the real incident gauge records
 //! of 2013-05-22 (samples 1–8): the acceptance criteria — peak within 15 %, 10–90 % rise
 //! and duration at 10 % of peak within 20 %, one parameter set for 10, 12.5 and 15 psi. The
-//! calibration itself and the full comparison: examples/calibrate_pulse.rs,
+//! calibration itself and the full comparison: `cargo run --release -p shpb-validate --bin calibrate_pulse`,
 //! validation/pulse/REPORT.md.
 
-use shpb::apparatus::{Apparatus, IncidentEnd, PulseOptions};
-use shpb::bar::Dispersion;
+use shpb::apparatus::Apparatus;
 use shpb::gauge::{PulseMetrics, pulse_metrics};
-use shpb::numeric::resample;
 use shpb::prelude::*;
 use shpb::shaper::PulseShaper;
-use shpb::solver::pulse::simulate_chain;
 use shpb::striker::PSI_PA;
 use shpb::validate::gauge_records::{SAMPLES, Sample, incident_pulse};
 use std::path::PathBuf;
@@ -38,31 +35,8 @@ fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper) -> (Vec<f64>, Vec<f64>) 
     let ch = a.gauges.channel("incident").unwrap();
     let c0 = a.material.wave_speed_m_s();
     let end = (a.incident.length_m - ch.distance_from_specimen_m) / c0 + 270e-6;
-    let setup = a.pulse_chain(&PulseOptions {
-        specimen: None,
-        striker_velocity_m_s: v,
-        shaper: Some(shaper),
-        end: IncidentEnd::Transmission,
-        cell_size_m: 1e-3,
-        dispersion: Dispersion::None,
-        end_time_s: end,
-        gauge_length_m: 2e-3,
-        snapshot_interval_s: None,
-    });
-    let k = setup
-        .gauges
-        .iter()
-        .position(|g| g.name == "incident")
-        .unwrap();
-    let r = simulate_chain(&setup).unwrap();
-    let dt = ch.digitiser.sample_interval_s();
-    let t: Vec<f64> = (0..(end / dt) as usize).map(|i| i as f64 * dt).collect();
-    let e = a.material.youngs_modulus_pa;
-    let s = resample(&r.time_s, &r.strain[k], &t)
-        .iter()
-        .map(|x| -e * x)
-        .collect();
-    (t, s)
+    let s = a.incident_signal(v, Some(shaper), 1e-3, 2e-3, end).unwrap();
+    (s.time_s, s.stress_pa)
 }
 
 fn authors() -> Apparatus {

@@ -131,8 +131,8 @@ pub struct PulseOptions {
 
 impl Apparatus {
     /// The chain striker → (shaper) → incident (→ transmission) at Courant 1 in the bars.
-    pub fn pulse_chain(&self, o: &PulseOptions) -> crate::solver::pulse::ChainSetup {
-        use crate::solver::pulse::{ChainSetup, GaugeProbe, Joint};
+    pub fn pulse_chain(&self, o: &PulseOptions) -> crate::solver::ChainSetup {
+        use crate::solver::{ChainSetup, GaugeProbe, Joint};
         let c0 = self.material.wave_speed_m_s();
         let dt = o.cell_size_m / c0;
         let (shaper, end, dispersion) = (o.shaper, o.end, o.dispersion);
@@ -205,7 +205,7 @@ impl Apparatus {
         }
         let record_every = ((1.0 / 10e6) / dt).floor().max(1.0) as usize;
         ChainSetup {
-            bars,
+            bodies: bars.into_iter().map(Into::into).collect(),
             joints,
             striker_velocity_m_s: o.striker_velocity_m_s,
             dt_s: dt,
@@ -218,5 +218,69 @@ impl Apparatus {
                 .map(|i| ((i / dt).round() as usize).max(1)),
             snapshot_spacing_m: 5e-3,
         }
+    }
+}
+
+/// The incident gauge of a pulse run as the digitiser samples it: compressive stress −E ε.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IncidentSignal {
+    /// Sample times at the digitiser's rate from 0, s.
+    pub time_s: Vec<f64>,
+    /// Bar stress at the incident gauge, compression positive, Pa.
+    pub stress_pa: Vec<f64>,
+    /// The whole chain run (energies, striker's final velocity).
+    pub chain: crate::solver::ChainResult,
+}
+
+impl Apparatus {
+    /// The incident gauge signal of a pulse run without specimen, transmission bar pressed on and
+    /// no dispersion, as `pulse` scenes compute it: `cell_size_m` cells, a `gauge_length_m` grid,
+    /// sampled at the incident channel's digitiser rate up to `end_time_s`.
+    pub fn incident_signal(
+        &self,
+        striker_velocity_m_s: f64,
+        shaper: Option<PulseShaper>,
+        cell_size_m: f64,
+        gauge_length_m: f64,
+        end_time_s: f64,
+    ) -> Result<IncidentSignal> {
+        let ch = self.gauges.channel("incident").ok_or_else(|| {
+            crate::Error::invalid(
+                "gauges",
+                "no channel named incident",
+                "a set-up with an incident gauge",
+            )
+        })?;
+        let setup = self.pulse_chain(&PulseOptions {
+            specimen: None,
+            striker_velocity_m_s,
+            shaper,
+            end: IncidentEnd::Transmission,
+            cell_size_m,
+            dispersion: Dispersion::None,
+            end_time_s,
+            gauge_length_m,
+            snapshot_interval_s: None,
+        });
+        let k = setup
+            .gauges
+            .iter()
+            .position(|g| g.name == "incident")
+            .expect("the incident channel sits on the incident bar");
+        let chain = crate::solver::simulate_chain(&setup)?;
+        let dt = ch.digitiser.sample_interval_s();
+        let time_s: Vec<f64> = (0..(end_time_s / dt) as usize)
+            .map(|i| i as f64 * dt)
+            .collect();
+        let e = self.material.youngs_modulus_pa;
+        let stress_pa = crate::numeric::resample(&chain.time_s, &chain.strain[k], &time_s)
+            .iter()
+            .map(|x| -e * x)
+            .collect();
+        Ok(IncidentSignal {
+            time_s,
+            stress_pa,
+            chain,
+        })
     }
 }

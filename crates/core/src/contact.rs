@@ -276,21 +276,33 @@ pub struct ContactEval {
     pub strain_rate_per_s: f64,
 }
 
-/// A force law between two spheres; implementations keep their memory in [`ContactHistory`].
-pub trait ContactLaw: Send + Sync {
+/// A force law between two spheres that owns the type of its memory (`State`): Hertz needs
+/// none, the elastoplastic law keeps its Thornton unloading state ([`ContactHistory`]); a new
+/// unloading rule brings its own state without touching the solvers, which see a law only as a
+/// [`Contact`] (law and state together).
+pub trait ContactLaw: Send + Sync + Clone + 'static {
+    /// What the law remembers between evaluations (reset to `Default` before contact).
+    type State: Clone + Default + Send + Sync + std::fmt::Debug + 'static;
+
     /// Short name used in scenes and output (`burgoyne-daraio`, `rate-independent`, `hertz`).
     fn name(&self) -> &'static str;
 
-    /// Force at approach `delta_m` with approach speed `approach_speed_m_s` (δ̇), updating `history`.
+    /// Force at approach `delta_m` with approach speed `approach_speed_m_s` (δ̇), updating `state`.
     fn evaluate(
         &self,
-        history: &mut ContactHistory,
+        state: &mut Self::State,
         delta_m: f64,
         approach_speed_m_s: f64,
     ) -> ContactEval;
 
     /// The virgin loading force at `delta_m` under a constant strain rate (no history).
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
+
+    /// Whether `delta_m` loads the contact on its virgin curve (beyond any approach reached before).
+    fn is_loading(&self, state: &Self::State, delta_m: f64) -> bool;
+
+    /// Approach below which the contact carries no force, given its memory (δr), m.
+    fn zero_force_approach(&self, state: &Self::State) -> f64;
 
     /// Whether the law has a yield stress to report (false for elastic Hertz).
     fn has_yield_stress(&self) -> bool {
@@ -301,10 +313,95 @@ pub trait ContactLaw: Send + Sync {
     fn is_rate_dependent(&self) -> bool {
         false
     }
+}
 
-    /// Approach below which the contact carries no force, given its history (δr), m.
-    fn zero_force_approach(&self, history: &ContactHistory) -> f64 {
-        history.residual_delta_m.max(0.0)
+/// A contact as the solvers see it: a [`ContactLaw`] together with its memory, behind one
+/// object-safe interface (what a contact joint of a chain or the two-sphere DEM holds).
+pub trait Contact: Send + Sync {
+    /// The law's name ([`ContactLaw::name`]).
+    fn name(&self) -> &'static str;
+
+    /// Evaluates and commits: force at `delta_m` and approach speed δ̇, updating the memory.
+    fn evaluate(&mut self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval;
+
+    /// Evaluates without committing (for the implicit solves of a step), memory untouched.
+    fn trial(&self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval;
+
+    /// The virgin loading force at `delta_m` under a constant strain rate ([`ContactLaw::loading_force`]).
+    fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
+
+    /// Whether `delta_m` loads the contact on its virgin curve ([`ContactLaw::is_loading`]).
+    fn is_loading(&self, delta_m: f64) -> bool;
+
+    /// Approach below which the contact carries no force now (δr), m.
+    fn zero_force_approach(&self) -> f64;
+
+    /// Whether the law has a yield stress to report ([`ContactLaw::has_yield_stress`]).
+    fn has_yield_stress(&self) -> bool;
+
+    /// Whether the force depends on the approach speed ([`ContactLaw::is_rate_dependent`]).
+    fn is_rate_dependent(&self) -> bool;
+
+    /// The same law with no memory (a contact that never touched).
+    fn fresh(&self) -> Box<dyn Contact>;
+}
+
+/// A contact law with its memory: the one implementation of [`Contact`].
+#[derive(Debug, Clone)]
+pub struct Stateful<L: ContactLaw> {
+    /// The law.
+    pub law: L,
+    /// Its memory.
+    pub state: L::State,
+}
+
+impl<L: ContactLaw> Stateful<L> {
+    /// The law with a fresh (default) memory.
+    pub fn new(law: L) -> Stateful<L> {
+        Stateful {
+            law,
+            state: L::State::default(),
+        }
+    }
+}
+
+impl<L: ContactLaw> Contact for Stateful<L> {
+    fn name(&self) -> &'static str {
+        self.law.name()
+    }
+
+    fn evaluate(&mut self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval {
+        self.law
+            .evaluate(&mut self.state, delta_m, approach_speed_m_s)
+    }
+
+    fn trial(&self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval {
+        self.law
+            .evaluate(&mut self.state.clone(), delta_m, approach_speed_m_s)
+    }
+
+    fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64 {
+        self.law.loading_force(delta_m, strain_rate_per_s)
+    }
+
+    fn is_loading(&self, delta_m: f64) -> bool {
+        self.law.is_loading(&self.state, delta_m)
+    }
+
+    fn zero_force_approach(&self) -> f64 {
+        self.law.zero_force_approach(&self.state)
+    }
+
+    fn has_yield_stress(&self) -> bool {
+        self.law.has_yield_stress()
+    }
+
+    fn is_rate_dependent(&self) -> bool {
+        self.law.is_rate_dependent()
+    }
+
+    fn fresh(&self) -> Box<dyn Contact> {
+        Box::new(Stateful::new(self.law.clone()))
     }
 }
 
@@ -320,16 +417,13 @@ pub struct Hertz {
 }
 
 impl ContactLaw for Hertz {
+    type State = ();
+
     fn name(&self) -> &'static str {
         "hertz"
     }
 
-    fn evaluate(
-        &self,
-        _history: &mut ContactHistory,
-        delta_m: f64,
-        approach_speed_m_s: f64,
-    ) -> ContactEval {
+    fn evaluate(&self, _state: &mut (), delta_m: f64, approach_speed_m_s: f64) -> ContactEval {
         ContactEval {
             force_n: hertz_force(self.e_star_pa, self.radius_m, delta_m),
             yield_stress_pa: f64::INFINITY,
@@ -339,6 +433,14 @@ impl ContactLaw for Hertz {
 
     fn loading_force(&self, delta_m: f64, _strain_rate_per_s: f64) -> f64 {
         hertz_force(self.e_star_pa, self.radius_m, delta_m)
+    }
+
+    fn is_loading(&self, _state: &(), delta_m: f64) -> bool {
+        delta_m > 0.0
+    }
+
+    fn zero_force_approach(&self, _state: &()) -> f64 {
+        0.0
     }
 
     fn has_yield_stress(&self) -> bool {
@@ -433,6 +535,8 @@ impl BurgoyneDaraio {
 }
 
 impl ContactLaw for BurgoyneDaraio {
+    type State = ContactHistory;
+
     fn name(&self) -> &'static str {
         if self.rate_dependent {
             "burgoyne-daraio"
@@ -501,6 +605,14 @@ impl ContactLaw for BurgoyneDaraio {
         self.curve_at(strain_rate_per_s).force(delta_m)
     }
 
+    fn is_loading(&self, h: &ContactHistory, delta_m: f64) -> bool {
+        delta_m >= h.delta_max_m && delta_m > 0.0
+    }
+
+    fn zero_force_approach(&self, h: &ContactHistory) -> f64 {
+        h.residual_delta_m.max(0.0)
+    }
+
     fn is_rate_dependent(&self) -> bool {
         self.rate_dependent && self.props.rate.c != 0.0
     }
@@ -527,20 +639,24 @@ impl LawKind {
     ];
 
     /// Builds the law for a pair's effective properties (C¹ region II).
-    pub fn build(self, props: ContactProperties) -> Box<dyn ContactLaw> {
+    pub fn build(self, props: ContactProperties) -> Box<dyn Contact> {
         self.build_with(props, Region2Form::Smooth)
     }
 
     /// Builds the law with the chosen form of region II (ignored by Hertz).
-    pub fn build_with(self, props: ContactProperties, region2: Region2Form) -> Box<dyn ContactLaw> {
+    pub fn build_with(self, props: ContactProperties, region2: Region2Form) -> Box<dyn Contact> {
         match self {
-            LawKind::BurgoyneDaraio => Box::new(BurgoyneDaraio::with_form(props, true, region2)),
-            LawKind::RateIndependent => Box::new(BurgoyneDaraio::with_form(props, false, region2)),
-            LawKind::Hertz => Box::new(Hertz {
+            LawKind::BurgoyneDaraio => Box::new(Stateful::new(BurgoyneDaraio::with_form(
+                props, true, region2,
+            ))),
+            LawKind::RateIndependent => Box::new(Stateful::new(BurgoyneDaraio::with_form(
+                props, false, region2,
+            ))),
+            LawKind::Hertz => Box::new(Stateful::new(Hertz {
                 e_star_pa: props.e_star_pa,
                 radius_m: props.radius_m,
                 sum_of_radii_m: props.sum_of_radii_m,
-            }),
+            })),
         }
     }
 }
@@ -581,10 +697,9 @@ mod tests {
         let h = 1e-10;
         let numeric = (hertz_energy(e, r, d + h) - hertz_energy(e, r, d - h)) / (2.0 * h);
         assert_relative_eq!(numeric, hertz_force(e, r, d), max_relative = 1e-6);
-        let law = LawKind::Hertz.build(p);
-        let mut hist = ContactHistory::default();
-        let up = law.evaluate(&mut hist, d, 1.0).force_n;
-        let down = law.evaluate(&mut hist, 0.5 * d, -1.0).force_n;
+        let mut contact = LawKind::Hertz.build(p);
+        let up = contact.evaluate(d, 1.0).force_n;
+        let down = contact.evaluate(0.5 * d, -1.0).force_n;
         assert_relative_eq!(up, hertz_force(e, r, d), max_relative = 1e-12);
         assert_relative_eq!(down, hertz_force(e, r, 0.5 * d), max_relative = 1e-12);
     }

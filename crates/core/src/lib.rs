@@ -14,6 +14,8 @@ pub mod bar;
 pub mod contact;
 pub mod error;
 pub mod fidelity;
+#[cfg(test)]
+mod fixtures;
 pub mod gauge;
 pub mod material;
 pub mod numeric;

@@ -37,7 +37,7 @@ pub struct RunOutput {
     /// `/energy/<name>`, J, on the `/time` axis.
     pub energy: Vec<(String, Vec<f64>)>,
     /// `/bars/<name>/{snapshots,x,time}`: decimated x–t stress fields.
-    pub bars: Vec<crate::solver::pulse::BarSnapshots>,
+    pub bars: Vec<crate::solver::BarSnapshots>,
     /// Scalar results (attributes of `/summary`).
     pub summary: Vec<SummaryItem>,
     /// The lab's reduction of the simulated gauge records (`/reduction/*`), full SHPB tests only.

@@ -4,7 +4,7 @@
 
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::bar::Dispersion;
-use crate::contact::{ContactLaw, Degenerate, LawKind, LoadingCurve, Region2Form};
+use crate::contact::{Contact, Degenerate, LawKind, LoadingCurve, Region2Form};
 use crate::error::Result;
 use crate::fidelity::Fidelity;
 use crate::numeric::resample;
@@ -81,7 +81,7 @@ pub struct Params {
 
 impl Params {
     /// The contact law of this scene.
-    pub fn contact_law(&self) -> Box<dyn ContactLaw> {
+    pub fn contact_law(&self) -> Box<dyn Contact> {
         self.law
             .build_with(self.pair.contact_properties(), self.region2)
     }
@@ -277,7 +277,7 @@ fn force_driven_summary(
 /// Runs a `pulse` scene: simulates the chain, digitises every gauge, and summarises each pulse.
 fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) -> Result<RunOutput> {
     let chain = apparatus.pulse_chain(options);
-    let r = crate::solver::pulse::simulate_chain(&chain)?;
+    let r = crate::solver::simulate_chain(&chain)?;
     let e = apparatus.material.youngs_modulus_pa;
     let mut summary = vec![
         item("pressure", pressure_pa, "Pa"),

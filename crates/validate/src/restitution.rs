@@ -4,7 +4,7 @@
 
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit};
-use shpb_core::contact::{ContactLaw, LawKind, Region2Form};
+use shpb_core::contact::{Contact, LawKind, Region2Form};
 use shpb_core::material::Material;
 use shpb_core::solver::{self, CollisionSetup};
 use shpb_core::specimen::SpherePair;
@@ -30,7 +30,7 @@ const ELASTIC_MAX: f64 = 1e-9;
 const ENERGY_MAX: f64 = 1e-9;
 
 /// One collision's restitution and energy-balance error.
-fn collide(pair: &SpherePair, law: &dyn ContactLaw, speed: f64) -> Result<(f64, f64)> {
+fn collide(pair: &SpherePair, law: &dyn Contact, speed: f64) -> Result<(f64, f64)> {
     let p = pair.contact_properties();
     let tc = solver::hertz_impact_duration(pair.reduced_mass_kg(), p.e_star_pa, p.radius_m, speed);
     let setup = CollisionSetup {

@@ -32,9 +32,17 @@
 //! past yield), so a larger deficit is the scheme's doing: the run stops with
 //! [`Error::Unstable`] naming the step, time and quantity instead of reporting a restitution > 1.
 
-pub mod pulse;
+pub mod body;
+pub mod chain;
+pub mod joint;
+pub mod record;
 
-use crate::contact::{ContactEval, ContactHistory, ContactLaw, hertz_force};
+pub use body::{Body, BodySpec, MassSpec};
+pub use chain::{Chain, ChainResult, ChainSetup, simulate_chain, simulate_chain_with};
+pub use joint::Joint;
+pub use record::{BarSnapshots, GaugeProbe, Recorder};
+
+use crate::contact::{Contact, ContactEval, hertz_force};
 use crate::error::{Error, Result};
 use crate::specimen::SpherePair;
 
@@ -72,7 +80,7 @@ pub fn contact_period(reduced_mass_kg: f64, e_star_pa: f64, radius_m: f64, force
 
 /// One rigid sphere moving along the bar axis, optionally held by a dashpot (a 1D elastic medium).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Body {
+pub struct DashpotSphere {
     /// Mass, kg.
     pub mass_kg: f64,
     /// Dashpot coefficient: impedance Z = ρ c0 A of the medium it presses on, kg/s (0 for none).
@@ -100,12 +108,13 @@ pub struct EnergyLedger {
 pub const PASSIVITY_TOLERANCE: f64 = 0.1;
 
 /// State of the two-sphere system advanced by [`PairStepper::step`].
-pub struct PairStepper<'a> {
-    law: &'a dyn ContactLaw,
+pub struct PairStepper {
+    /// The contact law with its memory.
+    law: Box<dyn Contact>,
     /// Incident-side sphere.
-    pub sphere1: Body,
+    pub sphere1: DashpotSphere,
     /// Transmission-side sphere.
-    pub sphere2: Body,
+    pub sphere2: DashpotSphere,
     /// r1 + r2: δ = r1 + r2 − (x2 − x1), m.
     pub sum_of_radii_m: f64,
     /// Time step, s.
@@ -114,8 +123,6 @@ pub struct PairStepper<'a> {
     pub time_s: f64,
     /// Steps taken.
     pub step_index: usize,
-    /// Contact memory.
-    pub history: ContactHistory,
     /// Last contact evaluation.
     pub contact: ContactEval,
     /// External force on sphere 1 at the current time, N.
@@ -128,19 +135,19 @@ pub struct PairStepper<'a> {
     external_work_abs_j: f64,
 }
 
-impl<'a> PairStepper<'a> {
-    /// A stepper for `pair` under `law`, with the spheres just touching (δ = 0) at t = 0.
-    pub fn new(law: &'a dyn ContactLaw, pair: &SpherePair, dt_s: f64) -> PairStepper<'a> {
+impl PairStepper {
+    /// A stepper for `pair` under a fresh copy of `law`, with the spheres just touching (δ = 0) at t = 0.
+    pub fn new(law: &dyn Contact, pair: &SpherePair, dt_s: f64) -> PairStepper {
         let sum = pair.sphere1.radius_m + pair.sphere2.radius_m;
         PairStepper {
-            law,
-            sphere1: Body {
+            law: law.fresh(),
+            sphere1: DashpotSphere {
                 mass_kg: pair.sphere1.mass_kg,
                 damping_kg_s: 0.0,
                 position_m: 0.0,
                 velocity_m_s: 0.0,
             },
-            sphere2: Body {
+            sphere2: DashpotSphere {
                 mass_kg: pair.sphere2.mass_kg,
                 damping_kg_s: 0.0,
                 position_m: sum,
@@ -150,14 +157,18 @@ impl<'a> PairStepper<'a> {
             dt_s,
             time_s: 0.0,
             step_index: 0,
-            history: ContactHistory::default(),
             // What the law reports before contact (the static σy for Burgoyne–Daraio).
-            contact: law.evaluate(&mut ContactHistory::default(), 0.0, 0.0),
+            contact: law.fresh().trial(0.0, 0.0),
             external_force_n: 0.0,
             energy: EnergyLedger::default(),
             initial_kinetic_energy_j: None,
             external_work_abs_j: 0.0,
         }
+    }
+
+    /// Approach below which the contact carries no force now (the residual approach δr), m.
+    pub fn zero_force_approach_m(&self) -> f64 {
+        self.law.zero_force_approach()
     }
 
     /// Approach δ of the sphere centres (positive in compression), m.
@@ -194,15 +205,12 @@ impl<'a> PairStepper<'a> {
             b2.velocity_m_s + 0.5 * dt * (f_now - b2.damping_kg_s * b2.velocity_m_s) / b2.mass_kg;
         b2.position_m += dt * v2h;
         let delta_next = self.approach_m();
-        let speed = if self.law.is_rate_dependent()
-            && delta_next >= self.history.delta_max_m
-            && delta_next > 0.0
-        {
+        let speed = if self.law.is_rate_dependent() && self.law.is_loading(delta_next) {
             self.implicit_approach_speed(v1h, v2h, external_force_next_n, delta_next)
         } else {
             (delta_next - delta_now) / dt
         };
-        let eval = self.law.evaluate(&mut self.history, delta_next, speed);
+        let eval = self.law.evaluate(delta_next, speed);
         let f_next = eval.force_n;
         let b1 = &mut self.sphere1;
         b1.velocity_m_s = (v1h + 0.5 * dt * (external_force_next_n - f_next) / b1.mass_kg)
@@ -236,11 +244,7 @@ impl<'a> PairStepper<'a> {
         let k2 = 1.0 + 0.5 * dt * b2.damping_kg_s / b2.mass_kg;
         let a = (v1h + 0.5 * dt * fext_next / b1.mass_kg) / k1 - v2h / k2;
         let b = 0.5 * dt / (b1.mass_kg * k1) + 0.5 * dt / (b2.mass_kg * k2);
-        let force = |u: f64| {
-            self.law
-                .evaluate(&mut self.history.clone(), delta, u)
-                .force_n
-        };
+        let force = |u: f64| self.law.trial(delta, u).force_n;
         // g(u) = u − A + B F(u) is increasing in u (F does not fall with the rate): bracket its root.
         let g = |u: f64| u - a + b * force(u);
         let u_hi = a - b * force(0.0);
@@ -375,7 +379,7 @@ pub use crate::numeric::argmax;
 
 /// Quasi-static loading curve F(δ) on `points` equally spaced approaches up to `max_m` (Fig. 2).
 pub fn loading_curve(
-    law: &dyn ContactLaw,
+    law: &dyn Contact,
     max_m: f64,
     points: usize,
     strain_rate_per_s: f64,
@@ -391,21 +395,21 @@ pub fn loading_curve(
 
 /// Spheres pressed together at constant approach speed (Fig. 3): δ = v t up to `max_m`.
 pub fn constant_rate(
-    law: &dyn ContactLaw,
+    law: &dyn Contact,
     pair: &SpherePair,
     strain_rate_per_s: f64,
     max_m: f64,
     points: usize,
 ) -> ContactSeries {
     let speed = strain_rate_per_s * (pair.sphere1.radius_m + pair.sphere2.radius_m);
-    let mut history = ContactHistory::default();
+    let mut contact = law.fresh();
     let mut s = ContactSeries::dynamic(points);
     if !law.has_yield_stress() {
         s.yield_stress_pa = None;
     }
     for i in 0..points {
         let d = max_m * i as f64 / (points - 1) as f64;
-        let eval = law.evaluate(&mut history, d, speed);
+        let eval = contact.evaluate(d, speed);
         s.push(d / speed, d, &eval);
     }
     s
@@ -451,7 +455,7 @@ pub struct CollisionResult {
 
 /// Two free spheres collide, starting in touch (δ = 0) with the given velocities.
 pub fn collision(
-    law: &dyn ContactLaw,
+    law: &dyn Contact,
     pair: &SpherePair,
     setup: &CollisionSetup,
 ) -> Result<CollisionResult> {
@@ -479,7 +483,7 @@ pub fn collision(
         }
         if st.contact.force_n == 0.0 && peak > 0.0 && st.approach_speed_m_s() < 0.0 {
             // Force returned to zero: interpolate the crossing of δ through δr.
-            let d0 = law.zero_force_approach(&st.history);
+            let d0 = st.zero_force_approach_m();
             let frac = if d_prev != d {
                 (d_prev - d0) / (d_prev - d)
             } else {
@@ -508,7 +512,7 @@ pub fn collision(
         kinetic_energy_before_j: ke0,
         kinetic_energy_after_j: ke1,
         dissipated_j: st.energy.contact_work_j,
-        residual_approach_m: law.zero_force_approach(&st.history),
+        residual_approach_m: st.zero_force_approach_m(),
     })
 }
 
@@ -568,7 +572,7 @@ pub struct ForceDrivenResult {
 
 /// Sphere 1 driven by a force history, sphere 2 on a linear medium of impedance Z (paper Fig. 4 DEM).
 pub fn force_driven(
-    law: &dyn ContactLaw,
+    law: &dyn Contact,
     pair: &SpherePair,
     setup: &ForceDrivenSetup,
 ) -> Result<ForceDrivenResult> {

@@ -252,8 +252,8 @@ pub(super) fn parse_bars(
         snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
     };
     // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
-    for spec in &apparatus.pulse_chain(&options).bars {
-        shpb_core::bar::Bar::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
+    for spec in &apparatus.pulse_chain(&options).bodies {
+        shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
     }
     // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads.
     let pair = match specimen {

@@ -25,12 +25,10 @@ mod nelder_mead;
 
 use nelder_mead::nelder_mead;
 use rayon::prelude::*;
-use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
-use shpb_core::bar::Dispersion;
+use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
 use shpb_core::numeric::{bisect, moving_average, resample};
 use shpb_core::shaper::PulseShaper;
-use shpb_core::solver::pulse::simulate_chain;
 use shpb_core::striker::Gun;
 use shpb_input::Validator;
 use shpb_input::prelude::*;
@@ -108,23 +106,7 @@ fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper, cell_m: f64, gauge_m: f6
     let ch = a.gauges.channel("incident").expect("incident channel");
     let arrival = (a.incident.length_m - ch.distance_from_specimen_m) / c0;
     let end = arrival + WINDOW_S.1 + 20e-6;
-    let setup = a.pulse_chain(&PulseOptions {
-        specimen: None,
-        striker_velocity_m_s: v,
-        shaper: Some(shaper),
-        end: IncidentEnd::Transmission,
-        cell_size_m: cell_m,
-        dispersion: Dispersion::None,
-        end_time_s: end,
-        gauge_length_m: gauge_m,
-        snapshot_interval_s: None,
-    });
-    let k = setup
-        .gauges
-        .iter()
-        .position(|g| g.name == "incident")
-        .expect("incident gauge");
-    let Ok(r) = simulate_chain(&setup) else {
+    let Ok(s) = a.incident_signal(v, Some(shaper), cell_m, gauge_m, end) else {
         return Simulated {
             time_s: vec![],
             stress_pa: vec![],
@@ -134,20 +116,13 @@ fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper, cell_m: f64, gauge_m: f6
             shaper_work_j: f64::NAN,
         };
     };
-    let dt = ch.digitiser.sample_interval_s();
-    let time_s: Vec<f64> = (0..(end / dt) as usize).map(|i| i as f64 * dt).collect();
-    let e = a.material.youngs_modulus_pa;
-    let stress_pa: Vec<f64> = resample(&r.time_s, &r.strain[k], &time_s)
-        .iter()
-        .map(|s| -e * s)
-        .collect();
     Simulated {
-        metrics: pulse_metrics(&time_s, &stress_pa, false),
-        energy_j: pulse_energy_j(a, &time_s, &stress_pa),
-        time_s,
-        stress_pa,
-        striker_final_velocity_m_s: r.striker_final_velocity_m_s,
-        shaper_work_j: r.shaper_energy_j.last().copied().unwrap_or(f64::NAN),
+        metrics: pulse_metrics(&s.time_s, &s.stress_pa, false),
+        energy_j: pulse_energy_j(a, &s.time_s, &s.stress_pa),
+        striker_final_velocity_m_s: s.chain.striker_final_velocity_m_s,
+        shaper_work_j: s.chain.shaper_energy_j.last().copied().unwrap_or(f64::NAN),
+        time_s: s.time_s,
+        stress_pa: s.stress_pa,
     }
 }
 

@@ -1,0 +1,218 @@
+//! The bodies of a chain (docs/physics.md §5–§6): bar segments discretised on the common time
+//! step, and rigid masses (a sphere between two contacts). Both advance by the same leapfrog
+//! (v^{n+1/2} = v^{n−1/2} + Δt F/m, u^{n+1} = u^n + Δt v^{n+1/2}) and expose the same end
+//! data to the joints: current displacement, last half-step velocity, the velocity the coming
+//! step would give the end without the joint's force, and the end's mobility ∂v/∂F.
+
+use crate::bar::{Bar, BarSpec};
+use crate::error::{Error, Result};
+
+/// What a chain is built from, left to right.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BodySpec {
+    /// An elastic bar (striker, incident, transmission, an insert).
+    Bar(BarSpec),
+    /// A rigid mass, e.g. a sphere of a chain between two contacts.
+    Mass(MassSpec),
+}
+
+impl From<BarSpec> for BodySpec {
+    fn from(spec: BarSpec) -> BodySpec {
+        BodySpec::Bar(spec)
+    }
+}
+
+/// A rigid body moving along the bar axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MassSpec {
+    /// Name (e.g. `sphere 2`).
+    pub name: String,
+    /// Mass, kg.
+    pub mass_kg: f64,
+}
+
+/// A rigid mass on the chain's time step (same leapfrog as a bar node).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointMass {
+    name: String,
+    mass_kg: f64,
+    dt_s: f64,
+    /// Displacement from the initial position at level n, m.
+    displacement_m: f64,
+    /// Velocity at level n − 1/2, m/s.
+    velocity_m_s: f64,
+    step_index: usize,
+}
+
+impl PointMass {
+    /// A mass at rest on time step `dt_s`; errors on a mass that is not finite and positive.
+    pub fn new(spec: &MassSpec, dt_s: f64) -> Result<PointMass> {
+        if !(spec.mass_kg.is_finite() && spec.mass_kg > 0.0) {
+            return Err(Error::Invalid {
+                object: spec.name.clone(),
+                quantity: "mass_kg".into(),
+                problem: format!("{} is not a finite positive mass", spec.mass_kg),
+                allowed: "> 0 kg".into(),
+            });
+        }
+        Ok(PointMass {
+            name: spec.name.clone(),
+            mass_kg: spec.mass_kg,
+            dt_s,
+            displacement_m: 0.0,
+            velocity_m_s: 0.0,
+            step_index: 0,
+        })
+    }
+}
+
+/// A body of a chain, in its time-stepping state.
+#[derive(Debug, Clone)]
+pub enum Body {
+    /// An elastic bar (boxed: a bar is large, a mass is small).
+    Bar(Box<Bar>),
+    /// A rigid mass.
+    Mass(PointMass),
+}
+
+impl Body {
+    /// Builds the body on time step `dt_s` (bars check their stability limit).
+    pub fn new(spec: &BodySpec, dt_s: f64) -> Result<Body> {
+        Ok(match spec {
+            BodySpec::Bar(s) => Body::Bar(Box::new(Bar::new(s, dt_s)?)),
+            BodySpec::Mass(m) => Body::Mass(PointMass::new(m, dt_s)?),
+        })
+    }
+
+    /// The body's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Body::Bar(b) => b.name(),
+            Body::Mass(m) => &m.name,
+        }
+    }
+
+    /// The bar, if the body is one.
+    pub fn as_bar(&self) -> Option<&Bar> {
+        match self {
+            Body::Bar(b) => Some(b),
+            Body::Mass(_) => None,
+        }
+    }
+
+    /// Displacement u^n of an end (right end if `right`), m.
+    pub fn end_displacement_m(&self, right: bool) -> f64 {
+        match self {
+            Body::Bar(b) => b.displacement_m(if right { b.node_count() - 1 } else { 0 }),
+            Body::Mass(m) => m.displacement_m,
+        }
+    }
+
+    /// Velocity v^{n−1/2} of an end, m/s.
+    pub fn end_half_step_velocity_m_s(&self, right: bool) -> f64 {
+        match self {
+            Body::Bar(b) => b.half_step_velocity_m_s(if right { b.node_count() - 1 } else { 0 }),
+            Body::Mass(m) => m.velocity_m_s,
+        }
+    }
+
+    /// v^{n+1/2} of an end if the joint at that end carried no force, given the force (N, toward
+    /// +x) applied at the other end this step: a bar's ends are one step apart, so a bar ignores
+    /// it; a rigid mass moves as a whole.
+    pub fn free_end_velocity_m_s(&self, right: bool, other_end_force_n: f64) -> f64 {
+        match self {
+            Body::Bar(b) => b.free_end_velocity_m_s(right),
+            Body::Mass(m) => m.velocity_m_s + m.dt_s * other_end_force_n / m.mass_kg,
+        }
+    }
+
+    /// ∂v^{n+1/2}/∂F of an end per newton applied at that same end, s/kg.
+    pub fn end_mobility_s_per_kg(&self, right: bool) -> f64 {
+        match self {
+            Body::Bar(b) => b.end_mobility_s_per_kg(right, right),
+            Body::Mass(m) => m.dt_s / m.mass_kg,
+        }
+    }
+
+    /// Whether the force at one end moves the other end within the same step (a rigid mass).
+    pub fn is_rigid(&self) -> bool {
+        matches!(self, Body::Mass(_))
+    }
+
+    /// Advances one step with forces (N, toward +x) at the left and right ends.
+    pub fn step(&mut self, left_force_n: f64, right_force_n: f64) {
+        match self {
+            Body::Bar(b) => b.step(left_force_n, right_force_n),
+            Body::Mass(m) => {
+                m.velocity_m_s += m.dt_s * (left_force_n + right_force_n) / m.mass_kg;
+                m.displacement_m += m.dt_s * m.velocity_m_s;
+                m.step_index += 1;
+            }
+        }
+    }
+
+    /// Sets the body moving rigidly at `v_m_s` (the striker, or the first sphere of a collision).
+    pub fn set_initial_velocity(&mut self, v_m_s: f64) {
+        match self {
+            Body::Bar(b) => b.set_initial_velocity(v_m_s),
+            Body::Mass(m) => m.velocity_m_s = v_m_s,
+        }
+    }
+
+    /// Total mass, kg.
+    pub fn mass_kg(&self) -> f64 {
+        match self {
+            Body::Bar(b) => (0..b.node_count()).map(|i| b.node_mass_kg(i)).sum(),
+            Body::Mass(m) => m.mass_kg,
+        }
+    }
+
+    /// Momentum Σ m v, kg·m/s (a bar's nodes at level n, a mass at its last half level).
+    pub fn momentum_kg_m_s(&self) -> f64 {
+        match self {
+            Body::Bar(b) => (0..b.node_count())
+                .map(|i| b.node_mass_kg(i) * b.velocity_m_s(i))
+                .sum(),
+            Body::Mass(m) => m.mass_kg * m.velocity_m_s,
+        }
+    }
+
+    /// Kinetic plus strain energy at the half level n − 1/2 (the scheme's conserved energy), J.
+    pub fn energy_j(&self) -> f64 {
+        match self {
+            Body::Bar(b) => b.kinetic_energy_j() + b.strain_energy_j(),
+            Body::Mass(m) => 0.5 * m.mass_kg * m.velocity_m_s * m.velocity_m_s,
+        }
+    }
+
+    /// Energy that left through absorbing ends so far, J (0 for a mass).
+    pub fn absorbed_energy_j(&self) -> f64 {
+        match self {
+            Body::Bar(b) => b.absorbed_energy_j(),
+            Body::Mass(_) => 0.0,
+        }
+    }
+
+    /// Checks that the state is finite (Error::Unstable naming step, time and quantity).
+    pub fn check_finite(&self) -> Result<()> {
+        match self {
+            Body::Bar(b) => b.check_finite(),
+            Body::Mass(m) => {
+                for (what, value) in [
+                    ("displacement", m.displacement_m),
+                    ("velocity", m.velocity_m_s),
+                ] {
+                    if !value.is_finite() {
+                        return Err(Error::Unstable {
+                            step: m.step_index,
+                            time_s: m.step_index as f64 * m.dt_s,
+                            quantity: format!("mass {}: {what}", m.name),
+                            value,
+                        });
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}

@@ -1,0 +1,200 @@
+//! Joints between the right end of one body and the left end of the next (docs/physics.md §6).
+//!
+//! Couplings are solved implicitly for the step's end velocities, so they add no stiffness to
+//! the explicit limit of the bars (which sit exactly at it at Courant 1):
+//! * a **butt joint** (striker on bar without shaper, bar pressed on bar) carries compression
+//!   only: while closed, the two half-mass end nodes move as one full node, exactly as a
+//!   continuous bar would; it opens when holding it would need tension;
+//! * a **pulse shaper** is a massless nonlinear spring F(closure): its force at level n is
+//!   evaluated at the Newmark average closure (c^{n+1}(F) + 2c^n + c^{n−1})/4 (the β = 1/4
+//!   "average acceleration" rule: unconditionally stable and, for an elastic spring, energy
+//!   conserving) and solved by bisection (F_shaper does not fall with closure). The work it takes
+//!   from the bodies is F^n (c^{n+1} − c^{n−1})/2, the same discrete work the bars' ledgers count;
+//! * a **sphere contact** is solved the same way with a contact law ([`Contact`]) at the Newmark
+//!   average approach and the centred approach rate (the law's memory is committed once a step).
+
+use super::body::Body;
+use crate::contact::{Contact, ContactEval, LawKind, Region2Form};
+use crate::shaper::{PulseShaper, ShaperState};
+use crate::specimen::ContactProperties;
+
+/// How two body ends touch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Joint {
+    /// Compression-only butt contact.
+    Butt,
+    /// A copper pulse shaper between the ends.
+    Shaper(PulseShaper),
+    /// Two spheres touching through a contact law (paper Eqs. 1–3). A sphere at a bar end is a
+    /// mass added to the bar's end node; a sphere between two contacts is a [`Body::Mass`].
+    Spheres {
+        /// Effective contact properties of the pair.
+        props: ContactProperties,
+        /// The contact law.
+        law: LawKind,
+        /// Form of region II.
+        region2: Region2Form,
+    },
+}
+
+/// State of a joint: its law, memory and the work it has taken.
+pub struct JointState {
+    /// The joint's law.
+    pub joint: Joint,
+    /// Shaper memory (unused for other joints).
+    pub shaper: ShaperState,
+    /// The contact law with its memory, for a `Spheres` joint.
+    pub law: Option<Box<dyn Contact>>,
+    /// Last contact evaluation of a `Spheres` joint.
+    pub contact: ContactEval,
+    /// Sphere approach δ at which the last force was evaluated, m.
+    pub approach_m: f64,
+    /// Compressive force carried in the last step, N.
+    pub force_n: f64,
+    /// Work the joint has taken from the bodies, J (dissipation plus elastic energy held).
+    pub work_j: f64,
+}
+
+impl JointState {
+    /// A joint with no history.
+    pub fn new(joint: Joint) -> JointState {
+        let law = match joint {
+            Joint::Spheres {
+                props,
+                law,
+                region2,
+            } => Some(law.build_with(props, region2)),
+            _ => None,
+        };
+        let contact = match &law {
+            Some(l) => l.trial(0.0, 0.0),
+            None => ContactEval {
+                force_n: 0.0,
+                yield_stress_pa: 0.0,
+                strain_rate_per_s: 0.0,
+            },
+        };
+        JointState {
+            joint,
+            shaper: ShaperState::default(),
+            law,
+            contact,
+            approach_m: 0.0,
+            force_n: 0.0,
+            work_j: 0.0,
+        }
+    }
+
+    /// Work taken from the bodies so far (plastic work plus elastic energy held), J.
+    pub fn dissipated_j(&self) -> f64 {
+        self.work_j
+    }
+
+    /// The joint force for a prediction without committing the memory (≥ 0, compressive), N.
+    pub fn trial_force_n(&self, p: &JointPrediction, dt_s: f64) -> f64 {
+        match self.joint {
+            Joint::Butt => {
+                // Closed joint: force that makes both ends move together (closure rate 0), if
+                // compressive (0 when the joint stays open: the ends would not meet within the step).
+                ((p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)).max(0.0)
+            }
+            Joint::Shaper(s) => {
+                let shaper = self.shaper;
+                solve_force(|f| s.force_n(&mut shaper.clone(), p.average_closure_m(f, dt_s)))
+            }
+            Joint::Spheres { .. } => {
+                let law = self.law.as_ref().expect("sphere joints carry their law");
+                solve_force(|f| {
+                    law.trial(p.average_closure_m(f, dt_s), p.closure_rate_m_s(f, dt_s))
+                        .force_n
+                })
+            }
+        }
+    }
+
+    /// Commits the step with force `f`: the joint's memory and its work ledger.
+    pub fn commit(&mut self, p: &JointPrediction, f: f64, dt_s: f64) {
+        match self.joint {
+            Joint::Shaper(s) => {
+                s.force_n(&mut self.shaper, p.average_closure_m(f, dt_s));
+            }
+            Joint::Spheres { .. } => {
+                let law = self.law.as_mut().expect("sphere joints carry their law");
+                self.approach_m = p.average_closure_m(f, dt_s);
+                self.contact = law.evaluate(self.approach_m, p.closure_rate_m_s(f, dt_s));
+            }
+            Joint::Butt => {}
+        }
+        self.work_j += f * 0.5 * (p.next_closure_m(f, dt_s) - p.previous_closure_m);
+        self.force_n = f;
+    }
+}
+
+/// End data needed to solve a joint: current closure, predicted closure rate without the
+/// joint force, and how the closure rate responds to it.
+#[derive(Debug, Clone, Copy)]
+pub struct JointPrediction {
+    /// Closure: displacement of the left body's end minus that of the right body's end (> 0 compresses), m.
+    pub closure_m: f64,
+    /// Closure at the previous level c^{n−1}, m.
+    pub previous_closure_m: f64,
+    /// Closure rate at the half step if the joint carried no force, m/s.
+    pub free_rate_m_s: f64,
+    /// Drop of the closure rate per newton of joint force (Δt/m_left + Δt/m_right for lumped ends), m/(s·N).
+    pub compliance: f64,
+}
+
+impl JointPrediction {
+    /// Predicts the joint between the right end of `left` and the left end of `right`, given the
+    /// forces (N, toward +x) on their other ends this step (they matter for rigid masses only).
+    pub fn new(
+        left: &Body,
+        right: &Body,
+        left_other_n: f64,
+        right_other_n: f64,
+        dt_s: f64,
+    ) -> Self {
+        let closure = left.end_displacement_m(true) - right.end_displacement_m(false);
+        let last_rate =
+            left.end_half_step_velocity_m_s(true) - right.end_half_step_velocity_m_s(false);
+        JointPrediction {
+            closure_m: closure,
+            previous_closure_m: closure - dt_s * last_rate,
+            free_rate_m_s: left.free_end_velocity_m_s(true, left_other_n)
+                - right.free_end_velocity_m_s(false, right_other_n),
+            compliance: left.end_mobility_s_per_kg(true) + right.end_mobility_s_per_kg(false),
+        }
+    }
+
+    /// Closure c^{n+1} if the joint carries force `f`, m.
+    pub fn next_closure_m(&self, f: f64, dt_s: f64) -> f64 {
+        self.closure_m + dt_s * (self.free_rate_m_s - self.compliance * f)
+    }
+
+    /// Newmark-average closure (c^{n+1} + 2c^n + c^{n−1})/4 at force `f`, m.
+    pub fn average_closure_m(&self, f: f64, dt_s: f64) -> f64 {
+        0.25 * (self.next_closure_m(f, dt_s) + 2.0 * self.closure_m + self.previous_closure_m)
+    }
+
+    /// Centred closure rate (c^{n+1} − c^{n−1})/(2Δt) at force `f`, m/s.
+    pub fn closure_rate_m_s(&self, f: f64, dt_s: f64) -> f64 {
+        (self.next_closure_m(f, dt_s) - self.previous_closure_m) / (2.0 * dt_s)
+    }
+}
+
+/// Root of F = law(F) for a law that does not grow with F (more force, less closure), in
+/// [0, law(0)], by bisection to 1e-12 relative.
+fn solve_force(law: impl Fn(f64) -> f64) -> f64 {
+    let f_hi = law(0.0);
+    if f_hi <= 0.0 {
+        return 0.0;
+    }
+    let (lo, hi) = crate::numeric::bisect(
+        0.0,
+        f_hi,
+        100,
+        |lo, hi| hi - lo <= 1e-12 * hi,
+        |f| law(f) > f,
+    );
+    0.5 * (lo + hi)
+}

@@ -1,0 +1,226 @@
+//! What a chain run keeps: recorders sample the bodies and joints while it runs (gauges,
+//! energies, the sphere contact, x–t stress snapshots). A new output is a new [`Recorder`],
+//! not a new field in the solver.
+
+use super::body::Body;
+use super::joint::JointState;
+use crate::bar::Bar;
+use crate::solver::ContactSeries;
+
+/// Something that samples a chain while it runs.
+pub trait Recorder {
+    /// Called before the first step (`step` 0) and after every step `step` = 1, 2, …, at time `time_s`.
+    fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]);
+}
+
+/// Which bar of the chain a gauge sits on, and where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaugeProbe {
+    /// Channel name.
+    pub name: String,
+    /// Index of the body in the chain (0 = striker); it must be a bar.
+    pub bar: usize,
+    /// Position along that bar from its left end, m.
+    pub x_m: f64,
+    /// Gauge grid length over which the strain is averaged, m (0: a point).
+    pub length_m: f64,
+}
+
+/// Axial displacement at position `x_m` along a bar (linear between nodes), m.
+fn displacement_at(bar: &Bar, x_m: f64) -> f64 {
+    let n = bar.node_count();
+    let (mut lo, mut hi) = (0, n - 1);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if bar.node_position_m(mid) <= x_m {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let (x0, x1) = (bar.node_position_m(lo), bar.node_position_m(hi));
+    let w = ((x_m - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    bar.displacement_m(lo) * (1.0 - w) + bar.displacement_m(hi) * w
+}
+
+/// Strain a gauge reads: the mean bar strain over its grid, (u(x+L/2) − u(x−L/2))/L, exactly what a
+/// bonded foil gauge of length L averages (and, over an even number of cells, free of the grid's
+/// two-cell zigzag); a point value for L = 0.
+pub fn gauge_strain(bar: &Bar, g: &GaugeProbe) -> f64 {
+    if g.length_m <= 0.0 {
+        return bar.strain_at(g.x_m);
+    }
+    (displacement_at(bar, g.x_m + 0.5 * g.length_m)
+        - displacement_at(bar, g.x_m - 0.5 * g.length_m))
+        / g.length_m
+}
+
+/// Gauge strains every `every` steps, on a common time axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaugeRecorder {
+    /// The gauges.
+    pub gauges: Vec<GaugeProbe>,
+    /// Sampling interval in steps.
+    pub every: usize,
+    /// Recording times, s.
+    pub time_s: Vec<f64>,
+    /// Strain per gauge (positive in tension), in the order of `gauges`.
+    pub strain: Vec<Vec<f64>>,
+}
+
+impl GaugeRecorder {
+    /// A recorder of `gauges` every `every` steps, with room for `capacity` samples.
+    pub fn new(gauges: Vec<GaugeProbe>, every: usize, capacity: usize) -> GaugeRecorder {
+        GaugeRecorder {
+            strain: vec![Vec::with_capacity(capacity); gauges.len()],
+            gauges,
+            every,
+            time_s: Vec::with_capacity(capacity),
+        }
+    }
+}
+
+impl Recorder for GaugeRecorder {
+    fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], _joints: &[JointState]) {
+        if !step.is_multiple_of(self.every) {
+            return;
+        }
+        self.time_s.push(time_s);
+        for (g, s) in self.gauges.iter().zip(self.strain.iter_mut()) {
+            let bar = bodies[g.bar].as_bar().expect("gauges sit on bars");
+            s.push(gauge_strain(bar, g));
+        }
+    }
+}
+
+/// The energy ledger every `every` steps.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EnergyRecorder {
+    /// Sampling interval in steps.
+    pub every: usize,
+    /// Kinetic + strain energy in all bodies, J.
+    pub body_energy_j: Vec<f64>,
+    /// Energy absorbed by non-reflecting ends so far, J.
+    pub absorbed_energy_j: Vec<f64>,
+    /// Work taken by pulse shapers and butt joints so far, J.
+    pub shaper_energy_j: Vec<f64>,
+    /// Work taken by sphere contacts so far (dissipated plus elastic energy held), J.
+    pub contact_energy_j: Vec<f64>,
+}
+
+impl Recorder for EnergyRecorder {
+    fn record(&mut self, step: usize, _time_s: f64, bodies: &[Body], joints: &[JointState]) {
+        if !step.is_multiple_of(self.every) {
+            return;
+        }
+        self.body_energy_j
+            .push(bodies.iter().map(Body::energy_j).sum());
+        self.absorbed_energy_j
+            .push(bodies.iter().map(Body::absorbed_energy_j).sum());
+        let work = |contact: bool| {
+            joints
+                .iter()
+                .filter(|j| j.law.is_some() == contact)
+                .map(JointState::dissipated_j)
+                .sum()
+        };
+        self.shaper_energy_j.push(work(false));
+        self.contact_energy_j.push(work(true));
+    }
+}
+
+/// The history of one sphere contact (approach, force, σy*, strain rate) every `every` steps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRecorder {
+    /// Index of the joint recorded.
+    pub joint: usize,
+    /// Sampling interval in steps.
+    pub every: usize,
+    /// The series.
+    pub series: ContactSeries,
+}
+
+impl ContactRecorder {
+    /// A recorder of joint `joint` every `every` steps, with room for `capacity` samples.
+    pub fn new(joint: usize, every: usize, capacity: usize) -> ContactRecorder {
+        ContactRecorder {
+            joint,
+            every,
+            series: ContactSeries {
+                time_s: Some(Vec::with_capacity(capacity)),
+                yield_stress_pa: Some(Vec::with_capacity(capacity)),
+                strain_rate_per_s: Some(Vec::with_capacity(capacity)),
+                ..Default::default()
+            },
+        }
+    }
+}
+
+impl Recorder for ContactRecorder {
+    fn record(&mut self, step: usize, time_s: f64, _bodies: &[Body], joints: &[JointState]) {
+        if step.is_multiple_of(self.every) {
+            let j = &joints[self.joint];
+            self.series.push(time_s, j.approach_m, &j.contact);
+        }
+    }
+}
+
+/// The decimated x–t stress field of one bar (for Lagrange diagrams).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarSnapshots {
+    /// Bar name.
+    pub name: String,
+    /// Positions along the bar, m.
+    pub x_m: Vec<f64>,
+    /// Snapshot times, s.
+    pub time_s: Vec<f64>,
+    /// Axial stress (tension positive), one row per time, Pa.
+    pub stress_pa: Vec<Vec<f64>>,
+}
+
+/// Stress fields of every bar every `every` steps (not at step 0), at `spacing_m` along each bar.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SnapshotRecorder {
+    /// Sampling interval in steps.
+    pub every: usize,
+    /// One field per bar of the chain, in chain order.
+    pub snapshots: Vec<BarSnapshots>,
+}
+
+impl SnapshotRecorder {
+    /// A recorder of the bars among `bodies` every `every` steps with points `spacing_m` apart.
+    pub fn new(bodies: &[Body], every: usize, spacing_m: f64) -> SnapshotRecorder {
+        let snapshots = bodies
+            .iter()
+            .filter_map(Body::as_bar)
+            .map(|b| {
+                let len = b.node_position_m(b.node_count() - 1);
+                let n = ((len / spacing_m).round() as usize).max(1);
+                BarSnapshots {
+                    name: b.name().to_string(),
+                    x_m: (0..=n).map(|k| len * k as f64 / n as f64).collect(),
+                    time_s: Vec::new(),
+                    stress_pa: Vec::new(),
+                }
+            })
+            .collect();
+        SnapshotRecorder { every, snapshots }
+    }
+}
+
+impl Recorder for SnapshotRecorder {
+    fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], _joints: &[JointState]) {
+        if step == 0 || !step.is_multiple_of(self.every) {
+            return;
+        }
+        for (b, s) in bodies
+            .iter()
+            .filter_map(Body::as_bar)
+            .zip(self.snapshots.iter_mut())
+        {
+            s.time_s.push(time_s);
+            s.stress_pa
+                .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+        }
+    }
+}
