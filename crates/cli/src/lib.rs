@@ -18,7 +18,7 @@ pub use shpb_core::{
     specimen, striker,
 };
 pub use shpb_input::{Error, Result, Validator, csv, error, gauges, kinds, units};
-pub use shpb_output::{io, plot, writer};
+pub use shpb_output::{io, plot, study as study_table, writer};
 pub use shpb_study::{bench, convergence, file as study_file, sweep};
 pub use shpb_validate as validate;
 

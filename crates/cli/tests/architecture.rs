@@ -1,5 +1,6 @@
 //! The workspace's structure, checked: no import cycle between the modules of any crate (crate
-//! cycles are refused by cargo itself), and a physics core free of I/O and configuration crates.
+//! cycles are refused by cargo itself), a physics core free of I/O and configuration crates, and
+//! HDF5 used by the output layer only.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -149,20 +150,41 @@ fn a_made_up_cycle_is_found() {
     );
 }
 
-#[test]
-fn the_core_depends_on_no_io_or_configuration_crate() {
-    let manifest = std::fs::read_to_string(workspace().join("crates/core/Cargo.toml")).unwrap();
-    let deps = manifest
+/// The `[dependencies]` section of `crates/<name>/Cargo.toml`.
+fn dependencies(name: &str) -> String {
+    let manifest =
+        std::fs::read_to_string(workspace().join("crates").join(name).join("Cargo.toml")).unwrap();
+    manifest
         .split("[dependencies]")
         .nth(1)
         .unwrap()
         .split("\n[")
         .next()
-        .unwrap();
+        .unwrap()
+        .to_string()
+}
+
+#[test]
+fn the_core_depends_on_no_io_or_configuration_crate() {
+    let deps = dependencies("core");
     for banned in ["serde", "toml", "clap", "hdf5", "plotters", "shpb-"] {
         assert!(
             !deps.contains(banned),
             "shpb-core depends on {banned}:\n{deps}"
         );
     }
+}
+
+/// HDF5 is a file format, so it belongs to shpb-output: the other library crates write and read
+/// their files through it (the study file: `shpb_output::study`).
+#[test]
+fn only_the_output_layer_depends_on_hdf5() {
+    for name in ["core", "input", "study", "validate"] {
+        let deps = dependencies(name);
+        assert!(
+            !deps.contains("hdf5"),
+            "crates/{name} depends on hdf5 (file formats belong to shpb-output):\n{deps}"
+        );
+    }
+    assert!(dependencies("output").contains("hdf5"));
 }

@@ -1,6 +1,8 @@
 //! shpb-output: everything shpb writes. One writer trait ([`Writer`]) with one implementation per
-//! format (HDF5, CSV, PNG); every file is written atomically (a temporary name in the same
-//! directory, then a rename that never replaces an existing file without `--force`).
+//! format (HDF5, CSV, PNG) for a run, and the study file of many runs ([`study::StudyTable`],
+//! written and read back by [`study::write_study_hdf5`] and [`study::read_study_hdf5`]). Every
+//! file is written atomically (a temporary name in the same directory, then a rename that never
+//! replaces an existing file without `--force`).
 
 #![warn(missing_docs)]
 
@@ -9,6 +11,7 @@ pub mod h5;
 pub mod io;
 pub mod plot;
 pub mod reduction;
+pub mod study;
 pub mod writer;
 
 pub use shpb_input::{Error, Result};
