@@ -137,11 +137,12 @@ impl Error {
     }
 }
 
-/// Validates numbers read from one input file, producing `Error::Input` that names file and key.
+/// Validates numbers read from one input file, producing `Error::Input` that names file and key
+/// (the dotted keys are the core's [`shpb_core::error::Named`] names, within this file).
 #[derive(Debug, Clone)]
 pub struct Validator {
     file: String,
-    prefix: String,
+    keys: shpb_core::error::Named,
 }
 
 impl Validator {
@@ -149,20 +150,15 @@ impl Validator {
     pub fn new(file: impl Into<String>) -> Self {
         Validator {
             file: file.into(),
-            prefix: String::new(),
+            keys: shpb_core::error::Named::new(""),
         }
     }
 
     /// The same file, with keys reported under the TOML table `table` (e.g. `specimen.sphere1`).
     pub fn table(&self, table: &str) -> Self {
-        let prefix = if self.prefix.is_empty() {
-            table.to_string()
-        } else {
-            format!("{}.{}", self.prefix, table)
-        };
         Validator {
             file: self.file.clone(),
-            prefix,
+            keys: self.keys.table(table),
         }
     }
 
@@ -199,11 +195,7 @@ impl Validator {
 
     /// The full dotted key for `key` in this table.
     pub fn key(&self, key: &str) -> String {
-        if self.prefix.is_empty() {
-            key.to_string()
-        } else {
-            format!("{}.{}", self.prefix, key)
-        }
+        self.keys.key(key)
     }
 
     /// An input error for `key` with the given problem and allowed range.

@@ -145,15 +145,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let v = Validator::new("example.toml");
-        let (pair, _, _, p) = parse(
-            KIND.example,
-            "example.toml",
-            Path::new("."),
-            Fidelity::Standard,
-            &v,
-        )
-        .unwrap();
+        let (pair, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
         let SceneParams::Collision(s) = p else {
             panic!("not a collision: {p:?}")
         };

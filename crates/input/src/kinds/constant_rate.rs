@@ -99,15 +99,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let v = Validator::new("example.toml");
-        let (_, _, _, p) = parse(
-            KIND.example,
-            "example.toml",
-            Path::new("."),
-            Fidelity::Fast,
-            &v,
-        )
-        .unwrap();
+        let (_, _, _, p) = super::super::parse_example(&KIND, Fidelity::Fast);
         assert_eq!(
             p,
             SceneParams::ConstantRate {

@@ -337,6 +337,20 @@ fn check_every(v: &Validator, n: usize) -> Result<usize> {
 /// one-line help, an example of this kind that parses (from any directory when `example_dir` is
 /// `None`), and documented keys that are exactly the keys the parser accepts (`undocumented`:
 /// keys the parser accepts but this kind ignores or refuses).
+/// Parses a kind's README example from a directory holding no file (built-ins only) at `fidelity`.
+#[cfg(test)]
+fn parse_example(kind: &SceneKind, fidelity: Fidelity) -> Parsed {
+    let v = Validator::new("example.toml");
+    (kind.parse)(
+        kind.example,
+        "example.toml",
+        Path::new("/nowhere"),
+        fidelity,
+        &v,
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", kind.name))
+}
+
 #[cfg(test)]
 fn check_kind(kind: &SceneKind, undocumented: &[&str]) {
     use crate::scene::SceneFile;

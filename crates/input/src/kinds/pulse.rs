@@ -316,15 +316,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let v = Validator::new("example.toml");
-        let (_, _, _, p) = parse(
-            KIND.example,
-            "example.toml",
-            Path::new("/nowhere"),
-            Fidelity::Standard,
-            &v,
-        )
-        .unwrap();
+        let (_, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
         let SceneParams::Pulse {
             pressure_pa,
             options,

@@ -99,15 +99,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let v = Validator::new("example.toml");
-        let (pair, law, region2, p) = parse(
-            KIND.example,
-            "example.toml",
-            Path::new("."),
-            Fidelity::Fast,
-            &v,
-        )
-        .unwrap();
+        let (pair, law, region2, p) = super::super::parse_example(&KIND, Fidelity::Fast);
         assert_eq!(pair.sphere1.radius_m, 3.175e-3);
         assert_eq!((law, region2), (LawKind::default(), Region2Form::default()));
         assert_eq!(

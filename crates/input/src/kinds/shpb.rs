@@ -54,15 +54,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let v = Validator::new("example.toml");
-        let (pair, law, region2, p) = parse(
-            KIND.example,
-            "example.toml",
-            Path::new("/nowhere"),
-            Fidelity::Fast,
-            &v,
-        )
-        .unwrap();
+        let (pair, law, region2, p) = super::super::parse_example(&KIND, Fidelity::Fast);
         let SceneParams::Pulse { options, .. } = p else {
             panic!("not a bar scene: {p:?}")
         };
