@@ -1,7 +1,8 @@
 //! The numeric helpers every part of shpb shares, one copy each: argmax, linear resampling,
-//! moving average, cumulative trapezoid, bisection and the FFT phase shift (docs/physics.md §7
-//! for where the reduction uses them).
+//! moving average, cumulative trapezoid, bisection, linear least squares (nalgebra's SVD) and the
+//! FFT phase shift (docs/physics.md §7 for where the reduction uses them).
 
+use nalgebra::{DMatrix, DVector, SVD};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
 
@@ -91,6 +92,48 @@ pub fn bisect(
     (lo, hi)
 }
 
+/// Linear least squares by SVD: the β minimising ‖Σⱼ βⱼ `columns[j]` − `y`‖₂, or None when the
+/// columns are rank-deficient (or any input is not finite).
+///
+/// Each column is a regressor sampled at the points of `y` (a column of ones gives an intercept)
+/// and must have `y`'s length. The columns are scaled to unit norm before the decomposition, so
+/// the rank test — a singular value at most max(rows, columns) · ε times the largest, NumPy's
+/// `matrix_rank` rule — does not depend on their units; fewer rows than columns is
+/// rank-deficient.
+pub fn least_squares(columns: &[&[f64]], y: &[f64]) -> Option<Vec<f64>> {
+    let (n, p) = (y.len(), columns.len());
+    assert!(
+        columns.iter().all(|c| c.len() == n),
+        "least_squares: every column needs y's length {n}"
+    );
+    if p == 0
+        || n < p
+        || !y
+            .iter()
+            .chain(columns.iter().copied().flatten())
+            .all(|v| v.is_finite())
+    {
+        return None;
+    }
+    let norms: Vec<f64> = columns
+        .iter()
+        .map(|c| c.iter().map(|v| v * v).sum::<f64>().sqrt())
+        .collect();
+    if norms.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return None;
+    }
+    let a = DMatrix::from_fn(n, p, |i, j| columns[j][i] / norms[j]);
+    // Finite input converges in a few sweeps per singular value; the cap only guards the loop.
+    let svd = SVD::try_new_unordered(a, true, true, 5.0 * f64::EPSILON, 100 * p)?;
+    let s = &svd.singular_values;
+    let tol = n.max(p) as f64 * f64::EPSILON * s.max();
+    if s.iter().any(|&v| v <= tol) {
+        return None;
+    }
+    let beta = svd.solve(&DVector::from_column_slice(y), tol).ok()?;
+    Some(beta.iter().zip(&norms).map(|(b, s)| b / s).collect())
+}
+
 /// Delays every Fourier component of `x` (step `dt`) at frequency f by `delay(f)` seconds
 /// (spectrum factor exp(−2πi f delay(|f|))). The segment is closed into a smooth periodic signal
 /// by a raised-cosine bridge from its last value back to its first over a padding at least as
@@ -178,6 +221,80 @@ mod tests {
         let (lo, hi) = bisect(0.0, 2.0, 200, |lo, hi| hi - lo <= 1e-14, |x| x * x < 2.0);
         assert!(hi - lo <= 1e-14);
         assert_relative_eq!(0.5 * (lo + hi), 2f64.sqrt(), epsilon = 1e-13);
+    }
+
+    #[test]
+    fn least_squares_recovers_an_exact_linear_model() {
+        // y = 2 − 3 x + 0.5 x² sampled without noise: the fit returns the coefficients.
+        let x: Vec<f64> = (0..12).map(|k| 0.25 * k as f64 - 1.0).collect();
+        let ones = vec![1.0; x.len()];
+        let x2: Vec<f64> = x.iter().map(|v| v * v).collect();
+        let y: Vec<f64> = x.iter().map(|v| 2.0 - 3.0 * v + 0.5 * v * v).collect();
+        let beta = least_squares(&[&ones, &x, &x2], &y).expect("full rank");
+        for (b, want) in beta.iter().zip([2.0, -3.0, 0.5]) {
+            assert_relative_eq!(*b, want, epsilon = 1e-13);
+        }
+        // Square and exactly determined: the solution of the system (columns in Pa-sized units).
+        let p = [68_947.6, 103_421.4];
+        let beta = least_squares(&[&p, &[1.0, 1.0]], &[20.0, 45.0]).expect("full rank");
+        assert_relative_eq!(beta[0] * p[0] + beta[1], 20.0, max_relative = 1e-13);
+        assert_relative_eq!(beta[0] * p[1] + beta[1], 45.0, max_relative = 1e-13);
+    }
+
+    #[test]
+    fn least_squares_refuses_rank_deficient_columns() {
+        let x = [1.0, 2.0, 3.0, 4.0];
+        let y = [1.0, 0.0, 2.0, 5.0];
+        let twice: Vec<f64> = x.iter().map(|v| 2.0 * v).collect();
+        assert_eq!(least_squares(&[&x, &twice], &y), None); // collinear
+        assert_eq!(least_squares(&[&x, &[0.0; 4]], &y), None); // a zero column
+        assert_eq!(least_squares(&[&x[..1], &[1.0]], &y[..1]), None); // fewer rows than columns
+        assert_eq!(least_squares(&[], &y), None);
+        assert_eq!(least_squares(&[&x], &[1.0, f64::NAN, 0.0, 0.0]), None);
+        // Independent columns of very different sizes are not rank-deficient.
+        assert!(least_squares(&[&[1e5, 2e5, 3e5, 4e5], &[1e-9, 1e-9, 1e-9, 1.1e-9]], &y).is_some());
+    }
+
+    #[test]
+    fn least_squares_matches_the_normal_equations_on_noisy_data() {
+        // 40 points of a quadratic in x ∈ [1, 3] plus deterministic ±0.05 noise.
+        let x: Vec<f64> = (0..40).map(|k| 1.0 + 0.05 * k as f64).collect();
+        let ones = vec![1.0; x.len()];
+        let x2: Vec<f64> = x.iter().map(|v| v * v).collect();
+        let y: Vec<f64> = (0..40)
+            .map(|k| {
+                let noise = 0.05 * ((k * 37 % 17) as f64 / 8.0 - 1.0);
+                1.5 + 0.7 * x[k] - 0.2 * x2[k] + noise
+            })
+            .collect();
+        let cols: [&[f64]; 3] = [&ones, &x, &x2];
+        let beta = least_squares(&cols, &y).expect("full rank");
+        // Normal equations (AᵀA) β = Aᵀy, by Cholesky.
+        let a = DMatrix::from_fn(40, 3, |i, j| cols[j][i]);
+        let ata = a.transpose() * &a;
+        let aty = a.transpose() * DVector::from_column_slice(&y);
+        let normal = ata.cholesky().expect("SPD").solve(&aty);
+        // Forming AᵀA squares the condition number: the normal equations' relative error is of
+        // order κ(A)² ε (Golub & Van Loan §5.3), the SVD's κ(A) ε, so they agree to a few κ² ε.
+        let sv = a.singular_values();
+        let kappa = sv.max() / sv.min();
+        let tol = 10.0 * kappa * kappa * f64::EPSILON;
+        assert!(
+            tol < 1e-8,
+            "κ = {kappa}: the test case is well enough conditioned"
+        );
+        let diff = (DVector::from_vec(beta.clone()) - &normal).norm() / normal.norm();
+        assert!(diff <= tol, "relative difference {diff:e} > {tol:e}");
+        // And it is the minimum: the residual is orthogonal to every column.
+        let r: Vec<f64> = (0..40)
+            .map(|i| y[i] - (0..3).map(|j| beta[j] * cols[j][i]).sum::<f64>())
+            .collect();
+        for c in cols {
+            let dot: f64 = c.iter().zip(&r).map(|(a, b)| a * b).sum();
+            let scale = c.iter().map(|v| v * v).sum::<f64>().sqrt()
+                * y.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(dot.abs() <= 1e-12 * scale, "Aᵀr = {dot:e}");
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, max_of, pct, read_columns, rms};
 use shpb_core::contact::{FIT_REFERENCE_RADIUS_M, FittedParameters, LoadingCurve, Region2Form};
-use shpb_core::numeric::resample;
+use shpb_core::numeric::{least_squares, resample};
 use shpb_core::scene::Params;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
@@ -34,32 +34,25 @@ const PAPER_C2: (f64, f64) = (-3.99e-6, 1.01e-9);
 /// Effective radius of the FEM's two 6.35 mm hemispheres, m.
 const FEM_RADIUS_M: f64 = 6.35e-3 / 4.0;
 
-/// Least-squares a, b of y = a/q + b.
-fn fit_inverse(q: &[f64], y: &[f64]) -> (f64, f64) {
-    let n = q.len() as f64;
+/// Least-squares a, b of y = a/q + b (None when the q do not determine them: all equal).
+fn fit_inverse(q: &[f64], y: &[f64]) -> Option<(f64, f64)> {
     let x: Vec<f64> = q.iter().map(|v| 1.0 / v).collect();
-    let (sx, sy) = (x.iter().sum::<f64>(), y.iter().sum::<f64>());
-    let sxx: f64 = x.iter().map(|v| v * v).sum();
-    let sxy: f64 = x.iter().zip(y).map(|(a, b)| a * b).sum();
-    let a = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-    (a, (sy - a * sx) / n)
+    let ab = least_squares(&[&x, &vec![1.0; q.len()]], y)?;
+    Some((ab[0], ab[1]))
 }
 
 /// Least-squares A, C of y = A q^B + C at fixed B, with its sum of squared residuals.
-fn fit_power_at(q: &[f64], y: &[f64], b: f64) -> (f64, f64, f64) {
+fn fit_power_at(q: &[f64], y: &[f64], b: f64) -> Option<(f64, f64, f64)> {
     let qb: Vec<f64> = q.iter().map(|v| v.powf(b)).collect();
-    let (a, c) = {
-        let inv: Vec<f64> = qb.iter().map(|v| 1.0 / v).collect();
-        // y = A·qb + C is y = A/(1/qb) + C: reuse the linear fit on 1/qb.
-        fit_inverse(&inv, y)
-    };
+    let ac = least_squares(&[&qb, &vec![1.0; q.len()]], y)?;
+    let (a, c) = (ac[0], ac[1]);
     let ss = qb.iter().zip(y).map(|(x, v)| (a * x + c - v).powi(2)).sum();
-    (a, c, ss)
+    Some((a, c, ss))
 }
 
 /// Least-squares A, B, C of y = A q^B + C (B by golden-section search on −1.5 … −0.01).
-fn fit_power(q: &[f64], y: &[f64]) -> (f64, f64, f64) {
-    let ss = |b: f64| fit_power_at(q, y, b).2;
+fn fit_power(q: &[f64], y: &[f64]) -> Option<(f64, f64, f64)> {
+    let ss = |b: f64| fit_power_at(q, y, b).map_or(f64::INFINITY, |f| f.2);
     // Coarse scan, then golden section around the best point.
     let grid: Vec<f64> = (0..=149).map(|k| -1.5 + 0.01 * k as f64).collect();
     let k = (0..grid.len())
@@ -76,8 +69,8 @@ fn fit_power(q: &[f64], y: &[f64]) -> (f64, f64, f64) {
         }
     }
     let b = 0.5 * (lo + hi);
-    let (a, c, _) = fit_power_at(q, y, b);
-    (a, b, c)
+    let (a, c, _) = fit_power_at(q, y, b)?;
+    Some((a, b, c))
 }
 
 /// The Fig. 2 comparison of one yield stress.
@@ -156,9 +149,19 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
             allowed: "at least 4 rows with q > 0".into(),
         });
     }
-    let fit_dp = fit_inverse(&q, &dp);
-    let fit_c1 = fit_power(&q, &c1);
-    let fit_c2 = fit_inverse(&q, &c2);
+    let (Some(fit_dp), Some(fit_c1), Some(fit_c2)) = (
+        fit_inverse(&q, &dp),
+        fit_power(&q, &c1),
+        fit_inverse(&q, &c2),
+    ) else {
+        return Err(Error::Input {
+            file: t.file.clone(),
+            key: "q_Estar_over_sy".into(),
+            problem: "the fits are undetermined (fewer than 2 distinct q, or a value not finite)"
+                .into(),
+            allowed: "at least 2 distinct q and finite values".into(),
+        });
+    };
     let paper = |q: f64| FittedParameters::at(q, FIT_REFERENCE_RADIUS_M);
     let (q_lo, q_hi) = (q.iter().copied().fold(f64::INFINITY, f64::min), max_of(&q));
     let q_grid: Vec<f64> = (0..=200)

@@ -10,7 +10,7 @@ mod common;
 
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{BridgeKind, RawRecord};
-use shpb_core::numeric::argmax;
+use shpb_core::numeric::{argmax, least_squares};
 use shpb_core::reduce::{
     Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
 };
@@ -105,12 +105,10 @@ fn fit_authors(eps_i: &[f64], eps_t: &[f64], ea: f64, c0: f64, dt: f64, a: &Auth
     let (mut best, mut m_best, mut s_best) = (f64::INFINITY, 0, 1.0);
     for m in 0..n - l {
         let seg = &ft[m..m + l];
-        let sxy: f64 = seg.iter().zip(&a.f).map(|(x, y)| x * y).sum();
-        let sxx: f64 = seg.iter().map(|x| x * x).sum();
-        if sxx <= 0.0 {
+        let Some(s) = least_squares(&[seg], &a.f) else {
             continue;
-        }
-        let s = sxy / sxx;
+        };
+        let s = s[0];
         let r: f64 = seg
             .iter()
             .zip(&a.f)

@@ -27,7 +27,7 @@ use nelder_mead::nelder_mead;
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
-use shpb_core::numeric::{bisect, moving_average, resample};
+use shpb_core::numeric::{bisect, least_squares, moving_average, resample};
 use shpb_core::shaper::PulseShaper;
 use shpb_core::striker::Gun;
 use shpb_input::Validator;
@@ -332,11 +332,9 @@ fn line_through(v10: f64, v15: f64) -> Option<(f64, f64)> {
 fn least_squares_gun(v: &[f64; 3]) -> (f64, f64, [f64; 3]) {
     let p: Vec<f64> = PRESSURES_PSI.iter().map(|x| x * PSI_PA).collect();
     let y: Vec<f64> = v.iter().map(|x| x * x).collect();
-    let (pm, ym) = (p.iter().sum::<f64>() / 3.0, y.iter().sum::<f64>() / 3.0);
-    let sxy: f64 = (0..3).map(|i| (p[i] - pm) * (y[i] - ym)).sum();
-    let sxx: f64 = (0..3).map(|i| (p[i] - pm) * (p[i] - pm)).sum();
-    let k = sxy / sxx;
-    let loss = pm - ym / k;
+    // v² = k p + c with c = −k p_loss.
+    let kc = least_squares(&[&p, &[1.0; 3]], &y).expect("three distinct pressures fix the line");
+    let (k, loss) = (kc[0], -kc[1] / kc[0]);
     let res = [0, 1, 2].map(|i| (k * (p[i] - loss)).max(0.0).sqrt() - v[i]);
     (k, loss, res)
 }
