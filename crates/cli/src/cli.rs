@@ -9,8 +9,7 @@ use shpb_core::fidelity::Fidelity;
 use shpb_input::Result;
 use std::path::PathBuf;
 
-/// The built-in set-up `--bars` names when not given.
-const DEFAULT_BARS: &str = "authors";
+use crate::cmd::common::DEFAULT_BARS;
 
 /// The help text after the options of `shpb --help` and `shpb run --help`: the scene kinds (from
 /// [`shpb_input::kinds::names_and_help`]), the built-in set-ups and the exit codes.
@@ -259,9 +258,10 @@ pub enum Command {
         /// The record (.csv or .h5).
         record: PathBuf,
         /// Bar set-up (bars, gauge distances, bridge, gain, polarity): a built-in set-up
-        /// (`shpb list`) or a set-up file.
-        #[arg(long, default_value = DEFAULT_BARS)]
-        bars: PathBuf,
+        /// (`shpb list`) or a set-up file [default: a run file's own set-up, else `authors`].
+        /// For a run file, a set-up that differs from the one it was simulated with is refused.
+        #[arg(long)]
+        bars: Option<PathBuf>,
         /// HDF5 output.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -402,18 +402,14 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             csv,
             no_dispersion,
             force,
-        } => {
-            // The set-up is named before an existing output is.
-            cmd::common::require_bars(&bars)?;
-            cmd::reduce::reduce_command(
-                &record,
-                &bars,
-                output.as_deref(),
-                csv.as_deref(),
-                force,
-                no_dispersion,
-            )
-        }
+        } => cmd::reduce::reduce_command(
+            &record,
+            bars.as_deref(),
+            output.as_deref(),
+            csv.as_deref(),
+            force,
+            no_dispersion,
+        ),
         Command::Strain {
             record,
             bars,

@@ -608,9 +608,13 @@ fn curve_prints_header_and_101_rows() {
 }
 
 /// Every dataset under `group`, recursively, as (path, dataset).
+/// Every numeric dataset under `group` (`/provenance` holds the input texts, not data).
 fn datasets(group: &hdf5::Group, prefix: &str, out: &mut Vec<(String, hdf5::Dataset)>) {
     for name in group.member_names().unwrap() {
         let path = format!("{prefix}/{name}");
+        if path == "/provenance" {
+            continue;
+        }
         if let Ok(ds) = group.dataset(&name) {
             out.push((path, ds));
         } else if let Ok(g) = group.group(&name) {

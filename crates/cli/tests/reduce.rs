@@ -831,7 +831,7 @@ fn reduce_command_writes_hdf5_and_csv_from_a_raw_record() {
     let h5 = dir.path().join("red.h5");
     let csv = dir.path().join("red.csv");
     let bars = root().join("bars/authors.toml");
-    reduce_command(rec, &bars, Some(&h5), Some(&csv), false, false).unwrap();
+    reduce_command(rec, Some(&bars), Some(&h5), Some(&csv), false, false).unwrap();
     let n = check_reduction_hdf5(&h5);
     let t = CsvTable::read(&csv).unwrap();
     assert_eq!(
@@ -849,9 +849,9 @@ fn reduce_command_writes_hdf5_and_csv_from_a_raw_record() {
     );
     assert_eq!(t.columns[0].len(), n);
     // An existing output is kept without --force, replaced with it.
-    let err = reduce_command(rec, &bars, Some(&h5), None, false, true).unwrap_err();
+    let err = reduce_command(rec, Some(&bars), Some(&h5), None, false, true).unwrap_err();
     assert!(matches!(err, Error::OutputExists(_)), "{err}");
-    reduce_command(rec, &bars, Some(&h5), None, true, true).unwrap();
+    reduce_command(rec, Some(&bars), Some(&h5), None, true, true).unwrap();
     let f = hdf5::File::open(&h5).unwrap();
     assert!(read_attr_string(&f, "scene").contains("--no-dispersion"));
     // No temporary files are left.
@@ -898,11 +898,11 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
     };
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run.h5");
-    write_hdf5(&run, false, "kind = \"shpb\"", &out).unwrap();
+    write_hdf5(&run, false, "kind = \"shpb\"", None, &out).unwrap();
     let red = dir.path().join("red.h5");
     reduce_command(
         &run,
-        &root().join("bars/authors.toml"),
+        Some(&root().join("bars/authors.toml")),
         Some(&red),
         None,
         false,
@@ -936,14 +936,14 @@ fn bad_inputs_name_file_and_key() {
     }
     let short = dir.path().join("short.csv");
     std::fs::write(&short, text).unwrap();
-    let err = reduce_command(&short, &bars, None, None, false, false).unwrap_err();
+    let err = reduce_command(&short, Some(&bars), None, None, false, false).unwrap_err();
     let msg = err.to_string();
     assert_eq!(err.exit_code(), 2, "{msg}");
     assert!(msg.contains("short.csv") && msg.contains("time_s"), "{msg}");
     // Missing files.
     let err = reduce_command(
         &dir.path().join("nope.csv"),
-        &bars,
+        Some(&bars),
         None,
         None,
         false,
@@ -953,7 +953,7 @@ fn bad_inputs_name_file_and_key() {
     assert!(err.to_string().contains("RECORD"), "{err}");
     let err = reduce_command(
         &short,
-        &dir.path().join("nope.toml"),
+        Some(&dir.path().join("nope.toml")),
         None,
         None,
         false,
@@ -964,7 +964,7 @@ fn bad_inputs_name_file_and_key() {
     // An HDF5 file without gauges names the dataset.
     let h5 = dir.path().join("empty.h5");
     hdf5::File::create(&h5).unwrap();
-    let err = reduce_command(&h5, &bars, None, None, false, false).unwrap_err();
+    let err = reduce_command(&h5, Some(&bars), None, None, false, false).unwrap_err();
     assert!(err.to_string().contains("time"), "{err}");
     // Options out of range.
     let s = setup(5000.0, 0.65, 0.35);

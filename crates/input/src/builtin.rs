@@ -28,12 +28,15 @@ pub fn setup(name: &str) -> Option<&'static str> {
     SETUPS
         .iter()
         .find(|(n, _, _)| *n == name)
-        .map(|(_, t, _)| *t)
+        .map(|(n, t, _)| crate::files::builtin(n, t))
 }
 
 /// The text of the built-in gauge file `name`.
 pub fn gauges(name: &str) -> Option<&'static str> {
-    GAUGES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    GAUGES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(n, t)| crate::files::builtin(n, t))
 }
 
 /// The built-in set-up names joined for messages.

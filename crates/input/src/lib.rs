@@ -10,6 +10,7 @@
 pub mod builtin;
 pub mod csv;
 pub mod error;
+pub mod files;
 pub mod gauges;
 pub mod kinds;
 pub mod material;

@@ -83,6 +83,7 @@ impl MaterialFile for Material {
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(n, text)| {
+                let text = crate::files::builtin(&format!("specimens/{n}.toml"), text);
                 Material::from_toml(text, &format!("specimens/{n}.toml"))
                     .expect("built-in material files are valid")
             })
@@ -92,7 +93,7 @@ impl MaterialFile for Material {
     fn resolve(reference: &str, base_dir: &Path, v: &Validator, key: &str) -> Result<Material> {
         if reference.ends_with(".toml") {
             let path = base_dir.join(reference);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = crate::files::read_to_string(&path).map_err(|e| {
                 v.error(
                     key,
                     format!("cannot read {}: {e}", path.display()),

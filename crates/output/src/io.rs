@@ -26,21 +26,46 @@ pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static
     cols
 }
 
-/// Writes a run to HDF5: `/contact/*` with units, `/summary` attributes, root `shpb_version` and `scene`.
-pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -> Result<()> {
+/// Origin of `/time` and `/contact/time` (both on the simulation clock).
+pub const TIME_ORIGIN: &str = "the striker's impact (t = 0 of the simulation)";
+
+/// Writes a run to HDF5: the series with their units, `/summary` (each value as an attribute
+/// and as a scalar dataset carrying its own `units`), root `shpb_version` and `scene`, and
+/// `/provenance` (module [`crate::provenance`]) when given. Every time axis states its origin
+/// and its offset from `/time` (attributes `origin`, `offset_from_time_s`).
+pub fn write_hdf5(
+    path: &Path,
+    force: bool,
+    scene_text: &str,
+    provenance: Option<&shpb_input::files::Provenance>,
+    out: &RunOutput,
+) -> Result<()> {
     write_atomically(path, force, |tmp| {
         let f = hdf5::File::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
         string_attr(&f, "scene", scene_text, path)?;
+        let origin = |g: &hdf5::Group, name: &str, origin: &str, offset_s: f64| -> Result<()> {
+            let ds = g.dataset(name).map_err(h5err(path))?;
+            string_attr(&ds, "origin", origin, path)?;
+            ds.new_attr::<f64>()
+                .shape(())
+                .create("offset_from_time_s")
+                .and_then(|a| a.write_scalar(&offset_s))
+                .map_err(h5err(path))
+        };
         if let Some(contact) = &out.contact {
             let g = f.create_group("contact").map_err(h5err(path))?;
             for (name, data, units) in contact_columns(contact) {
                 write_dataset(&g, name, data, units, path)?;
             }
+            if contact.time_s.is_some() {
+                origin(&g, "time", TIME_ORIGIN, 0.0)?;
+            }
         }
         if let Some(t) = &out.time_s {
             let root = f.group("/").map_err(h5err(path))?;
             write_dataset(&root, "time", t, "s", path)?;
+            origin(&root, "time", TIME_ORIGIN, 0.0)?;
         }
         if !out.gauges.is_empty() {
             let g = f.create_group("gauges").map_err(h5err(path))?;
@@ -81,6 +106,12 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
             for (name, data, units, _) in crate::reduction::reduction_columns(r) {
                 write_dataset(&g, name, data, units, path)?;
             }
+            origin(
+                &g,
+                "time",
+                "the incident pulse's foot at the specimen face (record clock: /time + offset_from_time_s)",
+                r.face_time_offset_s,
+            )?;
         }
         if !out.energy.is_empty() {
             let g = f.create_group("energy").map_err(h5err(path))?;
@@ -96,6 +127,13 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
                 .create(it.key.as_str())
                 .map_err(h5err(path))?;
             a.write_scalar(&it.value).map_err(h5err(path))?;
+            let ds = s
+                .new_dataset::<f64>()
+                .shape(())
+                .create(it.key.as_str())
+                .map_err(h5err(path))?;
+            ds.write_scalar(&it.value).map_err(h5err(path))?;
+            string_attr(&ds, "units", it.unit, path)?;
         }
         string_attr(
             &s,
@@ -108,6 +146,9 @@ pub fn write_hdf5(path: &Path, force: bool, scene_text: &str, out: &RunOutput) -
             path,
         )?;
         string_attr(&s, "warnings", &out.warnings.join("\n"), path)?;
+        if let Some(p) = provenance {
+            crate::provenance::write_provenance(&f, p, path)?;
+        }
         f.close().map_err(h5err(path))
     })
 }

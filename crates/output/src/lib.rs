@@ -10,6 +10,7 @@ pub mod atomic;
 pub mod h5;
 pub mod io;
 pub mod plot;
+pub mod provenance;
 pub mod reduction;
 pub mod study;
 pub mod writer;

@@ -15,9 +15,13 @@ pub trait Writer {
     fn write_run(&self, path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()>;
 }
 
-/// HDF5: every series, the summary, the reduction and the scene text (`shpb run -o`).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Hdf5;
+/// HDF5: every series, the summary, the reduction, the scene text and, when known, the run's
+/// provenance (`shpb run -o`).
+#[derive(Debug, Clone, Default)]
+pub struct Hdf5 {
+    /// What the run read and how it was asked for (`/provenance`), if known.
+    pub provenance: Option<shpb_input::files::Provenance>,
+}
 
 /// CSV: the contact series, or the gauge series of bar scenes (`shpb run --csv`).
 #[derive(Debug, Clone, Copy, Default)]
@@ -33,7 +37,7 @@ impl Writer for Hdf5 {
         "HDF5"
     }
     fn write_run(&self, path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()> {
-        crate::io::write_hdf5(path, force, &params.text, out)
+        crate::io::write_hdf5(path, force, &params.text, self.provenance.as_ref(), out)
     }
 }
 

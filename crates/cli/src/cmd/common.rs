@@ -7,6 +7,9 @@ use shpb_input::{Error, Result, Validator};
 use std::io::Write;
 use std::path::Path;
 
+/// The built-in set-up `--bars` names when not given.
+pub const DEFAULT_BARS: &str = "authors";
+
 /// An input error (exit code 2) naming the file (or "command line"), the key, the problem and
 /// what is allowed.
 pub fn input_err(

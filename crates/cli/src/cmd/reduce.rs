@@ -1,9 +1,13 @@
 //! `shpb reduce`: the lab's reduction of a raw record or of a run file.
 
-use super::common::{input_err, load_apparatus, require_bars, say};
+use super::common::{DEFAULT_BARS, input_err, load_apparatus, require_bars, say};
+use shpb_core::apparatus::Apparatus;
 use shpb_core::reduce::{PAPER_SPHERE_RADII_M, ReductionOptions, ReductionSetup, reduce_named};
+use shpb_core::scene::{Params, SceneParams};
 use shpb_input::Result;
 use shpb_input::gauges::reduce_record_file;
+use shpb_input::prelude::*;
+use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
 use shpb_output::reduction::{
     is_hdf5, read_hdf5_strains, write_reduction_csv, write_reduction_hdf5,
 };
@@ -16,16 +20,25 @@ use std::path::Path;
 /// the paper's spheres (r1 + r2 = 6.35 mm).
 pub fn reduce_command(
     record: &Path,
-    bars: &Path,
+    bars_flag: Option<&Path>,
     output: Option<&Path>,
     csv: Option<&Path>,
     force: bool,
     no_dispersion: bool,
 ) -> Result<()> {
-    for p in [output, csv].into_iter().flatten() {
-        shpb_output::io::check_output(p, force)?;
-    }
+    let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
+    let outputs = [
+        (output, "--output", &["h5", "hdf5"][..]),
+        (csv, "--csv", &["csv"][..]),
+    ];
+    for (p, flag, extensions) in outputs {
+        if let Some(p) = p {
+            check_output_flag(p, force, flag)?;
+            check_extension(p, flag, extensions)?;
+            check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
+        }
+    }
     if !record.is_file() {
         return Err(input_err(
             "command line",
@@ -34,13 +47,39 @@ pub fn reduce_command(
             "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
         ));
     }
-    let apparatus = load_apparatus(bars)?;
+    let hdf5_input = is_hdf5(record)?;
+    let run = if hdf5_input { run_setup(record)? } else { None };
+    let (apparatus, radii) = match run {
+        Some((run_apparatus, radii)) => {
+            if let Some(flag) = bars_flag {
+                let given = load_apparatus(flag)?;
+                if ReductionSetup::from_apparatus(&given)?
+                    != ReductionSetup::from_apparatus(&run_apparatus)?
+                {
+                    return Err(input_err(
+                        "command line",
+                        "--bars",
+                        format!(
+                            "{} was simulated with the set-up {} ({}); --bars {} differs ({})",
+                            record.display(),
+                            run_apparatus.source,
+                            describe(&run_apparatus),
+                            flag.display(),
+                            describe(&given)
+                        ),
+                        "no --bars (the run file's own set-up is used), or a set-up with the same bars and gauge distances",
+                    ));
+                }
+            }
+            (run_apparatus, radii)
+        }
+        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
+    };
     let options = ReductionOptions {
         dispersion_correction: !no_dispersion,
-        specimen_radii_m: Some(PAPER_SPHERE_RADII_M),
+        specimen_radii_m: Some(radii),
         ..ReductionOptions::default()
     };
-    let hdf5_input = is_hdf5(record)?;
     let r = if hdf5_input {
         let input = read_hdf5_strains(record)?;
         reduce_named(
@@ -52,7 +91,11 @@ pub fn reduce_command(
     } else {
         reduce_record_file(record, &apparatus, &options)?
     };
-    let mut scene = format!("shpb reduce {} --bars {}", record.display(), bars.display());
+    let mut scene = format!(
+        "shpb reduce {} --bars {}",
+        record.display(),
+        bars_flag.map_or(apparatus.source.clone(), |b| b.display().to_string())
+    );
     if let Some(o) = output {
         scene.push_str(&format!(" -o {}", o.display()));
     }
@@ -112,4 +155,41 @@ pub fn reduce_command(
         say(&format!("warning: {w}"))?;
     }
     Ok(())
+}
+
+/// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored
+/// in its `/provenance` (None for a file without a stored bar scene, e.g. `shpb strain`'s).
+fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
+    let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
+        return Ok(None);
+    };
+    if stored.scene_file.is_empty() {
+        return Ok(None);
+    }
+    let params = shpb_input::files::replay(&stored.inputs, || {
+        Params::from_file_with(Path::new(&stored.scene_file), None)
+    })?;
+    Ok(match params.params {
+        SceneParams::Pulse { apparatus, .. } => Some((
+            *apparatus,
+            (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
+        )),
+        _ => None,
+    })
+}
+
+/// The bar diameters and gauge distances of a set-up, for messages.
+fn describe(a: &Apparatus) -> String {
+    let gauge = |n: &str| {
+        a.gauges.channel(n).map_or("none".to_string(), |c| {
+            format!("{} m", c.distance_from_specimen_m)
+        })
+    };
+    format!(
+        "bars {} / {} mm, gauges at {} / {}",
+        a.incident.diameter_m * 1e3,
+        a.transmission.diameter_m * 1e3,
+        gauge("incident"),
+        gauge("transmission")
+    )
 }

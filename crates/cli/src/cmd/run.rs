@@ -1,16 +1,20 @@
-//! `shpb run`: run a scene file, print its summary and write its results.
+//! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
+//! summary and write its results.
 
 use super::common::print;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
-use shpb_input::Result;
+use shpb_input::files::{self, Provenance};
 use shpb_input::prelude::*;
-use shpb_output::io::check_output;
+use shpb_input::{Error, Result};
+use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
 use shpb_output::writer::{Csv, Hdf5, Png, Writer};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// `shpb run SCENE [-o OUT.h5] [--csv OUT.csv] [--plot OUT.png] [--force] [--fidelity F]`.
+/// `shpb run SCENE [-o OUT.h5] [--csv OUT.csv] [--plot OUT.png] [--force] [--fidelity F]`;
+/// SCENE may be a run file (`.h5` written by `shpb run -o`): the test is run again from the
+/// scene and input files stored in its `/provenance`, not from the disk.
 pub fn run(
     scene: &Path,
     output: Option<&Path>,
@@ -19,10 +23,32 @@ pub fn run(
     force: bool,
     fidelity: Option<Fidelity>,
 ) -> Result<()> {
-    for p in [output, csv, plot].into_iter().flatten() {
-        check_output(p, force)?;
+    let outputs = [
+        (output, "--output", &["h5", "hdf5"][..]),
+        (csv, "--csv", &["csv"][..]),
+        (plot, "--plot", &["png"][..]),
+    ];
+    for (p, flag, extensions) in outputs {
+        if let Some(p) = p {
+            check_output_flag(p, force, flag)?;
+            check_extension(p, flag, extensions)?;
+        }
     }
-    let params = Params::from_file_with(scene, fidelity)?;
+    let (params, provenance) = load(scene, fidelity)?;
+    // An output may never be one of the inputs (not even with --force).
+    let mut inputs: Vec<PathBuf> = vec![scene.to_path_buf()];
+    inputs.extend(
+        provenance
+            .inputs
+            .iter()
+            .filter(|f| !f.name.starts_with("built-in:"))
+            .map(|f| PathBuf::from(&f.name)),
+    );
+    for (p, flag, _) in outputs {
+        if let Some(p) = p {
+            check_not_input(p, flag, &inputs)?;
+        }
+    }
     let mut out = params.run()?;
     out.warnings.splice(0..0, params.warnings());
     for w in &out.warnings {
@@ -30,7 +56,10 @@ pub fn run(
     }
     print_summary(&params, &out)?;
     if let Some(p) = output {
-        Hdf5.write_run(p, force, &params, &out)?;
+        Hdf5 {
+            provenance: Some(provenance),
+        }
+        .write_run(p, force, &params, &out)?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = csv {
@@ -42,6 +71,45 @@ pub fn run(
         eprintln!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Reads the scene (recording every input it reads), or a run file's stored scene and inputs.
+fn load(scene: &Path, fidelity: Option<Fidelity>) -> Result<(Params, Provenance)> {
+    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
+    if scene.is_file() && shpb_output::reduction::is_hdf5(scene)? {
+        let stored = shpb_output::provenance::read_provenance(scene)?;
+        let fidelity = match fidelity {
+            Some(f) => Some(f),
+            None => match stored.fidelity_override.as_deref() {
+                Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
+                    file: scene.display().to_string(),
+                    key: "/provenance fidelity_override".into(),
+                    problem: format!("unknown fidelity `{name}`"),
+                    allowed: "fast, standard, reference".into(),
+                })?),
+                None => None,
+            },
+        };
+        let params = files::replay(&stored.inputs, || {
+            Params::from_file_with(Path::new(&stored.scene_file), fidelity)
+        })?;
+        let provenance = Provenance {
+            fidelity_override: fidelity.map(|f| f.name().to_string()),
+            command_line,
+            ..stored
+        };
+        return Ok((params, provenance));
+    }
+    let (params, inputs) = files::capture(|| Params::from_file_with(scene, fidelity));
+    Ok((
+        params?,
+        Provenance {
+            scene_file: scene.display().to_string(),
+            fidelity_override: fidelity.map(|f| f.name().to_string()),
+            command_line,
+            inputs,
+        },
+    ))
 }
 
 /// Prints the run summary; a closed pipe (`shpb run … | head`) is not an error.

@@ -4,7 +4,7 @@ use super::common::{load_apparatus, say};
 use shpb_core::run::RunOutput;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
-use shpb_output::io::check_output;
+use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
 use std::path::Path;
 
 /// `shpb strain RECORD [--bars SET-UP] [-o OUT.h5] [--csv OUT.csv] [--force]`.
@@ -15,11 +15,24 @@ pub fn strain(
     csv: Option<&Path>,
     force: bool,
 ) -> Result<()> {
-    for p in [output, csv].into_iter().flatten() {
-        check_output(p, force)?;
+    let outputs = [
+        (output, "--output", &["h5", "hdf5"][..]),
+        (csv, "--csv", &["csv"][..]),
+    ];
+    for (p, flag, extensions) in outputs {
+        if let Some(p) = p {
+            check_output_flag(p, force, flag)?;
+            check_extension(p, flag, extensions)?;
+            check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
+        }
     }
-    let apparatus = load_apparatus(bars)?;
-    let rec = shpb_core::gauge::RawRecord::read(record)?;
+    let (read, inputs) = shpb_input::files::capture(|| -> Result<_> {
+        Ok((
+            load_apparatus(bars)?,
+            shpb_core::gauge::RawRecord::read(record)?,
+        ))
+    });
+    let (apparatus, rec) = read?;
     let mut gauges = Vec::new();
     for (name, volts) in [
         ("incident", &rec.incident_v),
@@ -53,7 +66,13 @@ pub fn strain(
         bars.display()
     );
     if let Some(p) = output {
-        shpb_output::io::write_hdf5(p, force, &text, &out)?;
+        let provenance = shpb_input::files::Provenance {
+            scene_file: String::new(),
+            fidelity_override: None,
+            command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            inputs: inputs.clone(),
+        };
+        shpb_output::io::write_hdf5(p, force, &text, Some(&provenance), &out)?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = csv {

@@ -175,7 +175,7 @@ pub(super) fn parse_bars(
         (None, false) => None,
     };
     let set_up = base_dir.join(&f.bars);
-    if crate::builtin::setup(&f.bars).is_none() && !set_up.is_file() {
+    if crate::builtin::setup(&f.bars).is_none() && !crate::files::is_file(&set_up) {
         return Err(v.error(
             "bars",
             format!("cannot read {}: no such file", set_up.display()),
