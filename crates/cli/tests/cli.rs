@@ -171,9 +171,38 @@ fn missing_scene_file_is_named() {
     assert_refused(
         dir.path(),
         &out,
-        None,
+        Some(BAD_INPUT),
         &[scene.to_str().unwrap(), "No such file"],
     );
+}
+
+/// A missing input file is bad input (exit 2) wherever it is read: scene, record, set-up.
+#[test]
+fn a_missing_input_file_exits_2_in_every_command() {
+    let dir = TempDir::new().unwrap();
+    for args in [
+        &["run", "nope.toml"][..],
+        &["reduce", "nope.csv"][..],
+        &["strain", "nope.csv"][..],
+        &["incident", "nope.csv"][..],
+        &["sweep", "nope.toml", "--set", "pressure=10psi"][..],
+        &["convergence", "nope.toml"][..],
+        &["gun", "--pressure", "10psi", "--bars", "nope.toml"][..],
+        &["merge", "nope.h5", "-o", "m.h5"][..],
+    ] {
+        let out = shpb(dir.path(), args);
+        assert_eq!(
+            out.status.code(),
+            Some(BAD_INPUT),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+        assert!(
+            text(&out.stderr).contains("nope"),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+    }
 }
 
 #[test]
@@ -185,7 +214,7 @@ fn missing_force_csv_is_named() {
     assert_refused(
         dir.path(),
         &out,
-        None,
+        Some(BAD_INPUT),
         &[csv.to_str().unwrap(), "No such file"],
     );
 }

@@ -116,13 +116,15 @@ impl From<shpb_core::Error> for Error {
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
-    /// Process exit code for this error: 2 for bad input, 3 for an unstable run, 1 otherwise.
+    /// Process exit code for this error: 2 for bad input (a missing input file included,
+    /// wherever it is read), 3 for an unstable run, 1 otherwise.
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Input { .. }
             | Error::Parse { .. }
             | Error::OutputExists(_)
             | Error::Invalid { .. } => 2,
+            Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => 2,
             Error::Unstable { .. } => 3,
             Error::Io { .. } | Error::Hdf5 { .. } => 1,
         }

@@ -52,6 +52,32 @@ fn perr<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> Error + '_ {
     }
 }
 
+/// A tick label as a person writes it: at most six significant digits, no float noise
+/// (`0.30000000000000004` → `0.3`), no trailing zeros, no `-0`.
+pub fn tick(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return if v.is_nan() { "NaN".into() } else { "0".into() };
+    }
+    let magnitude = v.abs().log10().floor() as i32;
+    let decimals = (5 - magnitude).clamp(0, 15) as usize;
+    let text = format!("{v:.decimals$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    };
+    if text == "-0" { "0".into() } else { text }
+}
+
+/// A value label with three significant digits (`12.3`, `0.0456`, `1230`).
+pub fn three_digits(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return tick(v);
+    }
+    let unit = 10f64.powi(v.abs().log10().floor() as i32 - 2);
+    tick((v / unit).round() * unit)
+}
+
 /// Data range of the scaled curves, padded so a flat curve still has an axis.
 fn range(curves: &[Curve], axes: &Axes) -> (f64, f64, f64, f64) {
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
@@ -86,6 +112,8 @@ fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()
         .configure_mesh()
         .x_desc(axes.x_label)
         .y_desc(axes.y_label)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
         .label_style(("sans-serif", 17))
         .draw()
         .map_err(perr(path))?;
@@ -153,7 +181,44 @@ fn stress_colour(s: f64, scale: f64) -> RGBColor {
     }
 }
 
-/// Draws x–t fields (several bars side by side) as coloured cells.
+/// The colour bar of the x–t diagram: stress from −`full_mpa` to +`full_mpa` (MPa), with the
+/// colours of [`stress_colour`] (saturated beyond).
+fn draw_colour_bar(area: &Area, path: &Path, full_mpa: f64) -> Result<()> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(45)
+        .margin_bottom(65)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, -full_mpa..full_mpa)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("stress (MPa)")
+        .y_labels(7)
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(perr(path))?;
+    let steps = 100;
+    for k in 0..steps {
+        let (s0, s1) = (
+            -full_mpa + 2.0 * full_mpa * k as f64 / steps as f64,
+            -full_mpa + 2.0 * full_mpa * (k + 1) as f64 / steps as f64,
+        );
+        chart
+            .plotting_area()
+            .draw(&Rectangle::new(
+                [(0.0, s0), (1.0, s1)],
+                stress_colour(0.5 * (s0 + s1), full_mpa).filled(),
+            ))
+            .map_err(perr(path))?;
+    }
+    Ok(())
+}
+
+/// Draws x–t fields (several bars side by side) as coloured cells, with a colour bar.
 fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result<()> {
     let (mut xmin, mut xmax, mut tmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
     let mut magnitudes: Vec<f64> = Vec::new();
@@ -175,12 +240,10 @@ fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result
         return Ok(());
     }
     let smax = smax.max(1.0);
-    let mut chart = ChartBuilder::on(area)
+    let (area, bar_area) = area.split_horizontally(area.dim_in_pixel().0.saturating_sub(130));
+    let mut chart = ChartBuilder::on(&area)
         .caption(
-            format!(
-                "{title} (blue: compression, red: tension, full colour at {:.0} MPa)",
-                smax / 1e6
-            ),
+            format!("{title} (blue: compression, red: tension)"),
             ("sans-serif", 20),
         )
         .margin(15)
@@ -193,9 +256,12 @@ fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result
         .disable_mesh()
         .x_desc("position along the bars (mm, 0 = specimen)")
         .y_desc("time (µs)")
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
         .label_style(("sans-serif", 16))
         .draw()
         .map_err(perr(path))?;
+    draw_colour_bar(&bar_area, path, smax / 1e6)?;
     for f in fields {
         for (k, row) in f.stress_pa.iter().enumerate() {
             let t0 = if k == 0 { 0.0 } else { f.time_s[k - 1] };
@@ -292,7 +358,12 @@ fn draw_heat_map(
     let (y0, y1) = (ye[0].min(ye[ye.len() - 1]), ye[0].max(ye[ye.len() - 1]));
     let mut chart = ChartBuilder::on(area)
         .caption(
-            format!("{} (white {:.4e} → blue {:.4e})", labels.2, lo, hi),
+            format!(
+                "{} (white {} → blue {})",
+                labels.2,
+                three_digits(lo),
+                three_digits(hi)
+            ),
             ("sans-serif", 20),
         )
         .margin(15)
@@ -305,6 +376,8 @@ fn draw_heat_map(
         .disable_mesh()
         .x_desc(labels.0)
         .y_desc(labels.1)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
         .label_style(("sans-serif", 16))
         .draw()
         .map_err(perr(path))?;
@@ -322,7 +395,7 @@ fn draw_heat_map(
             chart
                 .plotting_area()
                 .draw(&Text::new(
-                    format!("{v:.3e}"),
+                    three_digits(v),
                     (0.5 * (xe[i] + xe[i + 1]), 0.5 * (ye[j] + ye[j + 1])),
                     ("sans-serif", 12),
                 ))
@@ -639,4 +712,64 @@ pub fn loglog_plot(
             .map_err(|e| perr(&e))?;
         root.present().map_err(|e| perr(&e))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_read_as_a_person_writes_them() {
+        assert_eq!(tick(0.1 + 0.2), "0.3");
+        assert_eq!(tick(-0.0), "0");
+        assert_eq!(tick(250.0), "250");
+        assert_eq!(tick(1.5e-7), "0.00000015");
+        assert_eq!(tick(123456.0), "123456");
+        assert_eq!(three_digits(12.3456), "12.3");
+        assert_eq!(three_digits(0.045678), "0.0457");
+        assert_eq!(three_digits(1234.5), "1230");
+        assert_eq!(three_digits(-7.0), "-7");
+    }
+
+    #[test]
+    fn the_x_t_diagram_has_a_colour_bar_from_compression_to_tension() {
+        let dir = tempfile::TempDir::new().unwrap();
+        let path = dir.path().join("xt.png");
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.01).collect();
+        let t: Vec<f64> = (1..=40).map(|k| k as f64 * 1e-6).collect();
+        let rows: Vec<Vec<f64>> = t
+            .iter()
+            .map(|&tk| {
+                x.iter()
+                    .map(|&xi| 1e8 * ((xi - 3e4 * tk) * 20.0).sin())
+                    .collect()
+            })
+            .collect();
+        let field = Field {
+            x_m: &x,
+            time_s: &t,
+            stress_pa: &rows,
+        };
+        let axes = Axes {
+            title: "t",
+            x_label: "x",
+            y_label: "y",
+            x_scale: 1.0,
+            y_scale: 1.0,
+        };
+        let curve = [Curve {
+            label: "c".into(),
+            x: &x,
+            y: &x,
+            measured: false,
+        }];
+        test_figure(&path, false, (&axes, &curve), (&axes, &curve), &[field]).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        // The colour bar sits in the last 130 px of the bottom panel: its column holds
+        // saturated blue (compression) and saturated red (tension).
+        let (w, h) = img.dimensions();
+        let column: Vec<[u8; 3]> = (620..h).map(|y| img.get_pixel(w - 60, y).0).collect();
+        assert!(column.iter().any(|p| p[2] == 255 && p[0] < 40), "no blue");
+        assert!(column.iter().any(|p| p[0] == 255 && p[2] < 40), "no red");
+    }
 }
