@@ -38,7 +38,9 @@ fn scenes_help() -> String {
     text.push_str("`shpb list` lists the built-in materials, set-ups and scene kinds.\n\n");
     text.push_str(
         "EXIT CODES: 0 success, 1 I/O or HDF5 failure, 2 bad input (file, key and allowed range are\n\
-         named), 3 numerical instability (step, time and quantity are named).",
+         named; a missing input file too), 3 numerical instability (step, time and quantity are named).\n\
+         OUTPUT: results on stdout (`--json`: one JSON object), messages, warnings and `wrote PATH`\n\
+         on stderr; an output path `-` writes that file to stdout.",
     );
     text
 }
@@ -50,6 +52,12 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    /// No result table and no `wrote` lines (warnings and errors still go to stderr).
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+    /// Print the result of `run`, `reduce`, `incident` and `sweep` as one JSON object on stdout.
+    #[arg(long, global = true)]
+    pub json: bool,
 }
 
 /// The contact laws selectable on the command line.
@@ -328,6 +336,7 @@ pub fn main() -> i32 {
 
 /// Runs one parsed command.
 pub fn dispatch(cli: Cli) -> Result<()> {
+    cmd::common::set_output_mode(cli.quiet, cli.json);
     match cli.command {
         Command::Run {
             scene,

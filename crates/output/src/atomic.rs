@@ -30,8 +30,16 @@ pub fn check_output(path: &Path, force: bool) -> Result<()> {
     check_output_flag(path, force, "output")
 }
 
+/// Whether `path` is `-`: the output goes to standard output.
+pub fn is_stdout(path: &Path) -> bool {
+    path == Path::new("-")
+}
+
 /// [`check_output`], naming the command-line `flag` that gave the path in its errors.
 pub fn check_output_flag(path: &Path, force: bool, flag: &str) -> Result<()> {
+    if is_stdout(path) {
+        return Ok(());
+    }
     let allowed = "a file name in an existing, writable directory";
     if path.is_dir() {
         return Err(bad_output(
@@ -72,6 +80,9 @@ pub fn check_output_flag(path: &Path, force: bool, flag: &str) -> Result<()> {
 
 /// Refuses an output whose extension is not one of `extensions` (lower case, without dot).
 pub fn check_extension(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
+    if is_stdout(path) {
+        return Ok(());
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
@@ -96,6 +107,9 @@ pub fn check_extension(path: &Path, flag: &str, extensions: &[&str]) -> Result<(
 /// Refuses an output that is one of the run's inputs (the same file, by any name), even with
 /// `--force`: an output may never replace what it was computed from.
 pub fn check_not_input(path: &Path, flag: &str, inputs: &[PathBuf]) -> Result<()> {
+    if is_stdout(path) {
+        return Ok(());
+    }
     let Some(out) = canonical_target(path) else {
         return Ok(());
     };
@@ -137,6 +151,9 @@ pub fn write_atomically(
     force: bool,
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<()> {
+    if is_stdout(path) {
+        return write_to_stdout(write);
+    }
     check_output(path, force)?;
     let dir = directory_of(path);
     let name = path
@@ -146,6 +163,30 @@ pub fn write_atomically(
     // The temporary name keeps the extension (plotters picks the image format from it).
     let tmp: PathBuf = dir.join(format!(".tmp-{}-{}-{name}", std::process::id(), unique()));
     let result = write(&tmp).and_then(|_| move_into_place(&tmp, path, force));
+    let _ = std::fs::remove_file(&tmp);
+    result
+}
+
+/// Writes through `write` to a temporary file, then copies it to standard output (a closed
+/// pipe is not an error).
+fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    use std::io::Write;
+    // The `.png` ending lets plotters choose its format; HDF5 and CSV writers ignore it.
+    let tmp = std::env::temp_dir().join(format!(
+        ".shpb-stdout-{}-{}.png",
+        std::process::id(),
+        unique()
+    ));
+    let result = write(&tmp).and_then(|_| {
+        let bytes = std::fs::read(&tmp).map_err(|e| Error::io(&tmp, e))?;
+        let mut out = std::io::stdout().lock();
+        match out.write_all(&bytes).and_then(|_| out.flush()) {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                Err(Error::io(Path::new("stdout"), e))
+            }
+            _ => Ok(()),
+        }
+    });
     let _ = std::fs::remove_file(&tmp);
     result
 }

@@ -16,7 +16,7 @@ pub fn bench(scene: &Path, repeats: usize, report: Option<&Path>, force: bool) -
     say(&md)?;
     if let Some(p) = report {
         shpb_output::io::write_text_atomically(p, force, &md)?;
-        eprintln!("wrote {}", p.display());
+        super::common::wrote(p);
     }
     Ok(())
 }

@@ -7,6 +7,78 @@ use shpb_input::{Error, Result, Validator};
 use std::io::Write;
 use std::path::Path;
 
+/// How results and messages are shown (`--quiet`, `--json`): set once by the command line.
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static JSON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Sets the output mode: `quiet` drops the result table and the `wrote` lines (warnings and
+/// errors still go to stderr); `json` prints the result as one JSON object on stdout instead.
+pub fn set_output_mode(quiet: bool, json: bool) {
+    QUIET.store(quiet, std::sync::atomic::Ordering::Relaxed);
+    JSON.store(json, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether `--json` was given.
+pub fn json_mode() -> bool {
+    JSON.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Whether `--quiet` was given.
+pub fn quiet_mode() -> bool {
+    QUIET.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Reports a file written (`wrote PATH` on stderr), unless quiet or the file went to stdout.
+pub fn wrote(path: &Path) {
+    if !quiet_mode() && !shpb_output::atomic::is_stdout(path) {
+        eprintln!("wrote {}", path.display());
+    }
+}
+
+/// A warning on stderr (also with `--quiet`).
+pub fn warn(message: &str) {
+    eprintln!("shpb: warning: {message}");
+}
+
+/// Prints a command's result: `json()` as one JSON object with `--json`, else `text` (nothing
+/// with `--quiet`).
+pub fn report(text: &str, json: impl FnOnce() -> serde_json::Value) -> Result<()> {
+    if json_mode() {
+        print(&format!("{}\n", json()))
+    } else if quiet_mode() {
+        Ok(())
+    } else {
+        print(text)
+    }
+}
+
+/// A number for JSON, which has no NaN or infinity: those become null.
+pub fn finite(v: f64) -> serde_json::Value {
+    if v.is_finite() {
+        serde_json::json!(v)
+    } else {
+        serde_json::Value::Null
+    }
+}
+
+/// Refuses two things on stdout at once: `--json` or the result table and an output `-`.
+pub fn stdout_once(outputs: &[Option<&Path>]) -> Result<bool> {
+    let to_stdout = outputs
+        .iter()
+        .flatten()
+        .filter(|p| shpb_output::atomic::is_stdout(p))
+        .count();
+    if to_stdout > 1 || (to_stdout == 1 && json_mode()) {
+        return Err(input_err(
+            "command line",
+            "-",
+            "standard output can take only one of: --json, one output `-`",
+            "at most one output `-`, and not with --json",
+        ));
+    }
+    Ok(to_stdout == 1)
+}
+
 /// The built-in set-up `--bars` names when not given.
 pub const DEFAULT_BARS: &str = "authors";
 
@@ -103,11 +175,11 @@ pub fn write_study(
 ) -> Result<()> {
     if let Some(p) = csv {
         shpb_output::io::write_text_atomically(p, true, table)?;
-        eprintln!("wrote {}", p.display());
+        wrote(p);
     }
     if let Some(p) = output {
         shpb_study::file::write_sweep_hdf5(p, true, scene_text, spec, keys, rows)?;
-        eprintln!("wrote {}", p.display());
+        wrote(p);
     }
     Ok(())
 }

@@ -23,11 +23,11 @@ pub fn convergence(
     say(&table)?;
     if let Some(p) = output {
         shpb_study::convergence::write_csv(p, force, &study)?;
-        eprintln!("wrote {}", p.display());
+        super::common::wrote(p);
     }
     if let Some(p) = plot {
         shpb_study::convergence::plot(p, force, &study)?;
-        eprintln!("wrote {}", p.display());
+        super::common::wrote(p);
     }
     Ok(())
 }

@@ -1,6 +1,8 @@
 //! `shpb reduce`: the lab's reduction of a raw record or of a run file.
 
-use super::common::{DEFAULT_BARS, input_err, load_apparatus, require_bars, say};
+use super::common::{
+    DEFAULT_BARS, finite, input_err, load_apparatus, report, require_bars, stdout_once, warn, wrote,
+};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::reduce::{PAPER_SPHERE_RADII_M, ReductionOptions, ReductionSetup, reduce_named};
 use shpb_core::scene::{Params, SceneParams};
@@ -47,6 +49,7 @@ pub fn reduce_command(
             "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
         ));
     }
+    let data_on_stdout = stdout_once(&[output, csv])?;
     let hdf5_input = is_hdf5(record)?;
     let run = if hdf5_input { run_setup(record)? } else { None };
     let (apparatus, radii) = match run {
@@ -110,9 +113,17 @@ pub fn reduce_command(
     }
     if let Some(o) = output {
         write_reduction_hdf5(o, force, &scene, &r)?;
+        wrote(o);
     }
     if let Some(c) = csv {
         write_reduction_csv(c, force, &r)?;
+        wrote(c);
+    }
+    for w in &r.warnings {
+        warn(w);
+    }
+    if data_on_stdout {
+        return Ok(());
     }
     let bridges: Vec<String> = ["incident", "transmission"]
         .iter()
@@ -126,35 +137,46 @@ pub fn reduce_command(
             )
         })
         .collect();
-    say(&format!(
-        "record: {} ({}); bridges: {}",
+    let text = format!(
+        "record: {} ({}); bridges: {}\n\
+         windows: incident from {:.2} µs, reflected +{:.2} µs, transmitted +{:.2} µs, {:.1} µs long; dispersion correction {}\n\
+         peak back force {:.1} N at t = {:.2} µs; displacement at peak force {:.2} µm; equilibrium ratio at peak {:.3}\n",
         record.display(),
         if hdf5_input {
             "HDF5 gauge strains"
         } else {
             "raw gauge voltages"
         },
-        bridges.join(", ")
-    ))?;
-    say(&format!(
-        "windows: incident from {:.2} µs, reflected +{:.2} µs, transmitted +{:.2} µs, {:.1} µs long; dispersion correction {}",
+        bridges.join(", "),
         r.windows.incident_start_s * 1e6,
         r.windows.reflected_delay_s * 1e6,
         r.windows.transmitted_delay_s * 1e6,
         r.windows.duration_s * 1e6,
-        if r.dispersion_corrected { "on" } else { "off" }
-    ))?;
-    say(&format!(
-        "peak back force {:.1} N at t = {:.2} µs; displacement at peak force {:.2} µm; equilibrium ratio at peak {:.3}",
+        if r.dispersion_corrected { "on" } else { "off" },
         r.peak_back_force_n,
         r.peak_back_force_time_s * 1e6,
         r.displacement_at_peak_force_m * 1e6,
         r.equilibrium_ratio_at_peak
-    ))?;
-    for w in &r.warnings {
-        say(&format!("warning: {w}"))?;
-    }
-    Ok(())
+    );
+    report(&text, || {
+        serde_json::json!({
+            "record": record.display().to_string(),
+            "set_up": apparatus.source,
+            "input": if hdf5_input { "hdf5 gauge strains" } else { "raw gauge voltages" },
+            "windows_s": {
+                "incident_start": finite(r.windows.incident_start_s),
+                "reflected_delay": finite(r.windows.reflected_delay_s),
+                "transmitted_delay": finite(r.windows.transmitted_delay_s),
+                "duration": finite(r.windows.duration_s),
+            },
+            "dispersion_corrected": r.dispersion_corrected,
+            "peak_back_force_N": finite(r.peak_back_force_n),
+            "peak_back_force_time_s": finite(r.peak_back_force_time_s),
+            "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),
+            "equilibrium_ratio_at_peak": finite(r.equilibrium_ratio_at_peak),
+            "warnings": r.warnings,
+        })
+    })
 }
 
 /// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored

@@ -1,7 +1,7 @@
 //! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
 //! summary and write its results.
 
-use super::common::print;
+use super::common::{finite, report, stdout_once, warn, wrote};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
@@ -34,6 +34,7 @@ pub fn run(
             check_extension(p, flag, extensions)?;
         }
     }
+    let data_on_stdout = stdout_once(&[output, csv, plot])?;
     let (params, provenance) = load(scene, fidelity)?;
     // An output may never be one of the inputs (not even with --force).
     let mut inputs: Vec<PathBuf> = vec![scene.to_path_buf()];
@@ -52,23 +53,25 @@ pub fn run(
     let mut out = params.run()?;
     out.warnings.splice(0..0, params.warnings());
     for w in &out.warnings {
-        eprintln!("shpb: warning: {w}");
+        warn(w);
     }
-    print_summary(&params, &out)?;
+    if !data_on_stdout {
+        print_summary(&params, &out)?;
+    }
     if let Some(p) = output {
         Hdf5 {
             provenance: Some(provenance),
         }
         .write_run(p, force, &params, &out)?;
-        eprintln!("wrote {}", p.display());
+        wrote(p);
     }
     if let Some(p) = csv {
         Csv.write_run(p, force, &params, &out)?;
-        eprintln!("wrote {}", p.display());
+        wrote(p);
     }
     if let Some(p) = plot {
         Png.write_run(p, force, &params, &out)?;
-        eprintln!("wrote {}", p.display());
+        wrote(p);
     }
     Ok(())
 }
@@ -131,17 +134,47 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             it.key, it.value, it.unit
         ));
     }
-    if let (Some(c), Some(r)) = (&out.contact, &out.reduction) {
-        let k = c.peak_index();
-        text.push_str(&format!(
-            "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
-             displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
-            c.force_n[k] * 1e-3,
-            r.peak_back_force_n * 1e-3,
-            c.displacement_m[k] * 1e6,
-            r.displacement_at_peak_force_m * 1e6,
-            r.equilibrium_ratio_at_peak
-        ));
-    }
-    print(&text)
+    let comparison = match (&out.contact, &out.reduction) {
+        (Some(c), Some(r)) => {
+            let k = c.peak_index();
+            text.push_str(&format!(
+                "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
+                 displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
+                c.force_n[k] * 1e-3,
+                r.peak_back_force_n * 1e-3,
+                c.displacement_m[k] * 1e6,
+                r.displacement_at_peak_force_m * 1e6,
+                r.equilibrium_ratio_at_peak
+            ));
+            Some(serde_json::json!({
+                "true_peak_force_N": c.force_n[k],
+                "reduced_peak_back_force_N": r.peak_back_force_n,
+                "true_displacement_at_peak_m": c.displacement_m[k],
+                "reduced_displacement_at_peak_m": r.displacement_at_peak_force_m,
+                "equilibrium_ratio_at_peak": r.equilibrium_ratio_at_peak,
+            }))
+        }
+        _ => None,
+    };
+    report(&text, || {
+        let summary: serde_json::Map<String, serde_json::Value> = out
+            .summary
+            .iter()
+            .map(|it| {
+                (
+                    it.key.clone(),
+                    serde_json::json!({"value": finite(it.value), "unit": it.unit}),
+                )
+            })
+            .collect();
+        serde_json::json!({
+            "scene": params.source,
+            "kind": params.kind,
+            "law": params.contact_law().name(),
+            "fidelity": params.fidelity.name(),
+            "summary": summary,
+            "result": comparison,
+            "warnings": out.warnings,
+        })
+    })
 }

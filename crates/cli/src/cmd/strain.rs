@@ -73,11 +73,11 @@ pub fn strain(
             inputs: inputs.clone(),
         };
         shpb_output::io::write_hdf5(p, force, &text, Some(&provenance), &out)?;
-        eprintln!("wrote {}", p.display());
+        super::common::wrote(p);
     }
     if let Some(p) = csv {
         shpb_output::io::write_csv(p, force, &out)?;
-        eprintln!("wrote {}", p.display());
+        super::common::wrote(p);
     }
     if output.is_none() && csv.is_none() {
         let peak = |s: &[f64]| s.iter().cloned().fold(0.0, f64::min);

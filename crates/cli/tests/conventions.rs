@@ -1,0 +1,111 @@
+//! One output convention for every command (issue 15, item 18): results on stdout (a table, or
+//! one JSON object with `--json`), messages, warnings and `wrote PATH` on stderr, `-` for an
+//! output on stdout, `--quiet` for silence.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use tempfile::TempDir;
+
+fn repo() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+fn shpb(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_shpb"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn out(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).to_string()
+}
+
+fn err(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+fn path(rel: &str) -> String {
+    repo().join(rel).display().to_string()
+}
+
+#[test]
+fn json_results_parse_and_carry_units() {
+    let dir = TempDir::new().unwrap();
+    let scene = path("scenes/shpb-ss440c-10psi.toml");
+    let o = shpb(dir.path(), &["run", &scene, "--fidelity", "fast", "--json"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
+    assert_eq!(v["kind"], "shpb");
+    assert_eq!(v["summary"]["peak_contact_force"]["unit"], "N");
+    let f = v["summary"]["peak_contact_force"]["value"]
+        .as_f64()
+        .unwrap();
+    assert!(f > 1e3, "{f}");
+    assert!(v["result"]["reduced_peak_back_force_N"].as_f64().unwrap() > 1e3);
+
+    let record = path("validation/gauge-records/data/2013-05-22_sample1_ss440c.csv");
+    let o = shpb(dir.path(), &["reduce", &record, "--json"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
+    assert!(v["peak_back_force_N"].as_f64().unwrap() > 1e3);
+    // Warnings are messages: on stderr, never mixed into the data on stdout.
+    assert!(!out(&o).contains("warning:"));
+
+    let force = path("validation/fig4-force-driven/data/ss440c_10psi_force10.csv");
+    let o = shpb(
+        dir.path(),
+        &["incident", &force, "--pressure", "10psi", "--json"],
+    );
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
+    assert!(v["energy_J"].as_f64().unwrap() > 0.0);
+    assert!(v["set_up_striker"]["possible"].is_boolean());
+}
+
+#[test]
+fn every_file_written_is_reported_on_stderr_and_quiet_silences_them() {
+    let dir = TempDir::new().unwrap();
+    let scene = path("scenes/collision-ss440c-5ms.toml");
+    let o = shpb(
+        dir.path(),
+        &[
+            "run", &scene, "-o", "a.h5", "--csv", "a.csv", "--plot", "a.png",
+        ],
+    );
+    assert!(o.status.success(), "{}", err(&o));
+    for f in ["a.h5", "a.csv", "a.png"] {
+        assert!(err(&o).contains(&format!("wrote {f}")), "{}", err(&o));
+        assert!(!out(&o).contains("wrote"), "messages belong on stderr");
+    }
+    let o = shpb(dir.path(), &["run", &scene, "-o", "b.h5", "--quiet"]);
+    assert!(o.status.success(), "{}", err(&o));
+    assert!(out(&o).is_empty(), "{}", out(&o));
+    assert!(err(&o).is_empty(), "{}", err(&o));
+    assert!(dir.path().join("b.h5").is_file());
+}
+
+#[test]
+fn dash_writes_an_output_to_stdout_alone() {
+    let dir = TempDir::new().unwrap();
+    let scene = path("scenes/collision-ss440c-5ms.toml");
+    let o = shpb(dir.path(), &["run", &scene, "--csv", "-"]);
+    assert!(o.status.success(), "{}", err(&o));
+    let text = out(&o);
+    let mut lines = text.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("time_s,displacement_m,force_N")
+    );
+    assert!(lines.count() > 10, "CSV rows on stdout");
+    assert!(!text.contains("scene:"), "no table mixed into the CSV");
+    // A file named `-` is not created.
+    assert!(!dir.path().join("-").exists());
+    // Two things on stdout at once are refused before anything runs.
+    let o = shpb(dir.path(), &["run", &scene, "--csv", "-", "--json"]);
+    assert_eq!(o.status.code(), Some(2), "{}", err(&o));
+    assert!(out(&o).is_empty());
+}
