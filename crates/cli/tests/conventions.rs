@@ -109,3 +109,20 @@ fn dash_writes_an_output_to_stdout_alone() {
     assert_eq!(o.status.code(), Some(2), "{}", err(&o));
     assert!(out(&o).is_empty());
 }
+
+#[test]
+fn a_run_shows_its_progress_with_an_eta() {
+    // On a terminal the line appears after two seconds; SHPB_PROGRESS=always prints it at once.
+    let dir = TempDir::new().unwrap();
+    let scene = path("scenes/shpb-ss440c-10psi.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_shpb"))
+        .current_dir(dir.path())
+        .args(["run", &scene, "--fidelity", "fast"])
+        .env("SHPB_PROGRESS", "always")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", err(&o));
+    let e = err(&o);
+    assert!(e.contains("ETA") && e.contains("100 % done"), "{e}");
+    assert!(!out(&o).contains("ETA"), "progress belongs on stderr");
+}

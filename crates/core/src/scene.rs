@@ -106,6 +106,12 @@ impl Params {
 
     /// Runs the scene.
     pub fn run(&self) -> Result<RunOutput> {
+        self.run_with_progress(&mut |_| {})
+    }
+
+    /// Runs the scene, calling `progress` with the fraction done (0 to 1) now and then during
+    /// long solves (bar scenes: every 1 % of the steps).
+    pub fn run_with_progress(&self, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
         let law = self.contact_law();
         let law = law.as_ref();
         match &self.params {
@@ -169,7 +175,7 @@ impl Params {
                 apparatus,
                 pressure_pa,
                 options,
-            } => run_pulse(apparatus, *pressure_pa, options),
+            } => run_pulse(apparatus, *pressure_pa, options, progress),
             SceneParams::ForceDriven {
                 setup,
                 measured_displacement_m,
@@ -275,9 +281,16 @@ fn force_driven_summary(
 }
 
 /// Runs a `pulse` scene: simulates the chain, digitises every gauge, and summarises each pulse.
-fn run_pulse(apparatus: &Apparatus, pressure_pa: f64, options: &PulseOptions) -> Result<RunOutput> {
+fn run_pulse(
+    apparatus: &Apparatus,
+    pressure_pa: f64,
+    options: &PulseOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<RunOutput> {
     let chain = apparatus.pulse_chain(options);
-    let r = crate::solver::simulate_chain(&chain)?;
+    let steps = (chain.end_time_s / chain.dt_s).ceil() as usize;
+    let mut report = crate::solver::record::Progress::new(steps, progress);
+    let r = crate::solver::simulate_chain_with(&chain, &mut [&mut report])?;
     let e = apparatus.material.youngs_modulus_pa;
     let mut summary = vec![
         item("pressure", pressure_pa, "Pa"),

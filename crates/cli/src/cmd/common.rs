@@ -52,6 +52,76 @@ pub fn report(text: &str, json: impl FnOnce() -> serde_json::Value) -> Result<()
     }
 }
 
+/// A progress line with an ETA on stderr for a run that takes longer than two seconds, shown
+/// only on a terminal and not with `--quiet` or `--json`. `SHPB_PROGRESS=always` prints it as
+/// plain lines at once, anywhere (for logs and tests).
+pub struct ProgressLine {
+    start: std::time::Instant,
+    label: String,
+    bar: Option<indicatif::ProgressBar>,
+    terminal: bool,
+    plain: bool,
+    last_decile: i64,
+}
+
+impl ProgressLine {
+    /// A progress line labelled `label` (e.g. the scene file).
+    pub fn new(label: &str) -> ProgressLine {
+        use std::io::IsTerminal;
+        ProgressLine {
+            start: std::time::Instant::now(),
+            label: label.to_string(),
+            bar: None,
+            terminal: std::io::stderr().is_terminal() && !quiet_mode() && !json_mode(),
+            plain: std::env::var("SHPB_PROGRESS").is_ok_and(|v| v == "always"),
+            last_decile: -1,
+        }
+    }
+
+    /// Shows `fraction` done (0 to 1).
+    pub fn update(&mut self, fraction: f64) {
+        let elapsed = self.start.elapsed();
+        if self.plain {
+            let decile = (fraction * 10.0).floor() as i64;
+            if decile > self.last_decile && fraction > 0.0 {
+                self.last_decile = decile;
+                let eta = elapsed.as_secs_f64() * (1.0 - fraction) / fraction;
+                eprintln!(
+                    "{}: {:.0} % done, elapsed {:.1} s, ETA {:.1} s",
+                    self.label,
+                    100.0 * fraction,
+                    elapsed.as_secs_f64(),
+                    eta
+                );
+            }
+            return;
+        }
+        if !self.terminal || elapsed < std::time::Duration::from_secs(2) {
+            return;
+        }
+        let bar = self.bar.get_or_insert_with(|| {
+            let bar = indicatif::ProgressBar::new(1000);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{msg} [{bar:40}] {percent:>3}% elapsed {elapsed} ETA {eta}",
+                )
+                .expect("valid template")
+                .progress_chars("=> "),
+            );
+            bar.set_message(self.label.clone());
+            bar
+        });
+        bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
+    }
+
+    /// Removes the line (the result follows).
+    pub fn finish(self) {
+        if let Some(bar) = self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
 /// A number for JSON, which has no NaN or infinity: those become null.
 pub fn finite(v: f64) -> serde_json::Value {
     if v.is_finite() {

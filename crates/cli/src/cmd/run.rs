@@ -1,7 +1,7 @@
 //! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
 //! summary and write its results.
 
-use super::common::{finite, report, stdout_once, warn, wrote};
+use super::common::{ProgressLine, finite, report, stdout_once, warn, wrote};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
@@ -50,7 +50,9 @@ pub fn run(
             check_not_input(p, flag, &inputs)?;
         }
     }
-    let mut out = params.run()?;
+    let mut progress = ProgressLine::new(&params.source);
+    let mut out = params.run_with_progress(&mut |f| progress.update(f))?;
+    progress.finish();
     out.warnings.splice(0..0, params.warnings());
     for w in &out.warnings {
         warn(w);

@@ -224,3 +224,47 @@ impl Recorder for SnapshotRecorder {
         }
     }
 }
+
+/// Reports the fraction of the run done to a callback, every 1 % of the steps.
+pub struct Progress<'a> {
+    steps: usize,
+    every: usize,
+    callback: &'a mut dyn FnMut(f64),
+}
+
+impl<'a> Progress<'a> {
+    /// Progress of a run of `steps` steps, reported to `callback`.
+    pub fn new(steps: usize, callback: &'a mut dyn FnMut(f64)) -> Progress<'a> {
+        Progress {
+            steps: steps.max(1),
+            every: (steps / 100).max(1),
+            callback,
+        }
+    }
+}
+
+impl Recorder for Progress<'_> {
+    fn record(&mut self, step: usize, _time_s: f64, _bodies: &[Body], _joints: &[JointState]) {
+        if step.is_multiple_of(self.every) || step == self.steps {
+            (self.callback)(step as f64 / self.steps as f64);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn progress_reports_rising_fractions_up_to_one() {
+        let mut seen = Vec::new();
+        let mut callback = |f: f64| seen.push(f);
+        let mut p = Progress::new(1000, &mut callback);
+        for step in 0..=1000 {
+            p.record(step, 0.0, &[], &[]);
+        }
+        assert_eq!(seen.len(), 101, "every 1 %");
+        assert!(seen.windows(2).all(|w| w[1] > w[0]));
+        assert_eq!((seen[0], *seen.last().unwrap()), (0.0, 1.0));
+    }
+}
