@@ -16,8 +16,9 @@ CARGO ?= cargo
 # Honour CARGO_TARGET_DIR so `demo` finds the binary cargo just built.
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/shpb
 
-# hdf5-metno needs libhdf5 (found through pkg-config); plotters needs fontconfig.
-APT_PACKAGES := libhdf5-dev pkg-config libfontconfig1-dev
+# hdf5-metno needs libhdf5 (found through pkg-config); plotters needs fontconfig; the tests
+# read every output with h5dump (hdf5-tools), as a user would.
+APT_PACKAGES := libhdf5-dev pkg-config libfontconfig1-dev hdf5-tools
 
 # The Fig. 4 SS440c 10 psi record (12.28 kN, 228 µm at peak) was shot with a 20 cm striker and no
 # shaper (validation/fig4-virtual-shpb/REPORT.md); scenes/shpb-ss440c-10psi.toml is the same test
@@ -34,7 +35,7 @@ all: build
 # one `apt-get install` (through sudo only when not root and sudo exists).
 deps:
 	@dpkg_ok() { dpkg -s "$$1" 2>/dev/null | grep -q '^Status: install ok installed'; }; \
-	if pkg-config --exists hdf5 2>/dev/null && dpkg_ok libhdf5-dev && dpkg_ok libfontconfig1-dev; then \
+	if pkg-config --exists hdf5 2>/dev/null && dpkg_ok libhdf5-dev && dpkg_ok libfontconfig1-dev && dpkg_ok hdf5-tools; then \
 	  exit 0; \
 	fi; \
 	if ! command -v apt-get >/dev/null 2>&1; then \

@@ -234,3 +234,32 @@ fn output_paths_are_refused_before_the_run_with_plain_messages() {
         assert!(out.stdout.is_empty(), "{args:?} ran");
     }
 }
+
+/// Every HDF5 file shpb writes (run, rerun, reduction, strain) reads with the HDF5 project's
+/// own h5dump (Debian `hdf5-tools`, installed by `make deps`), as a user's tools would.
+#[test]
+fn h5dump_reads_every_output() {
+    let dir = TempDir::new().unwrap();
+    small_bar_test(dir.path());
+    let record = repo().join("validation/gauge-records/data/2013-05-22_sample1_ss440c.csv");
+    let record = record.to_str().unwrap();
+    for args in [
+        &["run", "test.toml", "-o", "run.h5"][..],
+        &["run", "run.h5", "-o", "again.h5"][..],
+        &["reduce", "run.h5", "-o", "reduced-run.h5"][..],
+        &["reduce", record, "-o", "reduced-record.h5"][..],
+        &["strain", record, "-o", "strain.h5"][..],
+    ] {
+        let out = shpb(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    }
+    for file in ["run.h5", "again.h5", "reduced-run.h5", "reduced-record.h5", "strain.h5"] {
+        let dump = Command::new("h5dump")
+            .current_dir(dir.path())
+            .args(["-H", file])
+            .output()
+            .expect("h5dump (Debian hdf5-tools; `make deps` installs it)");
+        assert!(dump.status.success(), "h5dump {file}: {}", stderr(&dump));
+        assert!(String::from_utf8_lossy(&dump.stdout).contains("GROUP \"/\""));
+    }
+}
