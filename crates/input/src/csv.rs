@@ -99,7 +99,7 @@ impl CsvTable {
 
     /// Reads and parses a CSV file.
     pub fn read(path: &Path) -> Result<CsvTable> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
         CsvTable::parse(&text, &path.display().to_string())
     }
 

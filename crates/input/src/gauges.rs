@@ -160,7 +160,7 @@ impl GaugeSetupFile for GaugeSetup {
     /// Reads and validates a gauge file.
     fn from_file(path: impl AsRef<Path>) -> Result<GaugeSetup> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
         GaugeSetup::from_toml(&text, &path.display().to_string())
     }
 }
@@ -217,7 +217,7 @@ impl RawRecordFile for RawRecord {
 
     /// Reads a record file (see [`RawRecord::parse`]).
     fn read(path: &Path) -> Result<RawRecord> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
         RawRecord::parse(&text, &path.display().to_string())
     }
 }

@@ -92,7 +92,7 @@ impl MaterialFile for Material {
     fn resolve(reference: &str, base_dir: &Path, v: &Validator, key: &str) -> Result<Material> {
         if reference.ends_with(".toml") {
             let path = base_dir.join(reference);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let text = crate::provenance::read_to_string(&path).map_err(|e| {
                 v.error(
                     key,
                     format!("cannot read {}: {e}", path.display()),

@@ -86,7 +86,7 @@ impl SceneFile for Params {
     /// Reads a scene file with some keys replaced (dotted paths such as `shaper.thickness_m`
     /// reach into tables); the stored scene text is the modified TOML.
     fn from_file_overridden(path: &Path, overrides: &[(String, toml::Value)]) -> Result<Params> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file = path.display().to_string();
         let text = if overrides.is_empty() {
             text

@@ -102,7 +102,7 @@ pub trait ApparatusFile: Sized {
 impl ApparatusFile for Apparatus {
     /// Reads and validates a set-up file; its `gauges` file is resolved relative to it.
     fn from_file(path: &Path) -> Result<Apparatus> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file = path.display().to_string();
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         Apparatus::from_toml(&text, &file, &|g: &str| GaugeSetup::from_file(base.join(g)))

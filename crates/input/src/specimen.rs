@@ -79,7 +79,7 @@ impl PairSpec {
 
 /// Reads a pair file (`specimens/pair-*.toml`).
 pub fn load_pair_file(path: &Path) -> Result<SpherePair> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = crate::provenance::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let file = path.display().to_string();
     let spec: PairSpec = toml::from_str(&text).map_err(|e| Error::Parse {
         file: file.clone(),

@@ -1,8 +1,31 @@
 //! Atomic, no-clobber file writes: every output is written under a temporary name in its
 //! directory and renamed into place; an existing file is replaced only with `--force`.
+//!
+//! The temporary files of writes in progress are registered, so that a process stopped by a
+//! signal removes them ([`remove_temporaries`]) instead of leaving `.tmp-*` files behind.
 
 use shpb_input::{Error, Result};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
+
+/// The temporary files of the writes in progress in this process.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes the temporary file of every write in progress and returns a guard that keeps any
+/// write from being renamed into place (or a new one from starting) while it is held: what a
+/// process stopped by SIGINT/SIGTERM calls just before it exits, so that it leaves neither a
+/// temporary file nor a half-finished output.
+pub fn remove_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    let mut held = temporaries();
+    for tmp in held.drain(..) {
+        let _ = std::fs::remove_file(tmp);
+    }
+    held
+}
 
 /// Refuses to overwrite `path` unless `force`.
 pub fn check_output(path: &Path, force: bool) -> Result<()> {
@@ -30,9 +53,15 @@ pub fn write_atomically(
         .unwrap_or_else(|| "out".into());
     // The temporary name keeps the extension (plotters picks the image format from it).
     let tmp: PathBuf = dir.join(format!(".tmp-{}-{name}", std::process::id()));
-    let result =
-        write(&tmp).and_then(|_| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    temporaries().push(tmp.clone());
+    let result = write(&tmp).and_then(|_| {
+        // Renamed under the lock: a signal handler's `remove_temporaries` comes before or after.
+        let mut held = temporaries();
+        held.retain(|t| t != &tmp);
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+    });
     if result.is_err() {
+        temporaries().retain(|t| t != &tmp);
         let _ = std::fs::remove_file(&tmp);
     }
     result
