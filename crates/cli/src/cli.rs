@@ -324,6 +324,8 @@ pub enum Command {
 
 /// Parses the command line, runs it, prints errors; returns the process exit code.
 pub fn main() -> i32 {
+    // First, before any thread starts: SIGINT/SIGTERM remove temporary files and say what stopped.
+    crate::interrupt::install();
     let cli = Cli::parse();
     match dispatch(cli) {
         Ok(()) => 0,

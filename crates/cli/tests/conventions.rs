@@ -62,6 +62,19 @@ fn json_results_parse_and_carry_units() {
     let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
     assert!(v["energy_J"].as_f64().unwrap() > 0.0);
     assert!(v["set_up_striker"]["possible"].is_boolean());
+
+    let collision = path("scenes/collision-ss440c-5ms.toml");
+    let o = shpb(
+        dir.path(),
+        &["sweep", &collision, "--set", "velocity1_m_s=1,2", "--json"],
+    );
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    assert_eq!(runs[1]["inputs"]["velocity1_m_s"]["value"], 2.0);
+    assert_eq!(runs[1]["inputs"]["velocity1_m_s"]["unit"], "m/s");
+    assert_eq!(runs[1]["results"]["peak_force"]["unit"], "N");
 }
 
 #[test]

@@ -253,7 +253,13 @@ fn h5dump_reads_every_output() {
         let out = shpb(dir.path(), args);
         assert!(out.status.success(), "{args:?}: {}", stderr(&out));
     }
-    for file in ["run.h5", "again.h5", "reduced-run.h5", "reduced-record.h5", "strain.h5"] {
+    for file in [
+        "run.h5",
+        "again.h5",
+        "reduced-run.h5",
+        "reduced-record.h5",
+        "strain.h5",
+    ] {
         let dump = Command::new("h5dump")
             .current_dir(dir.path())
             .args(["-H", file])

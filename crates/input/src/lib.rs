@@ -14,6 +14,7 @@ pub mod files;
 pub mod gauges;
 pub mod kinds;
 pub mod material;
+pub mod provenance;
 pub mod scene;
 pub mod setup;
 pub mod specimen;

@@ -2,10 +2,33 @@
 //! directory and moved into place; an existing file is replaced only with `--force`. Without
 //! `--force` the move is a hard link (which fails if the name exists, so of two runs writing
 //! the same file at once exactly one succeeds) followed by removing the temporary name.
+//!
+//! The temporary files of writes in progress are registered, so that a process stopped by a
+//! signal removes them ([`remove_temporaries`]) instead of leaving `.tmp-*` files behind.
 
 use shpb_input::{Error, Result};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard};
+
+/// The temporary files of the writes in progress in this process.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes the temporary file of every write in progress and returns a guard that keeps any
+/// write from being moved into place (or a new one from starting) while it is held: what a
+/// process stopped by SIGINT/SIGTERM calls just before it exits, so that it leaves neither a
+/// temporary file nor a half-finished output.
+pub fn remove_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    let mut held = temporaries();
+    for tmp in held.drain(..) {
+        let _ = std::fs::remove_file(tmp);
+    }
+    held
+}
 
 /// The directory a file is written in (`.` for a bare name).
 fn directory_of(path: &Path) -> &Path {
@@ -162,7 +185,14 @@ pub fn write_atomically(
         .unwrap_or_else(|| "out".into());
     // The temporary name keeps the extension (plotters picks the image format from it).
     let tmp: PathBuf = dir.join(format!(".tmp-{}-{}-{name}", std::process::id(), unique()));
-    let result = write(&tmp).and_then(|_| move_into_place(&tmp, path, force));
+    temporaries().push(tmp.clone());
+    let result = write(&tmp).and_then(|_| {
+        // Moved under the lock: a signal handler's `remove_temporaries` comes before or after.
+        let mut held = temporaries();
+        held.retain(|t| t != &tmp);
+        move_into_place(&tmp, path, force)
+    });
+    temporaries().retain(|t| t != &tmp);
     let _ = std::fs::remove_file(&tmp);
     result
 }
@@ -177,6 +207,7 @@ fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
         std::process::id(),
         unique()
     ));
+    temporaries().push(tmp.clone());
     let result = write(&tmp).and_then(|_| {
         let bytes = std::fs::read(&tmp).map_err(|e| Error::io(&tmp, e))?;
         let mut out = std::io::stdout().lock();
@@ -187,6 +218,7 @@ fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
             _ => Ok(()),
         }
     });
+    temporaries().retain(|t| t != &tmp);
     let _ = std::fs::remove_file(&tmp);
     result
 }

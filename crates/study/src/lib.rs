@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod convergence;
 pub mod file;
+pub mod identity;
 pub mod sweep;
 
 pub use shpb_input::{Error, Result};

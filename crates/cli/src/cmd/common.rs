@@ -233,22 +233,25 @@ pub fn gun_shot(apparatus: &Apparatus, pressure: &str) -> Result<(f64, f64)> {
     Ok((p, v))
 }
 
-/// Writes a study's summary `table` as CSV and its HDF5 (atomically; the outputs were checked
-/// before the runs, so they are replaced here).
+/// Writes a study's summary `table` as CSV and its HDF5 (atomically; an existing file is
+/// replaced only with `replace`), the HDF5 stamped with the sweep's `identity`.
+#[allow(clippy::too_many_arguments)]
 pub fn write_study(
     scene_text: &str,
     spec: &[String],
+    identity: Option<&shpb_study::identity::Identity>,
     keys: &[String],
     rows: &[shpb_study::sweep::RunSummary],
     table: &str,
     (output, csv): (Option<&Path>, Option<&Path>),
+    replace: bool,
 ) -> Result<()> {
     if let Some(p) = csv {
-        shpb_output::io::write_text_atomically(p, true, table)?;
+        shpb_output::io::write_text_atomically(p, replace, table)?;
         wrote(p);
     }
     if let Some(p) = output {
-        shpb_study::file::write_sweep_hdf5(p, true, scene_text, spec, keys, rows)?;
+        shpb_study::file::write_sweep_hdf5(p, replace, scene_text, spec, identity, keys, rows)?;
         wrote(p);
     }
     Ok(())

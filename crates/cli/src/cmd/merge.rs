@@ -1,49 +1,33 @@
 //! `shpb merge`: the shard files of one sweep joined into one file.
 
 use super::common::write_study;
-use shpb_input::{Error, Result};
+use shpb_input::Result;
 use shpb_output::io::check_output;
 use std::path::{Path, PathBuf};
 
-/// `shpb merge`: joins shard files of one sweep (same scene and `--set`), sorted by run index.
+/// `shpb merge`: joins the shard files of one sweep, sorted by run index. Every file must record
+/// the same sweep (scene and set-up files by content, `--set`, shpb version) and every shard k/n
+/// must be there exactly once ([`shpb_study::file::merge_shards`]): one of two shards, or a shard
+/// given twice, is an input error (exit 2) naming the file and what is wrong.
 pub fn merge(inputs: &[PathBuf], output: &Path, csv: Option<&Path>, force: bool) -> Result<()> {
     for p in [Some(output), csv].into_iter().flatten() {
         check_output(p, force)?;
     }
-    let mut merged: Option<shpb_study::file::SweepFile> = None;
-    for p in inputs {
-        let part = shpb_study::file::read_sweep_hdf5(p)?;
-        merged = Some(match merged {
-            None => part,
-            Some(mut m) => {
-                if m.scene != part.scene
-                    || m.sweep_without_shard() != part.sweep_without_shard()
-                    || m.keys != part.keys
-                {
-                    return Err(Error::Input {
-                        file: p.display().to_string(),
-                        key: "sweep".into(),
-                        problem: "not a shard of the same sweep as the first file (scene or --set differ)".into(),
-                        allowed: "shards of one `shpb sweep` (same scene and --set, different --shard)".into(),
-                    });
-                }
-                m.rows.extend(part.rows);
-                m
-            }
-        });
-    }
-    let mut m = merged.expect("clap requires at least one input");
-    m.rows.sort_by_key(|r| r.index);
-    m.rows.dedup_by_key(|r| r.index);
+    let parts = inputs
+        .iter()
+        .map(|p| Ok((p.clone(), shpb_study::file::read_sweep_hdf5(p)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let m = shpb_study::file::merge_shards(parts)?;
     let table = shpb_study::sweep::summary_csv_keys(&m.keys, &m.rows);
-    let spec = m.sweep_without_shard();
     write_study(
         &m.scene,
-        &spec,
+        &m.sweep,
+        m.identity.as_ref(),
         &m.keys,
         &m.rows,
         &table,
         (Some(output), csv),
+        force,
     )?;
     eprintln!("merged {} runs", m.rows.len());
     Ok(())

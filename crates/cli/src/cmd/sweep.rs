@@ -1,12 +1,18 @@
 //! `shpb sweep`: a scene over the Cartesian product of swept parameters.
 
-use super::common::{say, write_study};
+use super::common::{finite, report, write_study};
 use shpb_input::{Error, Result};
 use shpb_output::io::check_output;
+use shpb_study::identity::Stamp;
+use shpb_study::sweep::{Axis, Limits, Point, RunSummary};
 use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// `shpb sweep`: validates every point first, runs the unfinished ones with a progress bar and a
-/// checkpoint, prints and writes the summary table.
+/// `shpb sweep`: refuses a sweep that cannot finish on the machine, validates every point first,
+/// runs the unfinished ones with a progress bar and a checkpoint stamped with what the sweep
+/// belongs to, prints and writes the summary table. `--resume` continues the checkpoint of the
+/// same sweep (and refuses another's), and says so when the sweep is already complete.
 pub fn sweep(
     scene: &Path,
     set: &[String],
@@ -17,10 +23,12 @@ pub fn sweep(
     force: bool,
 ) -> Result<()> {
     use shpb_study::sweep::{
-        Checkpoint, check_points, parse_axis, parse_shard, product, run_points,
+        Checkpoint, Outputs, check_points, checkpoint_path, estimate, parse_axes, parse_shard,
+        run_points, shard_points,
     };
+    let outputs = [output, csv, plot];
     if !resume {
-        for p in [output, csv, plot].into_iter().flatten() {
+        for p in outputs.into_iter().flatten() {
             check_output(p, force)?;
         }
     }
@@ -32,10 +40,7 @@ pub fn sweep(
             allowed: "a scene .toml file".into(),
         });
     }
-    let axes = set
-        .iter()
-        .map(|s| parse_axis(s))
-        .collect::<Result<Vec<_>>>()?;
+    let axes = parse_axes(set)?;
     if plot.is_some() && axes.len() > 2 {
         return Err(Error::Input {
             file: "command line".into(),
@@ -44,14 +49,10 @@ pub fn sweep(
             allowed: "one (line plot) or two (heat map) --set parameters".into(),
         });
     }
-    let mut points = product(&axes);
-    let mut spec = set.to_vec();
-    if let Some(s) = shard {
-        let (k, n) = parse_shard(s)?;
-        points = shpb_study::sweep::shard(points, k, n);
-        spec.push(format!("shard {k}/{n}"));
-    }
-    check_points(scene, &axes, &points)?;
+    let (k, n) = match shard {
+        Some(s) => parse_shard(s)?,
+        None => (1, 1),
+    };
     let anchor = output.or(csv);
     if resume && anchor.is_none() {
         return Err(Error::Input {
@@ -61,29 +62,133 @@ pub fn sweep(
             allowed: "the same -o/--csv as the interrupted sweep".into(),
         });
     }
-    let checkpoint = match anchor {
-        Some(a) => Some(Checkpoint::open(
-            a,
-            scene,
+    // Before anything is allocated: can the sweep finish on this machine?
+    let plan = estimate(
+        &axes,
+        (k, n),
+        Outputs {
+            hdf5: output.is_some(),
+            csv: csv.is_some(),
+            checkpoint: anchor.is_some(),
+        },
+    );
+    plan.check(&machine_limits(
+        &outputs.into_iter().flatten().collect::<Vec<_>>(),
+    ))?;
+    let total = plan.runs_total.expect("checked") as u64;
+    let points = shard_points(&axes, k, n);
+    let files = check_points(scene, &axes, &points)?;
+    let stamp = Stamp::new(
+        scene,
+        &files,
+        set,
+        shpb_study::sweep::axes_sha256(&axes),
+        (k, n),
+        total,
+    );
+    let mut spec = set.to_vec();
+    if shard.is_some() {
+        spec.push(format!("shard {k}/{n}"));
+    }
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
+
+    // A finished sweep: its output is there and no checkpoint (or an empty one, created by a
+    // sweep stopped before it wrote anything).
+    if resume
+        && !force
+        && let Some(a) = anchor
+        && a.exists()
+        && std::fs::metadata(checkpoint_path(a)).map_or(true, |m| m.len() == 0)
+    {
+        let rows = finished_rows(output, csv, &stamp, &axes, &points)?;
+        let table = shpb_study::sweep::summary_csv_keys(&keys, &rows);
+        report(&table, || sweep_json(&keys, &rows))?;
+        eprintln!(
+            "shpb: the sweep is complete: {} holds all its {} runs; nothing to run (--force \
+             runs it again and replaces the outputs)",
+            a.display(),
+            rows.len()
+        );
+        // Outputs asked for now that the finished sweep did not write.
+        fn missing(p: Option<&Path>) -> Option<&Path> {
+            p.filter(|p| !p.exists())
+        }
+        write_study(
+            &scene_text,
             &spec,
-            axes.len(),
-            resume,
-            force,
-        )?),
+            Some(&stamp.identity),
+            &keys,
+            &rows,
+            &table,
+            (missing(output), missing(csv)),
+            false,
+        )?;
+        if let Some(p) = missing(plot) {
+            sweep_plot(p, false, &axes, &rows)?;
+            super::common::wrote(p);
+        }
+        return Ok(());
+    }
+
+    let checkpoint = match anchor {
+        Some(a) => Some(Checkpoint::open(a, &stamp, keys.len(), resume, force)?),
         None => None,
     };
-    let mut rows = checkpoint.as_ref().map(|c| c.1.clone()).unwrap_or_default();
+    let (checkpoint, resumed) = match checkpoint {
+        Some((c, r)) => (Some(c), r),
+        None => (None, None),
+    };
+    if resumed.is_none() && !force {
+        // A fresh start (also `--resume` without a checkpoint): the outputs must not exist.
+        // Checked again now that the checkpoint is locked: a sweep that has just finished on
+        // the same output wrote its files before it let the checkpoint go.
+        if let Some(e) = outputs
+            .into_iter()
+            .flatten()
+            .find_map(|p| check_output(p, false).err())
+        {
+            if let Some(c) = checkpoint {
+                c.finish()?;
+            }
+            return Err(e);
+        }
+    }
+    let took_over = resumed.is_some();
+    let mut rows = resumed.unwrap_or_default();
     let finished: std::collections::HashSet<usize> = rows.iter().map(|r| r.index).collect();
-    let todo: Vec<_> = points
+    let todo: Vec<Point> = points
         .into_iter()
         .filter(|p| !finished.contains(&p.index))
         .collect();
     if resume {
-        eprintln!(
-            "shpb: resuming: {} runs done, {} to go",
-            rows.len(),
-            todo.len()
+        match took_over {
+            true => eprintln!(
+                "shpb: resuming: {} runs done, {} to go",
+                rows.len(),
+                todo.len()
+            ),
+            false => eprintln!(
+                "shpb: no checkpoint to resume ({} absent): running the whole sweep",
+                anchor.map(checkpoint_path).unwrap_or_default().display()
+            ),
+        }
+    }
+    let done = Arc::new(AtomicUsize::new(rows.len()));
+    let runs_here = rows.len() + todo.len();
+    if let Some(c) = &checkpoint {
+        let (done, path, command) = (
+            done.clone(),
+            c.path.clone(),
+            crate::interrupt::resume_command(),
         );
+        crate::interrupt::set_message(move || {
+            format!(
+                "{} of {runs_here} runs are done and kept in {}; resume with:\n  {command}",
+                done.load(Ordering::SeqCst),
+                path.display()
+            )
+        });
     }
     let bar = indicatif::ProgressBar::new(todo.len() as u64);
     bar.set_style(
@@ -95,11 +200,12 @@ pub fn sweep(
     );
     let failed = std::sync::Mutex::new(None);
     let new_rows = run_points(scene, &axes, &todo, jobs, |row| {
-        if let Some((c, _)) = &checkpoint
+        if let Some(c) = &checkpoint
             && let Err(e) = c.record(row)
         {
             *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
         }
+        done.fetch_add(1, Ordering::SeqCst);
         bar.inc(1);
     })?;
     bar.finish_and_clear();
@@ -108,19 +214,201 @@ pub fn sweep(
     }
     rows.extend(new_rows);
     rows.sort_by_key(|r| r.index);
-    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
     let table = shpb_study::sweep::summary_csv_keys(&keys, &rows);
-    say(table.trim_end())?;
-    let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
-    write_study(&scene_text, &spec, &keys, &rows, &table, (output, csv))?;
+    report(&table, || sweep_json(&keys, &rows))?;
+    // The outputs were checked before the runs; a resumed sweep owns the ones it left.
+    let replace = force || took_over;
+    write_study(
+        &scene_text,
+        &spec,
+        Some(&stamp.identity),
+        &keys,
+        &rows,
+        &table,
+        (output, csv),
+        replace,
+    )?;
     if let Some(p) = plot {
-        sweep_plot(p, resume || force, &axes, &rows)?;
-        eprintln!("wrote {}", p.display());
+        sweep_plot(p, replace || resume, &axes, &rows)?;
+        super::common::wrote(p);
     }
-    if let Some((c, _)) = checkpoint {
+    if let Some(c) = checkpoint {
         c.finish()?;
     }
+    crate::interrupt::clear_message();
     Ok(())
+}
+
+/// The runs of a finished sweep from its output (`-o`, else `--csv`), which must be of the sweep
+/// stamped `stamp` and hold exactly its `points`; else an input error naming what differs.
+fn finished_rows(
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    stamp: &Stamp,
+    axes: &[Axis],
+    points: &[Point],
+) -> Result<Vec<RunSummary>> {
+    let other = |file: &Path, problem: String| Error::Input {
+        file: file.display().to_string(),
+        key: "--resume".into(),
+        problem,
+        allowed: "the output of the same sweep (scene, set-up files, --set, --shard, shpb \
+                  version); or --force to run the sweep again and replace it"
+            .into(),
+    };
+    let expected: Vec<usize> = points.iter().map(|p| p.index).collect();
+    if let Some(path) = output {
+        let file = shpb_study::file::read_sweep_hdf5(path)?;
+        let Some(then) = file.stamp() else {
+            return Err(other(
+                path,
+                "the file records no sweep identity (written by an older shpb): cannot tell \
+                 whether it is this sweep"
+                    .into(),
+            ));
+        };
+        let differences = then.differences(stamp);
+        if !differences.is_empty() {
+            return Err(other(
+                path,
+                format!(
+                    "the file holds another sweep; what differs: {}",
+                    differences.join("; ")
+                ),
+            ));
+        }
+        let found: Vec<usize> = file.rows.iter().map(|r| r.index).collect();
+        if found != expected {
+            return Err(other(
+                path,
+                format!(
+                    "holds {} runs, not the {} of this sweep",
+                    found.len(),
+                    expected.len()
+                ),
+            ));
+        }
+        return Ok(file.rows);
+    }
+    // A CSV records no identity: its header and input cells must be this sweep's.
+    let path = csv.expect("an anchor");
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let mut rows: Vec<RunSummary> = points
+        .iter()
+        .map(|p| RunSummary {
+            index: p.index,
+            inputs: axes
+                .iter()
+                .zip(&p.coords)
+                .map(|(a, &c)| a.labels[c].clone())
+                .collect(),
+            peak_force_n: f64::NAN,
+            displacement_at_peak_m: f64::NAN,
+            peak_strain_rate_per_s: f64::NAN,
+            equilibrium_ratio_at_peak: f64::NAN,
+            time_to_equilibrium_s: f64::NAN,
+        })
+        .collect();
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    let expected = shpb_study::sweep::summary_csv_keys(&keys, &rows);
+    let (found, wanted) = (text.lines().count(), expected.lines().count());
+    if found != wanted {
+        return Err(other(
+            path,
+            format!(
+                "holds {} runs, not the {} of this sweep",
+                found.saturating_sub(1),
+                wanted - 1
+            ),
+        ));
+    }
+    let inputs = 1 + keys.len();
+    for (i, (line, want)) in text.lines().zip(expected.lines()).enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        let want: Vec<&str> = want.split(',').collect();
+        let same = if i == 0 {
+            cells == want
+        } else {
+            cells.len() == want.len() && cells[..inputs] == want[..inputs]
+        };
+        if !same {
+            return Err(other(
+                path,
+                format!("line {}, `{line}`, is not of this sweep's summary", i + 1),
+            ));
+        }
+        if i > 0 {
+            let r = &mut rows[i - 1];
+            let v: Vec<f64> = cells[inputs..]
+                .iter()
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect();
+            (
+                r.peak_force_n,
+                r.displacement_at_peak_m,
+                r.peak_strain_rate_per_s,
+                r.equilibrium_ratio_at_peak,
+                r.time_to_equilibrium_s,
+            ) = (v[0], v[1], v[2], v[3], v[4]);
+        }
+    }
+    Ok(rows)
+}
+
+/// What the machine allows a sweep: half the memory available (MemAvailable in /proc/meminfo,
+/// or what the cgroup still allows if less; the runs themselves need the rest) and the free disk
+/// space where the outputs go.
+fn machine_limits(outputs: &[&Path]) -> Limits {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+        t.lines()
+            .find_map(|l| l.strip_prefix("MemAvailable:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+            .map(|kb| kb * 1024)
+    });
+    let read = |p: &str| -> Option<u64> { std::fs::read_to_string(p).ok()?.trim().parse().ok() };
+    let cgroup = read("/sys/fs/cgroup/memory.max")
+        .zip(read("/sys/fs/cgroup/memory.current"))
+        .or_else(|| {
+            read("/sys/fs/cgroup/memory/memory.limit_in_bytes")
+                .zip(read("/sys/fs/cgroup/memory/memory.usage_in_bytes"))
+        })
+        .map(|(max, used)| max.saturating_sub(used));
+    let (available, basis) = match (meminfo, cgroup) {
+        (Some(m), Some(c)) if c < m => (c, "half of what the memory cgroup still allows"),
+        (Some(m), _) => (m, "half of MemAvailable in /proc/meminfo"),
+        (None, Some(c)) => (c, "half of what the memory cgroup still allows"),
+        (None, None) => (8 << 30, "half of an assumed 8 GiB (no /proc/meminfo)"),
+    };
+    let mut disk: Option<(u64, String)> = None;
+    for p in outputs {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        if let Some(free) = free_space(dir)
+            && disk.as_ref().is_none_or(|(d, _)| free < *d)
+        {
+            disk = Some((free, format!("free space in {}", dir.display())));
+        }
+    }
+    Limits {
+        memory_bytes: available / 2,
+        memory_basis: basis.to_string(),
+        disk_bytes: disk.as_ref().map(|(d, _)| *d),
+        disk_basis: disk.map(|(_, b)| b).unwrap_or_default(),
+    }
+}
+
+/// Bytes free for an unprivileged user on the file system of `dir` (`statvfs`).
+fn free_space(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: `c` is a valid NUL-terminated path and `s` a valid out-pointer.
+    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
+        return None;
+    }
+    Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
 }
 
 /// The summary plot of a finished sweep (rows of a sharded sweep that are missing stay blank).
@@ -177,4 +465,43 @@ fn sweep_plot(
             shpb_output::plot::sweep_figure(path, force, (&xl, &xv), Some((&yl, &yv)), &f, &r)
         }
     }
+}
+
+/// The summary of a sweep as JSON: one object per run with its inputs (SI value, unit and the
+/// text written; names as text) and its results with units.
+fn sweep_json(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> serde_json::Value {
+    let columns = shpb_study::sweep::input_columns(keys, rows);
+    let runs: Vec<serde_json::Value> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let inputs: serde_json::Map<String, serde_json::Value> = columns
+                .iter()
+                .map(|c| {
+                    let v = match &c.si {
+                        Some((si, units)) => serde_json::json!({
+                            "value": finite(si[i]),
+                            "unit": units,
+                            "as_written": c.values[i],
+                        }),
+                        None => serde_json::json!(c.values[i]),
+                    };
+                    (c.key.clone(), v)
+                })
+                .collect();
+            let results: serde_json::Map<String, serde_json::Value> =
+                shpb_study::sweep::SUMMARY_COLUMNS
+                    .iter()
+                    .zip(r.values())
+                    .map(|((name, unit), v)| {
+                        (
+                            name.to_string(),
+                            serde_json::json!({"value": finite(v), "unit": unit}),
+                        )
+                    })
+                    .collect();
+            serde_json::json!({"run": r.index, "inputs": inputs, "results": results})
+        })
+        .collect();
+    serde_json::json!({ "runs": runs })
 }
