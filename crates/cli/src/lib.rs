@@ -14,10 +14,10 @@ pub mod cli;
 pub mod cmd;
 
 pub use shpb_core::{
-    apparatus, bar, contact, fidelity, gauge, material, numeric, reduce, run, shaper, solver,
-    specimen, striker,
+    apparatus, bar, contact, estimate, fidelity, gauge, material, numeric, reduce, run, shaper,
+    solver, specimen, striker,
 };
-pub use shpb_input::{Error, Result, Validator, csv, error, gauges, kinds, units};
+pub use shpb_input::{Error, Result, Validator, csv, error, gauges, kinds, resources, units};
 pub use shpb_output::{io, plot, study as study_table, writer};
 pub use shpb_study::{bench, convergence, file as study_file, sweep};
 pub use shpb_validate as validate;

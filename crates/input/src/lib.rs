@@ -13,6 +13,7 @@ pub mod error;
 pub mod gauges;
 pub mod kinds;
 pub mod material;
+pub mod resources;
 pub mod scene;
 pub mod setup;
 pub mod specimen;
