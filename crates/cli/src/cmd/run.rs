@@ -63,16 +63,17 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             it.key, it.value, it.unit
         ));
     }
-    if let (Some(c), Some(r)) = (&out.contact, &out.reduction) {
-        let k = c.peak_index();
+    // True and reduced over the same window (the first loading pulse), so that a long run's
+    // later impacts are not compared with the first pulse's reduction.
+    if let Some(p) = out.peak_comparison() {
         text.push_str(&format!(
             "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
              displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
-            c.force_n[k] * 1e-3,
-            r.peak_back_force_n * 1e-3,
-            c.displacement_m[k] * 1e6,
-            r.displacement_at_peak_force_m * 1e6,
-            r.equilibrium_ratio_at_peak
+            p.true_peak_force_n * 1e-3,
+            p.reduced_peak_force_n * 1e-3,
+            p.true_displacement_at_peak_m * 1e6,
+            p.reduced_displacement_at_peak_m * 1e6,
+            p.equilibrium_ratio_at_peak
         ));
     }
     print(&text)
