@@ -121,13 +121,14 @@ impl Params {
             }
             SceneParams::Pulse {
                 apparatus, options, ..
-            } => estimate_bar_run(apparatus, options),
+            } => bar_run(apparatus, options),
         }
     }
 }
 
-/// The estimate of a `pulse` or `shpb` run (module docs).
-fn estimate_bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
+/// The estimate of a `pulse` or `shpb` run of `apparatus` with `options` (module docs), before
+/// its bars are built.
+pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
     let chain = apparatus.pulse_chain(options);
     let dt = chain.dt_s;
     let steps = (options.end_time_s / dt).ceil();

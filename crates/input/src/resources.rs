@@ -112,17 +112,24 @@ pub fn check_run(params: &Params) -> Result<RunEstimate> {
 }
 
 /// Checks the run of `params` against `limits`: an [`Error::TooLarge`] naming the scene, the
-/// estimate, the limit and the keys that make a run smaller when it does not fit.
+/// estimate, the limit and the keys that make the run smaller when it does not fit.
 pub fn check(params: &Params, limits: &Limits) -> Result<RunEstimate> {
     let e = params.estimate();
+    check_estimate(&params.source, &params.kind, &e, limits)?;
+    Ok(e)
+}
+
+/// Checks estimate `e` of a run of scene `file` of kind `kind` against `limits` (what
+/// [`check`] does, for a caller that has the estimate before the scene is complete).
+pub fn check_estimate(file: &str, kind: &str, e: &RunEstimate, limits: &Limits) -> Result<()> {
     let fits = e.steps <= limits.max_steps
         && e.updates() <= limits.max_updates
         && e.memory_bytes <= limits.memory_bytes;
     if fits {
-        return Ok(e);
+        return Ok(());
     }
     Err(Error::TooLarge {
-        file: params.source.clone(),
+        file: file.to_string(),
         needs: format!(
             "{} time steps ({} node updates), {} of memory, {} of output",
             format_si(e.steps.ceil(), ""),
@@ -137,7 +144,7 @@ pub fn check(params: &Params, limits: &Limits) -> Result<RunEstimate> {
             format_si(limits.memory_bytes, "B"),
             limits.memory_source
         ),
-        hint: smaller_run_hint(&params.kind).to_string(),
+        hint: smaller_run_hint(kind).to_string(),
     })
 }
 
