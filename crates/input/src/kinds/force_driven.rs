@@ -11,6 +11,7 @@ use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
 use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::error::format_si;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::{AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S, SceneParams};
 use shpb_core::solver::{self, ForceDrivenSetup, ForceHistory};
@@ -196,7 +197,12 @@ fn parse(
     if end / dt > 5e8 {
         return Err(v.error(
             "end_time_s",
-            format!("{end:e} s needs {:.1e} steps of {dt:e} s", end / dt),
+            format!(
+                "{} needs {} steps of {}",
+                format_si(end, "s"),
+                format_si(end / dt, ""),
+                format_si(dt, "s")
+            ),
             "at most 5e8 steps",
         ));
     }
