@@ -149,7 +149,7 @@ pub enum Command {
         #[arg(default_value = "scenes/shpb-ss440c-10psi.toml")]
         scene: PathBuf,
         /// Runs per timing (median reported; `reference` runs once).
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, allow_hyphen_values = true)]
         repeats: usize,
         /// Also write the tables as markdown to this file.
         #[arg(long)]
@@ -169,7 +169,12 @@ pub enum Command {
         #[arg(long = "set", required = true)]
         set: Vec<String>,
         /// Worker threads.
-        #[arg(short = 'j', long = "jobs", default_value_t = 1)]
+        #[arg(
+            short = 'j',
+            long = "jobs",
+            default_value_t = 1,
+            allow_hyphen_values = true
+        )]
         jobs: usize,
         /// Run only shard k of n (k/n): every n-th run from the k-th, deterministic.
         #[arg(long)]
@@ -213,15 +218,16 @@ pub enum Command {
         #[arg(long, default_value = "ss440c")]
         specimen: String,
         /// Global strain rate for Johnson–Cook hardening, 1/s (0: quasi-static).
-        // Negative numbers are parsed (not taken for options) so the range check can name them.
-        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+        // Values starting with `-` (-1, -1e-4, -.5) are taken as values, not options, so the
+        // range check can name them (`allow_negative_numbers` misses `-1e-4` and `-.5`).
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
         rate: f64,
         /// Largest approach δ, m.
-        #[arg(long, default_value_t = 250e-6, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 250e-6, allow_hyphen_values = true)]
         to: f64,
         /// Number of points.
-        #[arg(long, default_value_t = 101)]
-        points: usize,
+        #[arg(long, default_value_t = 101, allow_hyphen_values = true)]
+        points: i64,
         /// Contact law.
         #[arg(long, value_enum, default_value = "burgoyne-daraio")]
         law: LawArg,

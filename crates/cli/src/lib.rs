@@ -15,10 +15,12 @@ pub mod cmd;
 pub mod interrupt;
 
 pub use shpb_core::{
-    apparatus, bar, contact, fidelity, gauge, material, numeric, reduce, run, shaper, solver,
-    specimen, striker,
+    apparatus, bar, contact, estimate, fidelity, gauge, material, numeric, reduce, run, shaper,
+    solver, specimen, striker,
 };
-pub use shpb_input::{Error, Result, Validator, csv, error, gauges, kinds, provenance, units};
+pub use shpb_input::{
+    Error, Result, Validator, csv, error, gauges, kinds, provenance, resources, units,
+};
 pub use shpb_output::{io, plot, study as study_table, writer};
 pub use shpb_study::{bench, convergence, file as study_file, identity as study_identity, sweep};
 pub use shpb_validate as validate;

@@ -257,8 +257,8 @@ radius_m = 3e-3
 "#,
         &[
             "`specimen.sphere1.radius_m`",
-            "-1e-3 m is out of range",
-            "allowed: greater than 0 and at most 5e0 m",
+            "-1 mm is out of range",
+            "allowed: greater than 0 and at most 5 m",
         ],
     );
 }
@@ -404,8 +404,8 @@ fn curve_negative_to_names_option_and_range() {
         &[
             "command line",
             "`--to`",
-            "-1e0 m is out of range",
-            "allowed: greater than 0 and at most 1.5875e-3 m",
+            "-1 m is out of range",
+            "allowed: greater than 0 and at most 1.58 mm",
         ],
     );
     assert!(out.stdout.is_empty(), "no table on refusal");
@@ -423,7 +423,7 @@ fn curve_nan_rate_names_option_and_range() {
             "command line",
             "`--rate`",
             "NaN is not a finite number",
-            "allowed: 0e0 to 1e9 1/s",
+            "allowed: 0 to 1e9 1/s",
         ],
     );
     assert!(out.stdout.is_empty(), "no table on refusal");

@@ -609,7 +609,7 @@ fn gauge_file_errors_name_file_key_and_allowed_range() {
     let msg = toml_error(&second("polarity = -1.0", "polarity = 0.5"));
     assert_names(&msg, &["channel[1].polarity", "1 or -1"]);
     let msg = toml_error(&second("poisson_ratio = 0.31", "poisson_ratio = 0.7"));
-    assert_names(&msg, &["channel[1].poisson_ratio", "out of range", "5e-1"]);
+    assert_names(&msg, &["channel[1].poisson_ratio", "out of range", "0.5"]);
     let msg = toml_error(&second("noise_rms_v = 1.5e-4", "noise_rms_v = -1e-4"));
     assert_names(&msg, &["channel[1].noise_rms_v", "out of range"]);
     let msg = toml_error(&second("adc_range_v = 0.1", "adc_range_v = 0.0"));

@@ -40,6 +40,9 @@ pub struct Apparatus {
     pub striker: BarGeometry,
     /// Gas gun.
     pub gun: Gun,
+    /// The gauge pressures (lowest, highest) the gun (and shaper) were calibrated at, Pa; a run
+    /// outside them is warned about (the striker velocity is extrapolated). None: not stated.
+    pub gun_calibrated_pa: Option<(f64, f64)>,
     /// Default pulse shaper (None: no shaper).
     pub shaper: Option<PulseShaper>,
     /// Gauge channels.

@@ -13,6 +13,7 @@ pub mod apparatus;
 pub mod bar;
 pub mod contact;
 pub mod error;
+pub mod estimate;
 pub mod fidelity;
 #[cfg(test)]
 mod fixtures;

@@ -10,6 +10,13 @@ pub struct JohnsonCook {
     pub reference_rate_per_s: f64,
 }
 
+/// Largest global strain rate (paper Eq. 3) at which the Johnson–Cook constants were fitted or
+/// used, 1/s: the paper chose C (Fig. 4 values, docs/physics.md §2) to match its bar tests,
+/// whose global rates δ̇/(r1 + r2) reach 1.1e3–5.2e3 1/s (the Fig. 4 records, δ̇ over 2 µs), and
+/// ran its FEM with Johnson–Cook at 1e-3, 10 and 1e4 1/s (Fig. 3). Beyond it the rate hardening
+/// is an extrapolation and a run says so (a warning, not an error).
+pub const JOHNSON_COOK_RATE_LIMIT_PER_S: f64 = 1e4;
+
 impl JohnsonCook {
     /// No rate dependence (C = 0).
     pub const NONE: JohnsonCook = JohnsonCook {

@@ -33,23 +33,31 @@
 //! 1. Baseline: the mean of the first `baseline_samples` samples of each channel is subtracted
 //!    (the authors use the pre-trigger part; if the incident pulse starts earlier than that, the
 //!    baseline is re-taken over the samples before the pulse start).
-//! 2. Incident start `t_I` (at the incident gauge, record clock): with `y = −εI` (compression),
+//! 2. Polarity: on the incident gauge the incident pulse, compressive (ε < 0), comes first; the
+//!    reflected one, tensile for a specimen softer than the bars, only 2 d_I/c0 later. So the
+//!    first sample whose |ε| reaches half the record's largest |ε| must be negative; if it is
+//!    positive the channel's polarity is inverted (a compressive pulse recorded as tension) and
+//!    the reduction is refused, naming the channel, rather than taking the reflected pulse for
+//!    the incident one. The transmitted pulse is compressive too (the spheres can only push), so
+//!    the same rule holds on the transmission gauge. A channel is judged only when its largest
+//!    |ε| stands out of the noise (10 times the RMS of its baseline samples).
+//! 3. Incident start `t_I` (at the incident gauge, record clock): with `y = −εI` (compression),
 //!    `y_max` its largest value in the record, the first pulse is the first run of samples with
 //!    `y ≥ y_max/2`; its peak `y_p` is the largest `y` in that run; `t_I` is the time of the last
 //!    sample before the peak with `y < start_fraction·y_p` (default 2 %). `t_I` is therefore on
 //!    the sample grid, at the foot of the pulse. It can be overridden (`WindowOverride`).
-//! 3. Reflected window at the incident gauge: starts at `t_I + Δ_R`, `Δ_R = 2 d_I/c0`.
+//! 4. Reflected window at the incident gauge: starts at `t_I + Δ_R`, `Δ_R = 2 d_I/c0`.
 //!    Transmitted window at the transmission gauge: starts at `t_I + Δ_T`,
 //!    `Δ_T = d_I/c0 + d_T/c0 + specimen_transit_s`; the transit through the specimen (two
 //!    6.35 mm spheres, ≈ 2.5 µs at the spheres' bar-wave speed, but really set by the contact
 //!    compliance) is neglected by default (0). Both delays can be overridden. Fractional-sample
 //!    delays are applied exactly for band-limited signals (Fourier phase shift), not rounded.
-//! 4. Window length `D`: the longest clean window, `min(Δ_R` (the incident gauge sees only the
+//! 5. Window length `D`: the longest clean window, `min(Δ_R` (the incident gauge sees only the
 //!    incident wave until the reflected one arrives), `2 (L_I − d_I)/c0` (the reflected wave
 //!    comes back from the impact end after that), `2 (L_T − d_T)/c0` if the transmission bar's
 //!    far end is not absorbing`)`, then shortened so that both the reflected and the transmitted
 //!    windows lie inside the record. It can be overridden.
-//! 5. Time axis: `t = 0` is the arrival of the incident pulse's foot at the specimen face,
+//! 6. Time axis: `t = 0` is the arrival of the incident pulse's foot at the specimen face,
 //!    `t_I + d_I/c0` on the record clock (`Reduction::face_time_offset_s`); the three waves,
 //!    time-shifted to the faces, share it.
 //!
@@ -461,6 +469,64 @@ fn pulse_foot(y: &[f64], fraction: f64) -> Option<(usize, usize)> {
     Some((foot, k_peak))
 }
 
+/// How many times the RMS of its baseline a channel's largest |ε| must be for its polarity to be
+/// judged (module docs, "Windows" 2).
+const POLARITY_SIGNAL_TO_NOISE: f64 = 10.0;
+
+/// The first sample of `eps` (baseline removed) whose |ε| reaches half the largest |ε|, as
+/// (index, value), when that largest |ε| stands out of the noise of the first `baseline`
+/// samples (module docs, "Windows" 2); None for a channel without a clear pulse.
+fn first_pulse(eps: &[f64], baseline: usize) -> Option<(usize, f64)> {
+    let largest = eps.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    let nb = baseline.min(eps.len());
+    let noise = if nb > 0 {
+        (eps[..nb].iter().map(|e| e * e).sum::<f64>() / nb as f64).sqrt()
+    } else {
+        0.0
+    };
+    if !(largest > 0.0 && largest > POLARITY_SIGNAL_TO_NOISE * noise) {
+        return None;
+    }
+    eps.iter()
+        .position(|e| e.abs() >= 0.5 * largest)
+        .map(|k| (k, eps[k]))
+}
+
+/// Refuses a channel whose first pulse is tensile: its polarity is inverted (module docs,
+/// "Windows" 2). `channel` is `incident` or `transmission`.
+fn check_polarity(
+    eps: &[f64],
+    baseline: usize,
+    time_s: &[f64],
+    channel: &str,
+    file: &str,
+) -> Result<()> {
+    match first_pulse(eps, baseline) {
+        Some((k, e)) if e > 0.0 => Err(input_err(
+            file,
+            &format!("{channel}_strain"),
+            format!(
+                "the first pulse on the {channel} gauge is tensile (strain +{} at {}), but the \
+                 {} pulse, compressive, comes first there: the channel's polarity is inverted (a \
+                 compressive pulse recorded as tension)",
+                crate::error::format_si(e, ""),
+                crate::error::format_si(time_s[k], "s"),
+                if channel == "incident" {
+                    "incident"
+                } else {
+                    "transmitted"
+                }
+            ),
+            format!(
+                "a record whose first {channel} pulse is compressive (strain < 0): flip the sign \
+                 of `polarity` of the {channel} channel in the gauge set-up (bars/gauges-*.toml) \
+                 that reads this record, or correct the record"
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Cuts `n` samples starting at fractional index `start` out of `x` (uniform step `dt`), after
 /// delaying every Fourier component by `dispersion_delay_s(f, distance)` when `dispersion` is
 /// given as (distance, radius, c0). Exact copy when the start is on a sample and there is no
@@ -703,9 +769,17 @@ pub fn reduce_named(
     let incident_strain = moving_average(&input.incident_strain, half);
     let transmission_strain = moving_average(&input.transmission_strain, half);
 
-    // 1–2. Baseline, then the incident foot; the baseline must end before the pulse.
+    // 1–3. Baseline, polarity, then the incident foot; the baseline must end before the pulse.
     let mut nb = options.baseline_samples.min(n / 2);
     let mut eps_i = debias(&incident_strain, nb);
+    check_polarity(&eps_i, nb, &input.time_s, "incident", file)?;
+    check_polarity(
+        &debias(&transmission_strain, nb),
+        nb,
+        &input.time_s,
+        "transmission",
+        file,
+    )?;
     let foot = |e: &[f64]| {
         let y: Vec<f64> = e.iter().map(|v| -v).collect();
         pulse_foot(&y, options.start_fraction)
@@ -735,7 +809,7 @@ pub fn reduce_named(
     };
     let incident_peak = detected.map(|(_, k)| -eps_i[k]).unwrap_or(0.0);
 
-    // 3. Delays.
+    // 4. Delays.
     let c_i = bi.wave_speed_m_s;
     let c_t = bt.wave_speed_m_s;
     let nominal_r = 2.0 * d_i / c_i;
@@ -744,7 +818,7 @@ pub fn reduce_named(
         .transmitted_delay_s
         .unwrap_or(d_i / c_i + d_t / c_t + options.specimen_transit_s);
 
-    // 4. Window length.
+    // 5. Window length.
     let record_end = input.time_s[n - 1];
     let duration_s = match ov.duration_s {
         Some(d) => d,
@@ -925,4 +999,125 @@ pub fn record_strains(
         incident_strain: inc.strains_from_voltages(&debias(&record.incident_v, n)),
         transmission_strain: tra.strains_from_voltages(&debias(&record.transmission_v, n)),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record of the authors' bars (no dispersion): a compressive incident sin² pulse whose
+    /// foot passes the incident gauge at 100 µs, its reflection (tensile, 60 % of it) 2 d_I/c0
+    /// later, and a compressive transmitted pulse, sampled at 10 MHz with a little noise.
+    fn record() -> (ReductionInput, ReductionSetup) {
+        let bar = BarProperties {
+            youngs_modulus_pa: 192e9,
+            wave_speed_m_s: 4865.5,
+            area_m2: std::f64::consts::PI * 9.525e-3 * 9.525e-3,
+            radius_m: 9.525e-3,
+            poisson_ratio: 0.31,
+            length_m: None,
+        };
+        let setup = ReductionSetup {
+            incident_bar: bar,
+            transmission_bar: bar,
+            incident_gauge_m: 0.644525,
+            transmission_gauge_m: 0.3683,
+            transmission_absorbing: true,
+        };
+        let c0 = bar.wave_speed_m_s;
+        let pulse = |t: f64| {
+            let x = t / 120e-6;
+            if (0.0..=1.0).contains(&x) {
+                (std::f64::consts::PI * x).sin().powi(2)
+            } else {
+                0.0
+            }
+        };
+        let (t_i, d_r, d_t) = (100e-6, 2.0 * 0.644525 / c0, (0.644525 + 0.3683) / c0);
+        let time_s: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-7).collect();
+        let noise = |k: usize| 1e-7 * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
+        let incident_strain = time_s
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| -4e-4 * pulse(t - t_i) + 2.4e-4 * pulse(t - t_i - d_r) + noise(k))
+            .collect();
+        let transmission_strain = time_s
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| -1e-4 * pulse(t - t_i - d_t) + noise(k + 3))
+            .collect();
+        (
+            ReductionInput {
+                time_s,
+                incident_strain,
+                transmission_strain,
+            },
+            setup,
+        )
+    }
+
+    fn options() -> ReductionOptions {
+        ReductionOptions {
+            dispersion_correction: false,
+            ..ReductionOptions::default()
+        }
+    }
+
+    /// Issue 15, item 9: a record with inverted polarity was reduced with the reflected pulse
+    /// taken as the incident one; the first pulse on each gauge must be compressive.
+    #[test]
+    fn a_record_with_inverted_polarity_is_refused_naming_the_channel() {
+        let (input, setup) = record();
+        let r = reduce_named(&input, &setup, &options(), "rec.csv").unwrap();
+        // The foot (2 % of the peak) of the pulse starting at 100 µs.
+        assert!((100e-6..110e-6).contains(&r.windows.incident_start_s));
+
+        let mut inverted = input.clone();
+        for e in inverted
+            .incident_strain
+            .iter_mut()
+            .chain(inverted.transmission_strain.iter_mut())
+        {
+            *e = -*e;
+        }
+        let e = reduce_named(&inverted, &setup, &options(), "rec.csv").unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with(
+                "rec.csv: `incident_strain`: the first pulse on the incident gauge is tensile \
+                 (strain +2.01e-4 at 130.1 µs)"
+            ),
+            "{msg}"
+        );
+        assert!(msg.contains("the channel's polarity is inverted"), "{msg}");
+        assert!(
+            msg.contains("flip the sign of `polarity` of the incident channel"),
+            "{msg}"
+        );
+
+        // The transmission channel alone inverted.
+        let mut inverted = input.clone();
+        for e in inverted.transmission_strain.iter_mut() {
+            *e = -*e;
+        }
+        let msg = reduce_named(&inverted, &setup, &options(), "rec.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.starts_with("rec.csv: `transmission_strain`: the first pulse on the transmission gauge is tensile"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn polarity_is_not_judged_on_noise() {
+        // A channel that is all noise has no first pulse to judge.
+        let noise: Vec<f64> = (0..2000)
+            .map(|k| 1e-7 * ((k * 7919 % 101) as f64 - 50.0))
+            .collect();
+        assert_eq!(first_pulse(&noise, 900), None);
+        let mut pulse = noise.clone();
+        pulse[1500] = 1e-3;
+        assert_eq!(first_pulse(&pulse, 900), Some((1500, 1e-3)));
+    }
 }

@@ -73,6 +73,53 @@ impl RunOutput {
     }
 }
 
+/// The true contact of a simulated test and the lab's reduction of its records, compared over
+/// the same window: the reduction's (the first loading pulse, from the incident foot's arrival at
+/// the specimen face for the window's length). A run longer than that window (`end_time_s =
+/// 10e-3`) loads the spheres again when the waves come back; those later impacts are outside
+/// both sides of the comparison.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PeakComparison {
+    /// Largest true contact force within the window, N.
+    pub true_peak_force_n: f64,
+    /// True approach at that force, m.
+    pub true_displacement_at_peak_m: f64,
+    /// Simulation time of that force, s.
+    pub true_peak_time_s: f64,
+    /// Largest reduced back (transmitted) force, N.
+    pub reduced_peak_force_n: f64,
+    /// Reduced approach at that force, m.
+    pub reduced_displacement_at_peak_m: f64,
+    /// Reduced equilibrium ratio at that force.
+    pub equilibrium_ratio_at_peak: f64,
+    /// The window on the simulation clock (start, end), s.
+    pub window_s: (f64, f64),
+}
+
+impl RunOutput {
+    /// The true and the reduced peak force of a full test over the same window (the reduction's
+    /// window, [`PeakComparison`]); None without a reduction or a timed contact history.
+    pub fn peak_comparison(&self) -> Option<PeakComparison> {
+        let r = self.reduction.as_ref()?;
+        let c = self.contact.as_ref()?;
+        let t = c.time_s.as_ref()?;
+        let start = r.face_time_offset_s;
+        let end = start + r.windows.duration_s;
+        let k = (0..t.len())
+            .filter(|&i| t[i] >= start && t[i] <= end)
+            .max_by(|&a, &b| c.force_n[a].total_cmp(&c.force_n[b]))?;
+        Some(PeakComparison {
+            true_peak_force_n: c.force_n[k],
+            true_displacement_at_peak_m: c.displacement_m[k],
+            true_peak_time_s: t[k],
+            reduced_peak_force_n: r.peak_back_force_n,
+            reduced_displacement_at_peak_m: r.displacement_at_peak_force_m,
+            equilibrium_ratio_at_peak: r.equilibrium_ratio_at_peak,
+            window_s: (start, end),
+        })
+    }
+}
+
 // The reduction input of a run lives with the run, so that `reduce` does not depend on `run`.
 impl ReductionInput {
     /// The noise-free gauge strains of a simulated test (`/gauges/{incident,transmission}/strain`

@@ -5,11 +5,13 @@
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::bar::Dispersion;
 use crate::contact::{Contact, Degenerate, LawKind, LoadingCurve, Region2Form};
-use crate::error::Result;
+use crate::error::{Result, format_si};
 use crate::fidelity::Fidelity;
+use crate::material::JOHNSON_COOK_RATE_LIMIT_PER_S;
 use crate::numeric::resample;
 use crate::run::{RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
+use crate::specimen::MODEL_APPROACH_LIMIT_OF_RADIUS;
 use crate::specimen::SpherePair;
 
 /// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
@@ -104,7 +106,8 @@ impl Params {
         }
     }
 
-    /// Runs the scene.
+    /// Runs the scene; the output's warnings say where the run left the model's range of
+    /// validity ([`Params::validity_warnings`]).
     pub fn run(&self) -> Result<RunOutput> {
         self.run_with_progress(&mut |_| {})
     }
@@ -112,6 +115,93 @@ impl Params {
     /// Runs the scene, calling `progress` with the fraction done (0 to 1) now and then during
     /// long solves (bar scenes: every 1 % of the steps).
     pub fn run_with_progress(&self, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
+        let mut out = self.run_kind(progress)?;
+        let validity = self.validity_warnings(&out);
+        out.warnings.extend(validity);
+        Ok(out)
+    }
+
+    /// Where a run of this scene left the range the model was fitted or calibrated over (each a
+    /// warning, not an error): the sphere approach beyond
+    /// [`MODEL_APPROACH_LIMIT_OF_RADIUS`] of the smaller sphere radius (the paper's FEM range);
+    /// the global strain rate beyond [`JOHNSON_COOK_RATE_LIMIT_PER_S`] with rate hardening on;
+    /// a gun pressure outside the pressures the set-up's gun was calibrated at.
+    pub fn validity_warnings(&self, out: &RunOutput) -> Vec<String> {
+        let mut w = Vec::new();
+        let (pair, law) = match &self.params {
+            SceneParams::Pulse {
+                apparatus,
+                pressure_pa,
+                options,
+            } => {
+                if let Some((lo, hi)) = apparatus.gun_calibrated_pa
+                    && (*pressure_pa < lo || *pressure_pa > hi)
+                {
+                    let psi = crate::striker::PSI_PA;
+                    w.push(format!(
+                        "gun pressure {} is outside {}, the pressures the gun of {} was calibrated \
+                         at (validation/pulse/REPORT.md): the striker velocity {} is extrapolated",
+                        format_si(pressure_pa / psi, "psi"),
+                        crate::error::format_range(lo / psi, hi / psi, "psi"),
+                        apparatus.source,
+                        format_si(options.striker_velocity_m_s, "m/s"),
+                    ));
+                }
+                match &options.specimen {
+                    Some(sp) => (&sp.pair, sp.law),
+                    None => return w,
+                }
+            }
+            _ => (&self.pair, self.law),
+        };
+        let Some(contact) = &out.contact else {
+            return w;
+        };
+        let radius = pair.sphere1.radius_m.min(pair.sphere2.radius_m);
+        let limit = MODEL_APPROACH_LIMIT_OF_RADIUS * radius;
+        let approach = contact
+            .displacement_m
+            .iter()
+            .copied()
+            .fold(0.0f64, f64::max);
+        if approach > limit {
+            w.push(format!(
+                "the sphere approach reaches {} ({:.2} of the sphere radius {}), beyond {} \
+                 ({MODEL_APPROACH_LIMIT_OF_RADIUS} R), the range of the finite-element runs the \
+                 contact law was fitted to (paper Figs. 2–3: δ ≤ 0.19 R): the model is \
+                 extrapolated",
+                format_si(approach, "m"),
+                approach / radius,
+                format_si(radius, "m"),
+                format_si(limit, "m"),
+            ));
+        }
+        let rate_hardening =
+            law == LawKind::BurgoyneDaraio && pair.contact_properties().rate.c > 0.0;
+        let rate = match (&contact.strain_rate_per_s, &self.params) {
+            (Some(r), _) => r.iter().copied().fold(0.0f64, f64::max),
+            (
+                None,
+                SceneParams::Quasistatic {
+                    strain_rate_per_s, ..
+                },
+            ) => *strain_rate_per_s,
+            (None, _) => 0.0,
+        };
+        if rate_hardening && rate > JOHNSON_COOK_RATE_LIMIT_PER_S {
+            w.push(format!(
+                "the global strain rate reaches {}, beyond {}, the highest rate at which the \
+                 Johnson–Cook constants were fitted or used (paper Fig. 4 tests up to 5.2e3 1/s, \
+                 Fig. 3 FEM up to 1e4 1/s): the rate hardening is extrapolated",
+                format_si(rate, "1/s"),
+                format_si(JOHNSON_COOK_RATE_LIMIT_PER_S, "1/s"),
+            ));
+        }
+        w
+    }
+
+    /// Runs the scene's kind (without the validity warnings).
+    fn run_kind(&self, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
         let law = self.contact_law();
         let law = law.as_ref();
         match &self.params {

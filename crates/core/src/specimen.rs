@@ -42,6 +42,12 @@ pub struct ContactProperties {
     pub rate: JohnsonCook,
 }
 
+/// Largest approach δ, as a fraction of the smaller sphere radius, over which the contact law
+/// was fitted: the paper's quasi-static FEM (Fig. 2) compressed 3.175 mm hemispheres to at most
+/// δ = 0.6 mm (0.19 R), its constant-rate FEM (Fig. 3) to 0.25 mm (0.08 R). Beyond 0.2 R the law
+/// (and Hertz's small-strain theory) is extrapolated and a run says so (a warning, not an error).
+pub const MODEL_APPROACH_LIMIT_OF_RADIUS: f64 = 0.2;
+
 /// Two spheres in contact: sphere 1 is on the incident side, sphere 2 on the transmission side.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpherePair {

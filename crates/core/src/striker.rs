@@ -2,7 +2,7 @@
 //! the reservoir gas behind the striker over the barrel (Rohrbach et al., Am. J. Phys. 80, 24
 //! (2012); docs/physics.md §6).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, format_range, format_si};
 
 /// The quantity named in errors about the gun pressure.
 const PRESSURE: &str = "gun pressure";
@@ -57,8 +57,8 @@ impl GasGun {
             return Err(Error::invalid(
                 PRESSURE,
                 format!(
-                    "{:.4} psi is too low to overcome friction and back-pressure",
-                    p_gauge_pa / PSI_PA
+                    "{} is too low to overcome friction and back-pressure",
+                    format_si(p_gauge_pa / PSI_PA, "psi")
                 ),
                 allowed,
             ));
@@ -70,16 +70,17 @@ impl GasGun {
 /// Checks a gauge pressure against the gun's range; returns the range text for later errors.
 fn check_range(p_gauge_pa: f64, min_pa: f64, max_pa: f64) -> Result<String> {
     let allowed = format!(
-        "{:.3} to {:.3} psi ({:.0} to {:.0} Pa gauge)",
-        min_pa / PSI_PA,
-        max_pa / PSI_PA,
-        min_pa,
-        max_pa
+        "{} ({} gauge)",
+        format_range(min_pa / PSI_PA, max_pa / PSI_PA, "psi"),
+        format_range(min_pa, max_pa, "Pa")
     );
     if !p_gauge_pa.is_finite() || p_gauge_pa < min_pa || p_gauge_pa > max_pa {
         return Err(Error::invalid(
             PRESSURE,
-            format!("{:.4} psi is outside the gun's range", p_gauge_pa / PSI_PA),
+            format!(
+                "{} is outside the gun's range",
+                format_si(p_gauge_pa / PSI_PA, "psi")
+            ),
             allowed,
         ));
     }

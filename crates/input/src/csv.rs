@@ -1,9 +1,60 @@
 //! Numeric CSV tables: `#` comment lines, one header line, then rows of numbers. Errors name the
-//! file, line and column.
+//! file, line and column. Files may start with a UTF-8 byte-order mark and end their lines with
+//! CRLF (as spreadsheet programs write them); a file that is not UTF-8 text (a binary file, an
+//! HDF5 file, a UTF-16 export) is refused as "not a text CSV" ([`read_text`]).
 
 use crate::error::{Error, Result};
 use std::path::Path;
 use std::str::FromStr;
+
+/// The text of a CSV file, without a leading UTF-8 byte-order mark. A file that is not UTF-8
+/// text, or holds a NUL byte (binary data, UTF-16), is an [`Error::Parse`] "not a text CSV"
+/// naming the file and where the text stops; a file that cannot be read is an [`Error::Io`].
+pub fn read_text(path: &Path) -> Result<String> {
+    let bytes = crate::files::read(path).map_err(|e| Error::io(path, e))?;
+    let not_text = |at: usize, what: &str| Error::Parse {
+        file: path.display().to_string(),
+        message: format!(
+            "not a text CSV ({what} at byte {at}); expected UTF-8 text: `#` comment lines, a \
+             header line naming the columns, then rows of comma-separated numbers"
+        ),
+    };
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        return Err(not_text(at, "a NUL byte"));
+    }
+    let text = String::from_utf8(bytes)
+        .map_err(|e| not_text(e.utf8_error().valid_up_to(), "invalid UTF-8"))?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
+/// The sign convention of a force or approach column ([`CsvTable::compression_column`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SignConvention {
+    /// Compression positive: the project's convention (docs/physics.md, "Units and signs").
+    #[default]
+    CompressionPositive,
+    /// Tension positive (a bar-side convention): the column is negated on reading.
+    TensionPositive,
+}
+
+impl SignConvention {
+    /// The names a scene writes (`force_sign = "..."`).
+    pub const NAMES: [(&'static str, SignConvention); 2] = [
+        ("compression-positive", SignConvention::CompressionPositive),
+        ("tension-positive", SignConvention::TensionPositive),
+    ];
+
+    /// The convention called `name`.
+    pub fn parse(name: &str) -> Option<SignConvention> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, s)| s)
+    }
+}
 
 /// A numeric CSV table: `#` comment lines, one header line, then rows of numbers.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +68,10 @@ pub struct CsvTable {
 }
 
 impl CsvTable {
-    /// Parses CSV text; `file` names the source in errors.
+    /// Parses CSV text (a leading byte-order mark and CRLF line ends are accepted); `file` names
+    /// the source in errors.
     pub fn parse(text: &str, file: &str) -> Result<CsvTable> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let input = |line: usize, key: &str, problem: String, allowed: &str| Error::Input {
             file: format!("{file}:{line}"),
             key: key.to_string(),
@@ -97,9 +150,9 @@ impl CsvTable {
         })
     }
 
-    /// Reads and parses a CSV file.
+    /// Reads and parses a CSV file ([`read_text`]).
     pub fn read(path: &Path) -> Result<CsvTable> {
-        let text = crate::files::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = read_text(path)?;
         CsvTable::parse(&text, &path.display().to_string())
     }
 
@@ -115,6 +168,59 @@ impl CsvTable {
                 problem: "column missing".into(),
                 allowed: format!("a header with `{name}` (found: {})", self.names.join(", ")),
             })
+    }
+
+    /// The column `name` of a force or approach, compression positive (the project's convention,
+    /// docs/physics.md "Units and signs"). `sign` is the file's own convention: a
+    /// [`SignConvention::TensionPositive`] column is negated. The sample of largest magnitude
+    /// must then be positive (a loading record compresses the spheres): a column whose largest
+    /// value is a negative one holds compression negative, and is refused naming the file, the
+    /// column and `remedy` (what the user can set to read it), not read as a force that never
+    /// loads. A column of zeros is accepted.
+    pub fn compression_column(
+        &self,
+        name: &str,
+        sign: SignConvention,
+        remedy: &str,
+    ) -> Result<Vec<f64>> {
+        let factor = match sign {
+            SignConvention::CompressionPositive => 1.0,
+            SignConvention::TensionPositive => -1.0,
+        };
+        let column: Vec<f64> = self.column(name)?.iter().map(|x| factor * x).collect();
+        let (k, largest) = column
+            .iter()
+            .copied()
+            .enumerate()
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .unwrap_or((0, 0.0));
+        if largest < 0.0 {
+            let unit = if name.ends_with("_N") {
+                "N"
+            } else if name.ends_with("_m") {
+                "m"
+            } else {
+                ""
+            };
+            return Err(Error::Input {
+                file: self.file.clone(),
+                key: name.to_string(),
+                problem: format!(
+                    "the value of largest magnitude, {} (data row {}), is negative{}: this file \
+                     holds compression negative",
+                    shpb_core::error::format_si(largest, unit),
+                    k + 1,
+                    match sign {
+                        SignConvention::CompressionPositive => "",
+                        SignConvention::TensionPositive => " once negated as tension-positive",
+                    }
+                ),
+                allowed: format!(
+                    "compression positive (a loading record: force and approach grow positive); {remedy}"
+                ),
+            });
+        }
+        Ok(column)
     }
 
     /// The column called `name` if present.
@@ -150,5 +256,88 @@ impl CsvTable {
             });
         }
         Ok(t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp(name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("shpb-csv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+
+    #[test]
+    fn a_byte_order_mark_and_crlf_line_ends_read_like_plain_text() {
+        let plain = temp("plain.csv", b"# c\ntime_s,force_N\n0,1\n1e-6,2.5\n");
+        let excel = temp(
+            "excel.csv",
+            b"\xef\xbb\xbf# c\r\ntime_s,force_N\r\n0,1\r\n1e-6,2.5\r\n",
+        );
+        let a = CsvTable::read(&plain).unwrap();
+        let b = CsvTable::read(&excel).unwrap();
+        assert_eq!(a.names, b.names);
+        assert_eq!(a.columns, b.columns);
+        assert_eq!(b.column("time_s").unwrap(), [0.0, 1e-6]);
+        // Without a comment line the mark sits before the first column's name.
+        let bare = temp("bare.csv", b"\xef\xbb\xbftime_s,force_N\r\n0,1\r\n");
+        assert_eq!(CsvTable::read(&bare).unwrap().names, ["time_s", "force_N"]);
+    }
+
+    #[test]
+    fn a_force_column_with_compression_negative_is_refused() {
+        let text = "time_s,force_N\n0,0\n1e-6,-5000\n2e-6,-12000\n3e-6,150\n";
+        let t = CsvTable::parse(text, "f.csv").unwrap();
+        let e = t
+            .compression_column("force_N", SignConvention::CompressionPositive, "REMEDY")
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert_eq!(
+            e.to_string(),
+            "f.csv: `force_N`: the value of largest magnitude, -12 kN (data row 3), is negative: \
+             this file holds compression negative; allowed: compression positive (a loading \
+             record: force and approach grow positive); REMEDY"
+        );
+        let flipped = t
+            .compression_column("force_N", SignConvention::TensionPositive, "")
+            .unwrap();
+        assert_eq!(flipped, [-0.0, 5000.0, 12000.0, -150.0]);
+        // Declared tension-positive, but compression is positive already: refused too.
+        let t = CsvTable::parse("time_s,force_N\n0,0\n1e-6,12000\n", "g.csv").unwrap();
+        let e = t
+            .compression_column("force_N", SignConvention::TensionPositive, "")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("is negative once negated as tension-positive"),
+            "{e}"
+        );
+        assert_eq!(
+            SignConvention::parse("tension-positive"),
+            Some(SignConvention::TensionPositive)
+        );
+    }
+
+    #[test]
+    fn a_binary_file_is_not_a_text_csv() {
+        let hdf5 = temp("run.h5", b"\x89HDF\r\n\x1a\n\x00\x00\x00\x00");
+        let e = CsvTable::read(&hdf5).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with(&format!("{}: not a text CSV (", hdf5.display())),
+            "{msg}"
+        );
+        assert!(!msg.contains("stream did not contain valid UTF-8"), "{msg}");
+        let latin1 = temp("latin1.csv", b"time_s,force_N\n0,1\xb0\n");
+        let msg = CsvTable::read(&latin1).unwrap_err().to_string();
+        assert!(
+            msg.contains("not a text CSV (invalid UTF-8 at byte 18)"),
+            "{msg}"
+        );
     }
 }

@@ -60,6 +60,21 @@ pub enum Error {
         /// Its value.
         value: f64,
     },
+    /// A run that cannot finish on this machine (too many steps, too much memory), refused before
+    /// it starts (`crate::resources`).
+    #[error(
+        "{file}: the run cannot finish on this machine: it needs {needs}; limit: {limit}; {hint}"
+    )]
+    TooLarge {
+        /// The scene.
+        file: String,
+        /// The estimate: steps, node updates, memory and output.
+        needs: String,
+        /// The limits and where the memory limit comes from.
+        limit: String,
+        /// The keys that make the run smaller.
+        hint: String,
+    },
     /// A physical quantity outside its model's range, reported by the core without a file
     /// (a caller of the library passed it directly).
     #[error("{quantity}: {problem}; allowed: {allowed}")]
@@ -117,12 +132,14 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     /// Process exit code for this error: 2 for bad input (a missing input file included,
-    /// wherever it is read), 3 for an unstable run, 1 otherwise.
+    /// wherever it is read, and a run too large for the machine), 3 for an unstable run, 1
+    /// otherwise.
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Input { .. }
             | Error::Parse { .. }
             | Error::OutputExists(_)
+            | Error::TooLarge { .. }
             | Error::Invalid { .. } => 2,
             Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => 2,
             Error::Unstable { .. } => 3,

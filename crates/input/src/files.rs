@@ -75,6 +75,24 @@ pub fn read_to_string(path: &Path) -> std::io::Result<String> {
     Ok(text)
 }
 
+/// Reads a file's bytes (or, while replaying, its stored copy), noting it while capturing (as
+/// text: the inputs shpb reads are text; a binary file is refused by its reader anyway).
+pub fn read(path: &Path) -> std::io::Result<Vec<u8>> {
+    let name = path.display().to_string();
+    let bytes = match replayed(&name) {
+        Some(Some(text)) => text.into_bytes(),
+        Some(None) => {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "not among the inputs stored in the run file",
+            ));
+        }
+        None => std::fs::read(path)?,
+    };
+    note(&name, &String::from_utf8_lossy(&bytes));
+    Ok(bytes)
+}
+
 /// Whether `path` is a readable file (while replaying: whether the run file stored it).
 pub fn is_file(path: &Path) -> bool {
     match replayed(&path.display().to_string()) {

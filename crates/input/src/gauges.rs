@@ -215,9 +215,10 @@ impl RawRecordFile for RawRecord {
         })
     }
 
-    /// Reads a record file (see [`RawRecord::parse`]).
+    /// Reads a record file (see [`RawRecord::parse`]; a byte-order mark and CRLF line ends are
+    /// accepted, a binary file is "not a text CSV").
     fn read(path: &Path) -> Result<RawRecord> {
-        let text = crate::files::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = crate::csv::read_text(path)?;
         RawRecord::parse(&text, &path.display().to_string())
     }
 }

@@ -15,6 +15,7 @@ pub mod gauges;
 pub mod kinds;
 pub mod material;
 pub mod provenance;
+pub mod resources;
 pub mod scene;
 pub mod setup;
 pub mod specimen;

@@ -15,7 +15,8 @@ pub use toml::Value;
 pub trait SceneFile: Sized {
     /// Reads and validates a scene file.
     fn from_file(path: &Path) -> Result<Self>;
-    /// Validates scene TOML text; relative paths inside it are resolved against `base_dir`.
+    /// Validates scene TOML text; relative paths inside it are resolved against `base_dir`. A run
+    /// that cannot finish on this machine is refused (`crate::resources::check_run`).
     fn from_toml(text: &str, file: &str, base_dir: &Path) -> Result<Self>;
     /// Reads a scene file with its `fidelity` replaced by `fidelity` (when given): what
     /// `--fidelity` does. The stored scene text is the file's with the preset set.
@@ -61,7 +62,7 @@ impl SceneFile for Params {
             ));
         };
         let (pair, law, region2, params) = (scene_kind.parse)(text, file, base_dir, fidelity, &v)?;
-        Ok(Params {
+        let params = Params {
             source: file.to_string(),
             text: text.to_string(),
             kind,
@@ -70,7 +71,10 @@ impl SceneFile for Params {
             region2,
             fidelity,
             params,
-        })
+        };
+        // Refuse a run that cannot finish on this machine before anything is allocated for it.
+        crate::resources::check_run(&params)?;
+        Ok(params)
     }
 
     /// Reads a scene file with its `fidelity` replaced by `fidelity` (when given): what

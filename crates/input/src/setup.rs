@@ -41,6 +41,8 @@ struct GunToml {
     gamma: Option<f64>,
     min_pressure_pa: f64,
     max_pressure_pa: f64,
+    calibrated_min_pressure_pa: Option<f64>,
+    calibrated_max_pressure_pa: Option<f64>,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -195,6 +197,26 @@ impl ApparatusFile for Apparatus {
                 "min_pressure_pa < max_pressure_pa",
             ));
         }
+        let gun_calibrated_pa = match (g.calibrated_min_pressure_pa, g.calibrated_max_pressure_pa) {
+            (None, None) => None,
+            (Some(lo), Some(hi)) => {
+                let lo = gv.in_range("calibrated_min_pressure_pa", lo, pmin, pmax, "Pa")?;
+                let hi = gv.in_range("calibrated_max_pressure_pa", hi, lo, pmax, "Pa")?;
+                Some((lo, hi))
+            }
+            (lo, _) => {
+                let key = if lo.is_none() {
+                    "calibrated_min_pressure_pa"
+                } else {
+                    "calibrated_max_pressure_pa"
+                };
+                return Err(gv.error(
+                    key,
+                    "missing",
+                    "both calibrated_min_pressure_pa and calibrated_max_pressure_pa, or neither",
+                ));
+            }
+        };
         let need = |key: &str, x: Option<f64>| {
             x.ok_or_else(|| {
                 gv.error(
@@ -268,6 +290,7 @@ impl ApparatusFile for Apparatus {
             transmission_absorbing,
             striker: bar_geometry(&raw.striker, &v.table("striker"))?,
             gun,
+            gun_calibrated_pa,
             shaper,
             gauges,
         })
@@ -326,5 +349,54 @@ impl ShaperOverride {
             youngs_modulus_pa: self.youngs_modulus_pa.unwrap_or(b.youngs_modulus_pa),
         };
         shaper_from(&s, v).map(Some)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gun_calibration_is_read_and_checked() {
+        let authors = Apparatus::resolve("authors", Path::new(".")).unwrap();
+        let psi = shpb_core::striker::PSI_PA;
+        let (lo, hi) = authors.gun_calibrated_pa.unwrap();
+        assert!((lo / psi - 10.0).abs() < 1e-6 && (hi / psi - 15.0).abs() < 1e-6);
+        assert_eq!(
+            Apparatus::resolve("authors-20cm-striker", Path::new("."))
+                .unwrap()
+                .gun_calibrated_pa,
+            Some((lo, hi))
+        );
+        let text = crate::builtin::setup("authors").unwrap();
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        // Neither key: no calibration stated.
+        let none = text
+            .lines()
+            .filter(|l| !l.starts_with("calibrated_"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let a = Apparatus::from_toml(&none, "a.toml", &gauges).unwrap();
+        assert_eq!(a.gun_calibrated_pa, None);
+        // One without the other, or outside the gun's range, names the key.
+        let one = text.replace("calibrated_max_pressure_pa = 103421.36", "");
+        let e = Apparatus::from_toml(&one, "a.toml", &gauges).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("a.toml: `gun.calibrated_max_pressure_pa`: missing"),
+            "{e}"
+        );
+        let wide = text.replace(
+            "calibrated_max_pressure_pa = 103421.36",
+            "calibrated_max_pressure_pa = 3e5",
+        );
+        let e = Apparatus::from_toml(&wide, "a.toml", &gauges).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "a.toml: `gun.calibrated_max_pressure_pa`: 300 kPa is out of range; allowed: 69 kPa to 206.8 kPa"
+            ),
+            "{e}"
+        );
     }
 }

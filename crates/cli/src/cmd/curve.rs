@@ -8,7 +8,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// `shpb curve [--specimen S] [--rate R] [--to D] [--points N] [--law L]`.
-pub fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) -> Result<()> {
+pub fn curve(specimen: &str, rate: f64, to: f64, points: i64, law: LawKind) -> Result<()> {
     let v = Validator::new("command line");
     let pair = resolve_pair(specimen, Path::new("."), &v, "--specimen")?;
     v.in_range("--rate", rate, 0.0, 1e9, "1/s")?;
@@ -25,6 +25,7 @@ pub fn curve(specimen: &str, rate: f64, to: f64, points: usize, law: LawKind) ->
             "2 to 10000000",
         ));
     }
+    let points = points as usize;
     let law = law.build(pair.contact_properties());
     let s = shpb_core::solver::loading_curve(law.as_ref(), to, points, rate);
     let stdout = std::io::stdout();

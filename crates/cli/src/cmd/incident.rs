@@ -1,6 +1,7 @@
 //! `shpb incident`: the incident pulse a force–approach record implies.
 
 use super::common::{finite, gun_shot, load_apparatus, report};
+use shpb_input::csv::SignConvention;
 use shpb_input::{Error, Result, Validator};
 use std::path::Path;
 
@@ -26,20 +27,25 @@ pub fn incident(
     };
     let table = shpb_input::csv::CsvTable::read(record)?;
     let time = table.time_column("time_s")?;
+    // Compression positive, or refused naming the file and column (a record with compression
+    // negative would otherwise imply a plausible-looking pulse of the wrong sign).
+    let compression = |name: &str| {
+        table.compression_column(
+            name,
+            SignConvention::CompressionPositive,
+            "negate the column: shpb incident reads force_N and displacement_m compression positive",
+        )
+    };
+    let displacement = compression("displacement_m")?;
+    let force = compression("force_N")?;
     let bar = shpb_core::reduce::ReductionSetup::from_apparatus(&apparatus)?.incident_bar;
-    let pulse = shpb_core::reduce::implied_incident(
-        time,
-        table.column("displacement_m")?,
-        table.column("force_N")?,
-        &bar,
-        smoothing_s,
-    )
-    .ok_or_else(|| Error::Input {
-        file: table.file.clone(),
-        key: "force_N".into(),
-        problem: "the record implies no compressive incident pulse".into(),
-        allowed: "a loading record: force and approach growing from the start".into(),
-    })?;
+    let pulse = shpb_core::reduce::implied_incident(time, &displacement, &force, &bar, smoothing_s)
+        .ok_or_else(|| Error::Input {
+            file: table.file.clone(),
+            key: "force_N".into(),
+            problem: "the record implies no compressive incident pulse".into(),
+            allowed: "a loading record: force and approach growing from the start".into(),
+        })?;
     let c0 = bar.wave_speed_m_s;
     let rho_c = bar.youngs_modulus_pa / c0;
     let mut text = String::new();

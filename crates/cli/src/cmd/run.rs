@@ -136,28 +136,26 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             it.key, it.value, it.unit
         ));
     }
-    let comparison = match (&out.contact, &out.reduction) {
-        (Some(c), Some(r)) => {
-            let k = c.peak_index();
-            text.push_str(&format!(
-                "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
-                 displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
-                c.force_n[k] * 1e-3,
-                r.peak_back_force_n * 1e-3,
-                c.displacement_m[k] * 1e6,
-                r.displacement_at_peak_force_m * 1e6,
-                r.equilibrium_ratio_at_peak
-            ));
-            Some(serde_json::json!({
-                "true_peak_force_N": c.force_n[k],
-                "reduced_peak_back_force_N": r.peak_back_force_n,
-                "true_displacement_at_peak_m": c.displacement_m[k],
-                "reduced_displacement_at_peak_m": r.displacement_at_peak_force_m,
-                "equilibrium_ratio_at_peak": r.equilibrium_ratio_at_peak,
-            }))
-        }
-        _ => None,
-    };
+    // True and reduced over the same window (the first loading pulse), so that a long run's
+    // later impacts are not compared with the first pulse's reduction.
+    let comparison = out.peak_comparison().map(|p| {
+        text.push_str(&format!(
+            "result: peak force {:.3} kN (true contact) / {:.3} kN (reduced back force); \
+             displacement at peak force {:.1} µm / {:.1} µm; equilibrium ratio at peak {:.3}\n",
+            p.true_peak_force_n * 1e-3,
+            p.reduced_peak_force_n * 1e-3,
+            p.true_displacement_at_peak_m * 1e6,
+            p.reduced_displacement_at_peak_m * 1e6,
+            p.equilibrium_ratio_at_peak
+        ));
+        serde_json::json!({
+            "true_peak_force_N": finite(p.true_peak_force_n),
+            "reduced_peak_back_force_N": finite(p.reduced_peak_force_n),
+            "true_displacement_at_peak_m": finite(p.true_displacement_at_peak_m),
+            "reduced_displacement_at_peak_m": finite(p.reduced_displacement_at_peak_m),
+            "equilibrium_ratio_at_peak": finite(p.equilibrium_ratio_at_peak),
+        })
+    });
     report(&text, || {
         let summary: serde_json::Map<String, serde_json::Value> = out
             .summary

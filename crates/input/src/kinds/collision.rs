@@ -126,7 +126,7 @@ fn parse(
         velocity1_m_s: v1,
         velocity2_m_s: v2,
         dt_s: dt,
-        max_time_s: 1000.0 * tc,
+        max_time_s: solver::COLLISION_TIME_LIMIT_CONTACT_TIMES * tc,
         output_every: check_every(v, f.output_every)?,
     };
     Ok((pair, f.law, f.region2, SceneParams::Collision(setup)))
@@ -157,7 +157,7 @@ mod tests {
         let tc =
             solver::hertz_impact_duration(pair.reduced_mass_kg(), c.e_star_pa, c.radius_m, 5.0);
         assert_eq!(s.dt_s, tc / 2000.0);
-        assert_eq!(s.max_time_s, 1000.0 * tc);
+        assert_eq!(s.max_time_s, 100.0 * tc);
     }
 
     #[test]

@@ -117,7 +117,7 @@ mod tests {
         let e = parse(&text, "c.toml", Path::new("."), Fidelity::Standard, &v).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "c.toml: `strain_rate_per_s`: 0e0 1/s is out of range; allowed: greater than 0 and at most 1e9 1/s"
+            "c.toml: `strain_rate_per_s`: 0 1/s is out of range; allowed: greater than 0 and at most 1e9 1/s"
         );
     }
 }

@@ -5,12 +5,13 @@ use super::{
     Key, LAW, LawKindToml, OUTPUT_EVERY, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind,
     check_every, one,
 };
-use crate::csv::CsvTable;
+use crate::csv::{CsvTable, SignConvention};
 use crate::error::{Error, Result, Validator};
 use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
 use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::error::format_si;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::{AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S, SceneParams};
 use shpb_core::solver::{self, ForceDrivenSetup, ForceHistory};
@@ -41,6 +42,12 @@ pub(super) const KIND: SceneKind = SceneKind {
             unit: "",
             default: "force_N",
             meaning: "name of the CSV's force column (N)",
+        },
+        Key {
+            key: "force_sign",
+            unit: "",
+            default: "compression-positive",
+            meaning: "sign convention of the CSV's force and displacement_m columns: compression-positive (the project's) or tension-positive (both are negated on reading); a file whose largest force is negative under it is refused",
         },
         Key {
             key: "medium_impedance_kg_s",
@@ -90,6 +97,7 @@ struct ForceDrivenFile {
     time_column: String,
     #[serde(default = "default_force_column")]
     force_column: String,
+    force_sign: Option<String>,
     #[serde(default = "default_impedance")]
     medium_impedance_kg_s: f64,
     time_step_s: Option<f64>,
@@ -130,9 +138,30 @@ fn parse(
         ),
         other => other,
     })?;
+    let sign = match f.force_sign.as_deref() {
+        None => SignConvention::CompressionPositive,
+        Some(name) => SignConvention::parse(name).ok_or_else(|| {
+            v.error(
+                "force_sign",
+                format!("unknown sign convention `{name}`"),
+                "compression-positive, tension-positive",
+            )
+        })?,
+    };
+    let remedy = match sign {
+        SignConvention::CompressionPositive => format!(
+            "if the file's compression is negative, set force_sign = \"tension-positive\" in {file}"
+        ),
+        SignConvention::TensionPositive => format!(
+            "remove force_sign = \"tension-positive\" from {file} if compression is positive in the file"
+        ),
+    };
     let t = table.time_column(&f.time_column)?.to_vec();
-    let force = table.column(&f.force_column)?.to_vec();
-    let measured_displacement_m = table.optional_column("displacement_m").map(<[f64]>::to_vec);
+    let force = table.compression_column(&f.force_column, sign, &remedy)?;
+    let measured_displacement_m = match table.optional_column("displacement_m") {
+        Some(_) => Some(table.compression_column("displacement_m", sign, &remedy)?),
+        None => None,
+    };
     let drive = ForceHistory {
         time_s: t,
         force_n: force,
@@ -168,7 +197,12 @@ fn parse(
     if end / dt > 5e8 {
         return Err(v.error(
             "end_time_s",
-            format!("{end:e} s needs {:.1e} steps of {dt:e} s", end / dt),
+            format!(
+                "{} needs {} steps of {}",
+                format_si(end, "s"),
+                format_si(end / dt, ""),
+                format_si(dt, "s")
+            ),
             "at most 5e8 steps",
         ));
     }
@@ -202,14 +236,80 @@ mod tests {
     fn registry_entry() {
         super::super::check_kind(&KIND, &[]);
         let steps = Fidelity::ALL.map(|f| f.dem_steps().to_string()).join(", ");
-        assert_eq!(KIND.keys[8].default, format!("fidelity: {steps}"));
+        assert_eq!(KIND.keys[9].default, format!("fidelity: {steps}"));
         assert!(
-            KIND.keys[6]
+            KIND.keys[7]
                 .default
                 .starts_with(&format!("{:.2e} ", default_impedance()))
         );
         assert_eq!(KIND.keys[4].default, default_time_column());
         assert_eq!(KIND.keys[5].default, default_force_column());
+        assert_eq!(KIND.keys[6].default, SignConvention::NAMES[0].0);
+        for (name, _) in SignConvention::NAMES {
+            assert!(KIND.keys[6].meaning.contains(name));
+        }
+    }
+
+    /// Issue 15, item 8: a force CSV with compression negative ran (peak force 0, NaN error,
+    /// 482 J of kinetic energy); it is refused, naming the file and column, unless the scene
+    /// says the file is tension-positive, which negates the force and displacement columns.
+    #[test]
+    fn a_drive_with_compression_negative_is_refused_unless_declared() {
+        let dir = std::env::temp_dir().join(format!("shpb-fd-sign-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let source = CsvTable::read(
+            &repo().join("validation/fig4-force-driven/data/ss440c_10psi_force10.csv"),
+        )
+        .unwrap();
+        let mut text = String::from("time_s,displacement_m,force_N\n");
+        let col = |n: &str| source.column(n).unwrap();
+        for i in 0..col("time_s").len() {
+            text.push_str(&format!(
+                "{:e},{:e},{:e}\n",
+                col("time_s")[i],
+                -col("displacement_m")[i],
+                -col("force_N")[i]
+            ));
+        }
+        std::fs::write(dir.join("negative.csv"), text).unwrap();
+        let v = Validator::new("f.toml");
+        let scene = "kind = \"force-driven\"\nforce_csv = \"negative.csv\"\nspecimen = { pair = \"ss440c\" }\n";
+        let e = parse(scene, "f.toml", &dir, Fidelity::Fast, &v).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with(&format!(
+                "{}: `force_N`: the value of largest magnitude, -12.3 kN (data row ",
+                dir.join("negative.csv").display()
+            )),
+            "{msg}"
+        );
+        assert!(
+            msg.ends_with("set force_sign = \"tension-positive\" in f.toml"),
+            "{msg}"
+        );
+        // Declared: read as the original file.
+        let declared = format!("{scene}force_sign = \"tension-positive\"\n");
+        let (_, _, _, p) = parse(&declared, "f.toml", &dir, Fidelity::Fast, &v).unwrap();
+        let SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m,
+        } = p
+        else {
+            panic!("not force-driven")
+        };
+        assert_eq!(setup.drive.force_n, col("force_N"));
+        assert_eq!(
+            measured_displacement_m.as_deref(),
+            Some(col("displacement_m"))
+        );
+        // An unknown convention names the key.
+        let bad = format!("{scene}force_sign = \"up\"\n");
+        let e = parse(&bad, "f.toml", &dir, Fidelity::Fast, &v).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "f.toml: `force_sign`: unknown sign convention `up`; allowed: compression-positive, tension-positive"
+        );
     }
 
     #[test]

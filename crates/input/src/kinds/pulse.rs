@@ -251,7 +251,14 @@ pub(super) fn parse_bars(
         gauge_length_m,
         snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
     };
-    // Refuse a grid the bars cannot run (time step over the stability limit) now, not mid-run.
+    // Refuse a run too large for this machine before its bars are built (below), then a grid
+    // the bars cannot run (time step over the stability limit) now, not mid-run.
+    crate::resources::check_estimate(
+        file,
+        if is_test { "shpb" } else { "pulse" },
+        &shpb_core::estimate::bar_run(&apparatus, &options),
+        &crate::resources::Limits::of_machine()?,
+    )?;
     for spec in &apparatus.pulse_chain(&options).bodies {
         shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
     }
@@ -332,6 +339,36 @@ mod tests {
         assert_eq!(options.cell_size_m, 1e-3);
         assert_eq!(options.gauge_length_m, 2e-3);
         assert_eq!(options.shaper, apparatus.shaper);
+    }
+
+    /// Issue 15, item 5: the size check comes before the bars are built (a 100 m set-up at
+    /// 10 µm cells is 2e7 nodes, gigabytes of grid, before a step is taken).
+    #[test]
+    fn a_run_too_large_is_refused_before_its_bars_are_built() {
+        let dir = std::env::temp_dir().join(format!("shpb-long-bars-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let setup = crate::builtin::setup("authors")
+            .unwrap()
+            .replace("length_m = 1.21", "length_m = 100.0")
+            .replace("length_m = 1.02", "length_m = 100.0")
+            .replace("gauges = \"gauges-authors.toml\"", "gauges = \"g.toml\"");
+        std::fs::write(dir.join("long.toml"), setup).unwrap();
+        std::fs::write(
+            dir.join("g.toml"),
+            crate::builtin::gauges("gauges-authors.toml").unwrap(),
+        )
+        .unwrap();
+        let v = Validator::new("p.toml");
+        let text = "kind = \"pulse\"\nbars = \"long.toml\"\npressure = \"10psi\"\ncell_size_m = 1e-5\nend_time_s = 0.1\n";
+        // The kind's own parser refuses it: `from_toml`'s check of the finished scene comes later.
+        let e = parse(text, "p.toml", &dir, Fidelity::Standard, &v).unwrap_err();
+        assert!(matches!(e, crate::Error::TooLarge { .. }), "{e}");
+        assert!(
+            e.to_string().starts_with(
+                "p.toml: the run cannot finish on this machine: it needs 4.87e7 time steps (9.74e14 node updates)"
+            ),
+            "{e}"
+        );
     }
 
     #[test]
