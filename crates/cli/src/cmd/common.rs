@@ -122,6 +122,38 @@ impl ProgressLine {
     }
 }
 
+/// Refuses outputs that will not fit on their file system: the run's estimated output size
+/// (`bytes`, [`shpb_core::estimate::RunEstimate::output_bytes`]) against the space free where
+/// each output goes (exit 2, with both numbers).
+pub fn check_disk(outputs: &[(Option<&Path>, &str)], bytes: f64) -> Result<()> {
+    use shpb_core::error::format_si;
+    for (path, flag) in outputs {
+        let Some(path) = path.filter(|p| !shpb_output::atomic::is_stdout(p)) else {
+            continue;
+        };
+        let dir = path
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        if let Some(free) = free_space(dir)
+            && bytes > free as f64
+        {
+            return Err(input_err(
+                "command line",
+                flag,
+                format!(
+                    "the run writes about {} to {} but only {} are free there",
+                    format_si(bytes, "B"),
+                    path.display(),
+                    format_si(free as f64, "B")
+                ),
+                "an output on a file system with room for it, or a smaller run",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A number for JSON, which has no NaN or infinity: those become null.
 pub fn finite(v: f64) -> serde_json::Value {
     if v.is_finite() {
@@ -147,6 +179,18 @@ pub fn stdout_once(outputs: &[Option<&Path>]) -> Result<bool> {
         ));
     }
     Ok(to_stdout == 1)
+}
+
+/// Bytes free for an unprivileged user on the file system of `dir` (`statvfs`).
+pub fn free_space(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: `c` is a valid NUL-terminated path and `s` a valid out-pointer.
+    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
+        return None;
+    }
+    Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
 }
 
 /// The built-in set-up `--bars` names when not given.
@@ -255,4 +299,23 @@ pub fn write_study(
         wrote(p);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_output_larger_than_the_free_space_is_refused_with_both_numbers() {
+        let dir = std::env::temp_dir();
+        let out = dir.join("run.h5");
+        let free = free_space(&dir).expect("statvfs of the temporary directory") as f64;
+        assert!(check_disk(&[(Some(&out), "--output")], 0.5 * free).is_ok());
+        let e = check_disk(&[(Some(&out), "--output")], 2.0 * free + 1e9)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--output") && e.contains("free there"), "{e}");
+        // stdout and absent outputs take no disk space.
+        assert!(check_disk(&[(Some(Path::new("-")), "--csv"), (None, "-o")], 1e30).is_ok());
+    }
 }

@@ -1,7 +1,7 @@
 //! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
 //! summary and write its results.
 
-use super::common::{ProgressLine, finite, report, stdout_once, warn, wrote};
+use super::common::{ProgressLine, check_disk, finite, report, stdout_once, warn, wrote};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
@@ -50,6 +50,7 @@ pub fn run(
             check_not_input(p, flag, &inputs)?;
         }
     }
+    check_disk(&[(output, "--output")], params.estimate().output_bytes)?;
     let mut progress = ProgressLine::new(&params.source);
     let mut out = params.run_with_progress(&mut |f| progress.update(f))?;
     progress.finish();

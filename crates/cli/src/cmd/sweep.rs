@@ -385,7 +385,7 @@ fn machine_limits(outputs: &[&Path]) -> Limits {
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
-        if let Some(free) = free_space(dir)
+        if let Some(free) = super::common::free_space(dir)
             && disk.as_ref().is_none_or(|(d, _)| free < *d)
         {
             disk = Some((free, format!("free space in {}", dir.display())));
@@ -397,18 +397,6 @@ fn machine_limits(outputs: &[&Path]) -> Limits {
         disk_bytes: disk.as_ref().map(|(d, _)| *d),
         disk_basis: disk.map(|(_, b)| b).unwrap_or_default(),
     }
-}
-
-/// Bytes free for an unprivileged user on the file system of `dir` (`statvfs`).
-fn free_space(dir: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
-    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
-    // SAFETY: `c` is a valid NUL-terminated path and `s` a valid out-pointer.
-    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
-    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
-        return None;
-    }
-    Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
 }
 
 /// The summary plot of a finished sweep (rows of a sharded sweep that are missing stay blank).
