@@ -2,33 +2,11 @@
 //! one JSON object with `--json`), messages, warnings and `wrote PATH` on stderr, `-` for an
 //! output on stdout, `--quiet` for silence.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{repo_path as path, shpb, stderr as err, stdout as out};
+use std::process::Command;
 use tempfile::TempDir;
-
-fn repo() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-}
-
-fn shpb(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shpb"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn out(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).to_string()
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
-}
-
-fn path(rel: &str) -> String {
-    repo().join(rel).display().to_string()
-}
 
 #[test]
 fn json_results_parse_and_carry_units() {

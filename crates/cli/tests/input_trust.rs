@@ -6,21 +6,18 @@
 //! and refuse binary files plainly (item 17), and numbers in messages read as a person writes
 //! them, negative option values included (item 19).
 
+mod common;
+
+use common::{repo, shpb, shpb_env, stderr, stdout};
 use shpb::prelude::*;
 use shpb::run::RunOutput;
 use shpb::scene::Params;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use tempfile::TempDir;
-
-const BIN: &str = env!("CARGO_BIN_EXE_shpb");
 
 /// Exit code the CLI documents for bad input.
 const BAD_INPUT: i32 = 2;
-
-fn repo() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-}
 
 /// The measured SS440c 10 psi force history (time_s, displacement_m, force_N).
 fn fig4_csv() -> PathBuf {
@@ -30,29 +27,6 @@ fn fig4_csv() -> PathBuf {
 /// The authors' raw record of sample 2 (time_s, incident_V, transmission_V).
 fn record_csv() -> PathBuf {
     repo().join("validation/gauge-records/data/2013-05-22_sample2_ss440c.csv")
-}
-
-fn shpb_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(BIN);
-    c.current_dir(dir)
-        .args(args)
-        .env_remove("SHPB_MEMORY_LIMIT");
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run the shpb binary")
-}
-
-fn shpb(dir: &Path, args: &[&str]) -> Output {
-    shpb_env(dir, args, &[])
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 /// Checks a refusal: exit code 2, every needle in stderr, nothing on stdout, no output file.

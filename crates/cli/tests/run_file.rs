@@ -3,26 +3,13 @@
 //! every input read, command line, version) and its set-up, every value carries its unit, and
 //! the file alone reruns the test with identical results.
 
+mod common;
+
+use common::{repo, shpb, stderr};
 use hdf5::types::VarLenUnicode;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use tempfile::TempDir;
-
-fn repo() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-}
-
-fn shpb(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shpb"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
-}
 
 /// A fast full test (`shpb` kind) on the authors' set-up with 12.7 mm bars instead of 19.05 mm.
 fn small_bar_test(dir: &Path) -> PathBuf {
