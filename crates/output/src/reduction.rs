@@ -80,8 +80,8 @@ pub fn reduction_columns(r: &Reduction) -> Vec<(&'static str, &[f64], &'static s
     cols
 }
 
-/// Scalar results: (key, value, unit).
-fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
+/// Scalar results of a reduction, as `/summary` attributes: (key, value, unit).
+pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
     let mut v = vec![
         ("peak_back_force", r.peak_back_force_n, "N"),
         ("peak_back_force_time", r.peak_back_force_time_s, "s"),

@@ -1,9 +1,7 @@
 //! Helpers shared by the subcommands: printing on stdout (a closed pipe is not an error), the
 //! `--bars` set-up, the gun's `--pressure`, and input errors of the command line.
 
-use shpb_core::apparatus::Apparatus;
-use shpb_input::prelude::*;
-use shpb_input::{Error, Result, Validator};
+use shpb_input::{Error, Result};
 use std::io::Write;
 use std::path::Path;
 
@@ -193,8 +191,7 @@ pub fn free_space(dir: &Path) -> Option<u64> {
     Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
 }
 
-/// The built-in set-up `--bars` names when not given.
-pub const DEFAULT_BARS: &str = "authors";
+pub use shpb_study::api::DEFAULT_BARS;
 
 /// An input error (exit code 2) naming the file (or "command line"), the key, the problem and
 /// what is allowed.
@@ -234,48 +231,7 @@ pub fn say(line: &str) -> Result<()> {
     print(&format!("{line}\n"))
 }
 
-/// Names `--bars` and what is allowed when the set-up named on the command line is neither a
-/// built-in set-up ([`shpb_input::builtin::SETUPS`]) nor an existing file.
-pub fn require_bars(bars: &Path) -> Result<()> {
-    let builtin = bars
-        .to_str()
-        .is_some_and(|name| shpb_input::builtin::setup(name).is_some());
-    if !builtin && !bars.is_file() {
-        return Err(input_err(
-            "command line",
-            "--bars",
-            format!(
-                "cannot read {}: not a built-in set-up and no such file",
-                bars.display()
-            ),
-            format!(
-                "a built-in set-up ({}) or a bar set-up .toml file such as bars/authors.toml",
-                shpb_input::builtin::setup_names()
-            ),
-        ));
-    }
-    Ok(())
-}
-
-/// The bar set-up named by `--bars`: a built-in set-up or a set-up file (relative to the current
-/// directory).
-pub fn load_apparatus(bars: &Path) -> Result<Apparatus> {
-    require_bars(bars)?;
-    match bars.to_str() {
-        Some(reference) => Apparatus::resolve(reference, Path::new(".")),
-        None => Apparatus::from_file(bars),
-    }
-}
-
-/// The `--pressure` option read and checked against the set-up's gun: (gauge pressure Pa,
-/// striker velocity m/s).
-pub fn gun_shot(apparatus: &Apparatus, pressure: &str) -> Result<(f64, f64)> {
-    let p = shpb_input::units::cli_pressure(pressure)?;
-    let v = apparatus
-        .striker_velocity_m_s(p)
-        .map_err(Validator::new("command line").core("--pressure"))?;
-    Ok((p, v))
-}
+pub use shpb_study::api::{gun_shot, load_apparatus, require_bars};
 
 /// Writes a study's summary `table` as CSV and its HDF5 (atomically; an existing file is
 /// replaced only with `replace`), the HDF5 stamped with the sweep's `identity`.

@@ -1,18 +1,9 @@
 //! `shpb reduce`: the lab's reduction of a raw record or of a run file.
 
-use super::common::{
-    DEFAULT_BARS, finite, input_err, load_apparatus, report, require_bars, stdout_once, warn, wrote,
-};
-use shpb_core::apparatus::Apparatus;
-use shpb_core::reduce::{PAPER_SPHERE_RADII_M, ReductionOptions, ReductionSetup, reduce_named};
-use shpb_core::scene::{Params, SceneParams};
+use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, warn, wrote};
 use shpb_input::Result;
-use shpb_input::gauges::reduce_record_file;
-use shpb_input::prelude::*;
 use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
-use shpb_output::reduction::{
-    is_hdf5, read_hdf5_strains, write_reduction_csv, write_reduction_hdf5,
-};
+use shpb_output::reduction::{write_reduction_csv, write_reduction_hdf5};
 use std::path::Path;
 
 /// `shpb reduce RECORD --bars SET-UP [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
@@ -41,59 +32,12 @@ pub fn reduce_command(
             check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
         }
     }
-    if !record.is_file() {
-        return Err(input_err(
-            "command line",
-            "RECORD",
-            format!("cannot read {}: no such file", record.display()),
-            "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
-        ));
-    }
     let data_on_stdout = stdout_once(&[output, csv])?;
-    let hdf5_input = is_hdf5(record)?;
-    let run = if hdf5_input { run_setup(record)? } else { None };
-    let (apparatus, radii) = match run {
-        Some((run_apparatus, radii)) => {
-            if let Some(flag) = bars_flag {
-                let given = load_apparatus(flag)?;
-                if ReductionSetup::from_apparatus(&given)?
-                    != ReductionSetup::from_apparatus(&run_apparatus)?
-                {
-                    return Err(input_err(
-                        "command line",
-                        "--bars",
-                        format!(
-                            "{} was simulated with the set-up {} ({}); --bars {} differs ({})",
-                            record.display(),
-                            run_apparatus.source,
-                            describe(&run_apparatus),
-                            flag.display(),
-                            describe(&given)
-                        ),
-                        "no --bars (the run file's own set-up is used), or a set-up with the same bars and gauge distances",
-                    ));
-                }
-            }
-            (run_apparatus, radii)
-        }
-        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
-    };
-    let options = ReductionOptions {
-        dispersion_correction: !no_dispersion,
-        specimen_radii_m: Some(radii),
-        ..ReductionOptions::default()
-    };
-    let r = if hdf5_input {
-        let input = read_hdf5_strains(record)?;
-        reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &record.display().to_string(),
-        )?
-    } else {
-        reduce_record_file(record, &apparatus, &options)?
-    };
+    let shpb_study::api::Reduced {
+        reduction: r,
+        apparatus,
+        hdf5_input,
+    } = shpb_study::api::reduce_record(record, bars_flag, no_dispersion)?;
     let mut scene = format!(
         "shpb reduce {} --bars {}",
         record.display(),
@@ -177,41 +121,4 @@ pub fn reduce_command(
             "warnings": r.warnings,
         })
     })
-}
-
-/// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored
-/// in its `/provenance` (None for a file without a stored bar scene, e.g. `shpb strain`'s).
-fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
-    let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
-        return Ok(None);
-    };
-    if stored.scene_file.is_empty() {
-        return Ok(None);
-    }
-    let params = shpb_input::files::replay(&stored.inputs, || {
-        Params::from_file_with(Path::new(&stored.scene_file), None)
-    })?;
-    Ok(match params.params {
-        SceneParams::Pulse { apparatus, .. } => Some((
-            *apparatus,
-            (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
-        )),
-        _ => None,
-    })
-}
-
-/// The bar diameters and gauge distances of a set-up, for messages.
-fn describe(a: &Apparatus) -> String {
-    let gauge = |n: &str| {
-        a.gauges.channel(n).map_or("none".to_string(), |c| {
-            format!("{} m", c.distance_from_specimen_m)
-        })
-    };
-    format!(
-        "bars {} / {} mm, gauges at {} / {}",
-        a.incident.diameter_m * 1e3,
-        a.transmission.diameter_m * 1e3,
-        gauge("incident"),
-        gauge("transmission")
-    )
 }

@@ -5,9 +5,8 @@ use super::common::{ProgressLine, check_disk, finite, report, stdout_once, warn,
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
-use shpb_input::files::{self, Provenance};
-use shpb_input::prelude::*;
-use shpb_input::{Error, Result};
+use shpb_input::Result;
+use shpb_input::files::Provenance;
 use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
 use shpb_output::writer::{Csv, Hdf5, Png, Writer};
 use std::path::{Path, PathBuf};
@@ -52,9 +51,8 @@ pub fn run(
     }
     check_disk(&[(output, "--output")], params.estimate().output_bytes)?;
     let mut progress = ProgressLine::new(&params.source);
-    let mut out = params.run_with_progress(&mut |f| progress.update(f))?;
+    let out = shpb_study::api::run_scene(&params, &mut |f| progress.update(f))?;
     progress.finish();
-    out.warnings.splice(0..0, params.warnings());
     for w in &out.warnings {
         warn(w);
     }
@@ -82,40 +80,12 @@ pub fn run(
 /// Reads the scene (recording every input it reads), or a run file's stored scene and inputs.
 fn load(scene: &Path, fidelity: Option<Fidelity>) -> Result<(Params, Provenance)> {
     let command_line = std::env::args().collect::<Vec<_>>().join(" ");
-    if scene.is_file() && shpb_output::reduction::is_hdf5(scene)? {
-        let stored = shpb_output::provenance::read_provenance(scene)?;
-        let fidelity = match fidelity {
-            Some(f) => Some(f),
-            None => match stored.fidelity_override.as_deref() {
-                Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
-                    file: scene.display().to_string(),
-                    key: "/provenance fidelity_override".into(),
-                    problem: format!("unknown fidelity `{name}`"),
-                    allowed: "fast, standard, reference".into(),
-                })?),
-                None => None,
-            },
-        };
-        let params = files::replay(&stored.inputs, || {
-            Params::from_file_with(Path::new(&stored.scene_file), fidelity)
-        })?;
-        let provenance = Provenance {
-            fidelity_override: fidelity.map(|f| f.name().to_string()),
-            command_line,
-            ..stored
-        };
-        return Ok((params, provenance));
-    }
-    let (params, inputs) = files::capture(|| Params::from_file_with(scene, fidelity));
-    Ok((
-        params?,
-        Provenance {
-            scene_file: scene.display().to_string(),
-            fidelity_override: fidelity.map(|f| f.name().to_string()),
-            command_line,
-            inputs,
-        },
-    ))
+    shpb_study::api::load_scene(
+        shpb_study::api::Scene::File(scene),
+        fidelity,
+        &[],
+        command_line,
+    )
 }
 
 /// Prints the run summary; a closed pipe (`shpb run … | head`) is not an error.

@@ -1,0 +1,577 @@
+//! `shpb._shpb`: the Python extension module of shpb (PyO3, stable ABI for CPython ≥ 3.9).
+//!
+//! A thin binding of the library calls the `shpb` command line makes (`shpb_study::api`, the
+//! writers of `shpb-output`): no physics here. The pure-Python package `shpb`
+//! (`python/shpb/__init__.py`) wraps these functions into `Run` and `Table` objects with numpy
+//! arrays. Every error is a Python exception with the command line's message: exit-code-2 errors
+//! raise `InputError` (a `ValueError`), an unstable run `InstabilityError` (a `RuntimeError`),
+//! I/O and HDF5 failures `OSError`; a panic is caught and raised as `RuntimeError`.
+
+use numpy::PyArray1;
+use pyo3::create_exception;
+use pyo3::exceptions::{PyKeyError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use shpb_core::contact::LawKind;
+use shpb_core::fidelity::Fidelity;
+use shpb_core::reduce::Reduction;
+use shpb_core::run::RunOutput;
+use shpb_core::scene::Params;
+use shpb_input::Error;
+use shpb_input::files::Provenance;
+use shpb_output::Writer;
+use shpb_output::run_file::{Dataset, RunFile};
+use shpb_study::api::{self, Scene};
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
+
+create_exception!(
+    shpb,
+    InputError,
+    PyValueError,
+    "Bad input (exit code 2 of the `shpb` command): a scene, set-up or record with a missing, \
+     malformed or out-of-range value, a run too large for the machine, or an existing output."
+);
+create_exception!(
+    shpb,
+    InstabilityError,
+    PyRuntimeError,
+    "A run that became numerically unstable (exit code 3 of the `shpb` command)."
+);
+
+/// The Python exception of a shpb error, with the command line's message.
+fn py_err(e: Error) -> PyErr {
+    let message = e.to_string();
+    match &e {
+        Error::Io { source, .. } => match source.raw_os_error() {
+            Some(errno) => PyOSError::new_err((errno, message)),
+            None => PyOSError::new_err(message),
+        },
+        Error::Hdf5 { .. } => PyOSError::new_err(message),
+        Error::Unstable { .. } => InstabilityError::new_err(message),
+        _ => InputError::new_err(message),
+    }
+}
+
+fn input_error(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> PyErr {
+    py_err(Error::Input {
+        file: "python".into(),
+        key: key.into(),
+        problem: problem.into(),
+        allowed: allowed.into(),
+    })
+}
+
+/// Runs `f` without the GIL, catching a panic (raised as `RuntimeError`) and converting a shpb
+/// error into its Python exception.
+fn detached<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> shpb_input::Result<T> + Send,
+) -> PyResult<T> {
+    let result = py.allow_threads(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
+    match result {
+        Ok(r) => r.map_err(py_err),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(PyRuntimeError::new_err(format!(
+                "shpb: internal error (please report it): {what}"
+            )))
+        }
+    }
+}
+
+fn fidelity(name: Option<&str>) -> PyResult<Option<Fidelity>> {
+    name.map(|n| {
+        Fidelity::parse(n).ok_or_else(|| {
+            input_error(
+                "fidelity",
+                format!("unknown preset `{n}`"),
+                "fast, standard, reference",
+            )
+        })
+    })
+    .transpose()
+}
+
+/// A Python value of a scene dict as a TOML value.
+fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(v.extract()?));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.downcast::<PyDict>() {
+        return Ok(toml::Value::Table(to_table(d, key)?));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items = v
+            .try_iter()?
+            .map(|item| to_toml(&item?, key))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(toml::Value::Float(x));
+    }
+    Err(input_error(
+        key,
+        format!(
+            "a value of type {} cannot be written to a scene",
+            v.get_type().name()?
+        ),
+        "str, int, float, bool, dict and list values",
+    ))
+}
+
+fn to_table(d: &Bound<'_, PyDict>, prefix: &str) -> PyResult<toml::Table> {
+    let mut t = toml::Table::new();
+    for (k, v) in d.iter() {
+        let k: String = k
+            .extract()
+            .map_err(|_| input_error(prefix, "a key is not a string", "string keys"))?;
+        let key = if prefix.is_empty() {
+            k.clone()
+        } else {
+            format!("{prefix}.{k}")
+        };
+        t.insert(k, to_toml(&v, &key)?);
+    }
+    Ok(t)
+}
+
+/// The `set=` overrides of one run: a string is read as `shpb sweep --set KEY=VALUE` reads it
+/// (units such as `12psi`, `0.5mm`), a number or bool as it is.
+fn overrides(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, toml::Value)>> {
+    let Some(set) = set else { return Ok(vec![]) };
+    let mut out = Vec::new();
+    for (k, v) in set.iter() {
+        let key: String = k
+            .extract()
+            .map_err(|_| input_error("set", "a key is not a string", "dotted scene keys"))?;
+        if v.is_instance_of::<PyString>() {
+            let text: String = v.extract()?;
+            let axis = shpb_study::sweep::parse_axis(&format!("{key}={text}")).map_err(py_err)?;
+            if axis.values.len() != 1 {
+                return Err(input_error(
+                    &format!("set {key}"),
+                    format!("`{text}` is {} values", axis.values.len()),
+                    "one value per key (shpb.sweep takes several)",
+                ));
+            }
+            out.push((axis.key, axis.values[0].clone()));
+        } else {
+            let key = shpb_study::sweep::parse_axis(&format!("{key}=0"))
+                .map(|a| a.key)
+                .unwrap_or(key);
+            let value = to_toml(&v, &key)?;
+            out.push((key, value));
+        }
+    }
+    Ok(out)
+}
+
+enum Source {
+    /// A run of a scene, as `shpb run` makes it.
+    Simulated {
+        params: Box<Params>,
+        out: Box<RunOutput>,
+        provenance: Provenance,
+    },
+    /// A reduction of `shpb reduce`, with the command line it stands for.
+    Reduced {
+        scene: String,
+        reduction: Box<Reduction>,
+    },
+    /// A run or reduction file read back.
+    Loaded { path: PathBuf, file: Box<RunFile> },
+}
+
+/// The data of one run (a simulation, a reduction or a file read back); `shpb.Run` wraps it.
+#[pyclass(module = "shpb._shpb", name = "RunData", frozen)]
+struct RunData {
+    source: Source,
+}
+
+impl RunData {
+    fn datasets(&self) -> Vec<Dataset<'_>> {
+        let mut v = match &self.source {
+            Source::Simulated { out, .. } => shpb_output::run_file::run_datasets(out),
+            Source::Reduced { reduction, .. } => {
+                shpb_output::run_file::reduction_datasets(reduction)
+            }
+            Source::Loaded { file, .. } => file
+                .datasets
+                .iter()
+                .map(|d| Dataset {
+                    path: d.path.clone(),
+                    shape: d.shape.clone(),
+                    data: Cow::Borrowed(&d.data),
+                    units: Cow::Borrowed(&d.units),
+                })
+                .collect(),
+        };
+        v.sort_by(|a, b| a.path.cmp(&b.path));
+        v
+    }
+}
+
+#[pymethods]
+impl RunData {
+    /// `"run"`, `"reduction"` or `"file"`.
+    #[getter]
+    fn origin(&self) -> &'static str {
+        match self.source {
+            Source::Simulated { .. } => "run",
+            Source::Reduced { .. } => "reduction",
+            Source::Loaded { .. } => "file",
+        }
+    }
+
+    /// The summary: (key, value, units) in the order `shpb run` prints it.
+    fn summary(&self) -> Vec<(String, f64, String)> {
+        match &self.source {
+            Source::Simulated { out, .. } => out
+                .summary
+                .iter()
+                .map(|i| (i.key.clone(), i.value, i.unit.to_string()))
+                .collect(),
+            Source::Reduced { reduction, .. } => shpb_output::reduction::summary_items(reduction)
+                .into_iter()
+                .map(|(k, v, u)| (k.to_string(), v, u.to_string()))
+                .collect(),
+            Source::Loaded { file, .. } => file.summary.clone(),
+        }
+    }
+
+    /// Every numeric dataset: (path, shape, units), in path order.
+    fn dataset_info(&self) -> Vec<(String, Vec<usize>, String)> {
+        self.datasets()
+            .into_iter()
+            .map(|d| (d.path, d.shape, d.units.into_owned()))
+            .collect()
+    }
+
+    /// The values of the dataset `path`, flat (row-major; `dataset_info` gives the shape).
+    fn array<'py>(&self, py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let path = path.trim_start_matches('/');
+        let found = match &self.source {
+            Source::Loaded { file, .. } => file
+                .datasets
+                .iter()
+                .find(|d| d.path == path)
+                .map(|d| PyArray1::from_slice(py, &d.data)),
+            _ => self
+                .datasets()
+                .into_iter()
+                .find(|d| d.path == path)
+                .map(|d| PyArray1::from_slice(py, &d.data)),
+        };
+        found.ok_or_else(|| PyKeyError::new_err(path.to_string()))
+    }
+
+    /// The warnings of the run (one string each).
+    fn warnings(&self) -> Vec<String> {
+        match &self.source {
+            Source::Simulated { out, .. } => out.warnings.clone(),
+            Source::Reduced { reduction, .. } => reduction.warnings.clone(),
+            Source::Loaded { file, .. } => file.warnings.clone(),
+        }
+    }
+
+    /// The scene text (root attribute `scene` of the file).
+    fn scene(&self) -> String {
+        match &self.source {
+            Source::Simulated { params, .. } => params.text.clone(),
+            Source::Reduced { scene, .. } => scene.clone(),
+            Source::Loaded { file, .. } => file.scene.clone(),
+        }
+    }
+
+    /// The provenance, if any: (scene_file, fidelity_override, command_line, [(name, text)]).
+    #[allow(clippy::type_complexity)]
+    fn provenance(&self) -> Option<(String, Option<String>, String, Vec<(String, String)>)> {
+        let p = match &self.source {
+            Source::Simulated { provenance, .. } => provenance,
+            Source::Loaded { file, .. } => file.provenance.as_ref()?,
+            Source::Reduced { .. } => return None,
+        };
+        Some((
+            p.scene_file.clone(),
+            p.fidelity_override.clone(),
+            p.command_line.clone(),
+            p.inputs
+                .iter()
+                .map(|i| (i.name.clone(), i.text.clone()))
+                .collect(),
+        ))
+    }
+
+    /// Writes the file `shpb run -o` (or `shpb reduce -o`) writes; a file read back is copied.
+    #[pyo3(signature = (path, force = false))]
+    fn save(&self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<()> {
+        use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
+        detached(py, || {
+            check_output_flag(&path, force, "path")?;
+            check_extension(&path, "path", &["h5", "hdf5"])?;
+            match &self.source {
+                Source::Simulated {
+                    params,
+                    out,
+                    provenance,
+                } => {
+                    let inputs: Vec<PathBuf> = provenance
+                        .inputs
+                        .iter()
+                        .filter(|f| !f.name.starts_with("built-in:"))
+                        .map(|f| PathBuf::from(&f.name))
+                        .collect();
+                    check_not_input(&path, "path", &inputs)?;
+                    shpb_output::Hdf5 {
+                        provenance: Some(provenance.clone()),
+                    }
+                    .write_run(&path, force, params, out)
+                }
+                Source::Reduced { scene, reduction } => {
+                    shpb_output::reduction::write_reduction_hdf5(&path, force, scene, reduction)
+                }
+                Source::Loaded { path: source, .. } => {
+                    check_not_input(&path, "path", std::slice::from_ref(source))?;
+                    shpb_output::atomic::write_atomically(&path, force, |tmp| {
+                        std::fs::copy(source, tmp)
+                            .map(|_| ())
+                            .map_err(|e| Error::io(source, e))
+                    })
+                }
+            }
+        })
+    }
+}
+
+/// Runs a scene (a scene file, a run file to rerun, or a dict) as `shpb run` does.
+#[pyfunction]
+#[pyo3(signature = (scene, fidelity = None, set = None, command_line = String::new()))]
+fn run(
+    py: Python<'_>,
+    scene: &Bound<'_, PyAny>,
+    fidelity: Option<&str>,
+    set: Option<&Bound<'_, PyDict>>,
+    command_line: String,
+) -> PyResult<RunData> {
+    let fidelity = self::fidelity(fidelity)?;
+    let overrides = overrides(set)?;
+    let (path, text) = match scene.downcast::<PyDict>() {
+        Ok(d) => {
+            let table = to_table(d, "")?;
+            let text = toml::to_string(&table)
+                .map_err(|e| input_error("scene", e.to_string(), "a TOML-like dict"))?;
+            (None, Some(text))
+        }
+        Err(_) => (Some(scene.extract::<PathBuf>()?), None),
+    };
+    let (params, out, provenance) = detached(py, || {
+        let scene = match (&path, &text) {
+            (Some(p), _) => Scene::File(p),
+            (None, Some(t)) => Scene::Text {
+                name: "<dict>",
+                text: t,
+            },
+            (None, None) => unreachable!("a path or a text"),
+        };
+        let (params, provenance) = api::load_scene(scene, fidelity, &overrides, command_line)?;
+        let out = api::run_scene(&params, &mut |_| {})?;
+        Ok((params, out, provenance))
+    })?;
+    Ok(RunData {
+        source: Source::Simulated {
+            params: Box::new(params),
+            out: Box::new(out),
+            provenance,
+        },
+    })
+}
+
+/// Reads a run file (`shpb run -o`, `Run.save`) or reduction file (`shpb reduce -o`).
+#[pyfunction]
+fn load(py: Python<'_>, path: PathBuf) -> PyResult<RunData> {
+    let file = detached(py, || {
+        if !path.is_file() || !shpb_output::reduction::is_hdf5(&path)? {
+            return Err(Error::Input {
+                file: path.display().to_string(),
+                key: "path".into(),
+                problem: "not an HDF5 file".into(),
+                allowed: "a run file written by `shpb run -o` or `Run.save`, or a reduction file \
+                          of `shpb reduce -o`"
+                    .into(),
+            });
+        }
+        shpb_output::run_file::read_run_file(&path)
+    })?;
+    Ok(RunData {
+        source: Source::Loaded {
+            path,
+            file: Box::new(file),
+        },
+    })
+}
+
+/// The striker velocity (m/s) the set-up's gas gun gives at `pressure` (`shpb gun`).
+#[pyfunction]
+#[pyo3(signature = (pressure, bars = api::DEFAULT_BARS.into()))]
+fn gun(py: Python<'_>, pressure: String, bars: PathBuf) -> PyResult<f64> {
+    detached(py, || {
+        let apparatus = api::load_apparatus(&bars)?;
+        Ok(api::gun_shot(&apparatus, &pressure)?.1)
+    })
+}
+
+/// Two numpy arrays.
+type ArrayPair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// The loading curve F(δ) of a specimen (`shpb curve`): (displacement m, force N).
+#[pyfunction]
+#[pyo3(signature = (pair = "ss440c".into(), rate = 0.0, to = 250e-6, points = 101, law = "burgoyne-daraio".into()))]
+fn curve<'py>(
+    py: Python<'py>,
+    pair: String,
+    rate: f64,
+    to: f64,
+    points: i64,
+    law: String,
+) -> PyResult<ArrayPair<'py>> {
+    let Some(&(_, law)) = LawKind::ALL.iter().find(|(n, _)| *n == law) else {
+        return Err(input_error(
+            "law",
+            format!("unknown contact law `{law}`"),
+            LawKind::ALL
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", "),
+        ));
+    };
+    let s = detached(py, || api::loading_curve(&pair, rate, to, points, law))?;
+    Ok((
+        PyArray1::from_vec(py, s.displacement_m),
+        PyArray1::from_vec(py, s.force_n),
+    ))
+}
+
+/// The lab's reduction of a raw record or run file (`shpb reduce`).
+#[pyfunction]
+#[pyo3(signature = (record, bars = None, dispersion = true))]
+fn reduce(
+    py: Python<'_>,
+    record: PathBuf,
+    bars: Option<PathBuf>,
+    dispersion: bool,
+) -> PyResult<RunData> {
+    let (reduced, scene) = detached(py, || {
+        let r = api::reduce_record(&record, bars.as_deref(), !dispersion)?;
+        let mut scene = format!(
+            "shpb reduce {} --bars {}",
+            record.display(),
+            bars.as_deref()
+                .map_or(r.apparatus.source.clone(), |b| b.display().to_string())
+        );
+        if !dispersion {
+            scene.push_str(" --no-dispersion");
+        }
+        Ok((r, scene))
+    })?;
+    Ok(RunData {
+        source: Source::Reduced {
+            scene,
+            reduction: Box::new(reduced.reduction),
+        },
+    })
+}
+
+/// A sweep's table: the swept keys, each row's values as written, the SI value and units of each
+/// input column (None when not numeric), and the summary columns (name, units, values).
+type SweepTable = (
+    Vec<String>,
+    Vec<Vec<String>>,
+    Vec<Option<(String, Vec<f64>)>>,
+    Vec<(String, String, Vec<f64>)>,
+);
+
+/// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
+/// (`shpb sweep`, without checkpoint or files).
+#[pyfunction]
+#[pyo3(signature = (scene, set, jobs = 1))]
+fn sweep(py: Python<'_>, scene: PathBuf, set: Vec<String>, jobs: usize) -> PyResult<SweepTable> {
+    let (axes, rows) = detached(py, || api::sweep_rows(&scene, &set, jobs))?;
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    let labels: Vec<Vec<String>> = rows.iter().map(|r| r.inputs.clone()).collect();
+    let inputs = keys
+        .iter()
+        .enumerate()
+        .map(|(i, k)| {
+            let values: Option<Vec<(f64, &str)>> = rows
+                .iter()
+                .map(|r| shpb_study::sweep::input_si(k, &r.inputs[i]))
+                .collect();
+            let values = values?;
+            let unit = values.first().map_or("1", |v| v.1);
+            values
+                .iter()
+                .all(|v| v.1 == unit)
+                .then(|| (unit.to_string(), values.iter().map(|v| v.0).collect()))
+        })
+        .collect();
+    let columns = shpb_study::sweep::SUMMARY_COLUMNS
+        .iter()
+        .enumerate()
+        .map(|(j, (name, unit))| {
+            (
+                name.to_string(),
+                unit.to_string(),
+                rows.iter().map(|r| r.values()[j]).collect(),
+            )
+        })
+        .collect();
+    Ok((keys, labels, inputs, columns))
+}
+
+/// The version of shpb this module was built from.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// Whether a path names a run file that `shpb.run` would rerun (an HDF5 file).
+#[pyfunction]
+fn is_hdf5(path: PathBuf) -> bool {
+    path.is_file() && shpb_output::reduction::is_hdf5(Path::new(&path)).unwrap_or(false)
+}
+
+#[pymodule]
+fn _shpb(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("InputError", m.py().get_type::<InputError>())?;
+    m.add("InstabilityError", m.py().get_type::<InstabilityError>())?;
+    m.add_class::<RunData>()?;
+    for f in [
+        wrap_pyfunction!(run, m)?,
+        wrap_pyfunction!(load, m)?,
+        wrap_pyfunction!(gun, m)?,
+        wrap_pyfunction!(curve, m)?,
+        wrap_pyfunction!(reduce, m)?,
+        wrap_pyfunction!(sweep, m)?,
+        wrap_pyfunction!(version, m)?,
+        wrap_pyfunction!(is_hdf5, m)?,
+    ] {
+        m.add_function(f)?;
+    }
+    Ok(())
+}

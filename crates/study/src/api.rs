@@ -1,0 +1,366 @@
+//! The commands of `shpb` as library calls, without printing and without output-path checks:
+//! what the command line (`crates/cli/src/cmd/*.rs`) and the Python package (`crates/python`)
+//! share, so that both load, run, reduce and sweep a scene through the same code.
+
+use crate::sweep::{Axis, RunSummary};
+use shpb_core::apparatus::Apparatus;
+use shpb_core::contact::LawKind;
+use shpb_core::fidelity::Fidelity;
+use shpb_core::reduce::{PAPER_SPHERE_RADII_M, Reduction, ReductionOptions, ReductionSetup};
+use shpb_core::run::RunOutput;
+use shpb_core::scene::{Params, SceneParams};
+use shpb_core::solver::ContactSeries;
+use shpb_input::files::{self, InputFile, Provenance};
+use shpb_input::prelude::*;
+use shpb_input::scene::Value;
+use shpb_input::{Error, Result, Validator};
+use std::path::Path;
+
+/// The built-in set-up `--bars` names when not given.
+pub const DEFAULT_BARS: &str = "authors";
+
+fn input_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
+    Error::Input {
+        file: "command line".to_string(),
+        key: key.to_string(),
+        problem: problem.into(),
+        allowed: allowed.into(),
+    }
+}
+
+/// Names `--bars` and what is allowed when the set-up named on the command line is neither a
+/// built-in set-up ([`shpb_input::builtin::SETUPS`]) nor an existing file.
+pub fn require_bars(bars: &Path) -> Result<()> {
+    let builtin = bars
+        .to_str()
+        .is_some_and(|name| shpb_input::builtin::setup(name).is_some());
+    if !builtin && !bars.is_file() {
+        return Err(input_err(
+            "--bars",
+            format!(
+                "cannot read {}: not a built-in set-up and no such file",
+                bars.display()
+            ),
+            format!(
+                "a built-in set-up ({}) or a bar set-up .toml file such as bars/authors.toml",
+                shpb_input::builtin::setup_names()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The bar set-up named by `--bars`: a built-in set-up or a set-up file (relative to the current
+/// directory).
+pub fn load_apparatus(bars: &Path) -> Result<Apparatus> {
+    require_bars(bars)?;
+    match bars.to_str() {
+        Some(reference) => Apparatus::resolve(reference, Path::new(".")),
+        None => Apparatus::from_file(bars),
+    }
+}
+
+/// The `--pressure` option read and checked against the set-up's gun: (gauge pressure Pa,
+/// striker velocity m/s).
+pub fn gun_shot(apparatus: &Apparatus, pressure: &str) -> Result<(f64, f64)> {
+    let p = shpb_input::units::cli_pressure(pressure)?;
+    let v = apparatus
+        .striker_velocity_m_s(p)
+        .map_err(Validator::new("command line").core("--pressure"))?;
+    Ok((p, v))
+}
+
+/// `shpb curve`: the loading curve F(δ) of a specimen (`--specimen`, `--rate`, `--to`,
+/// `--points`, `--law`), checked as the command line checks it.
+pub fn loading_curve(
+    specimen: &str,
+    rate: f64,
+    to: f64,
+    points: i64,
+    law: LawKind,
+) -> Result<ContactSeries> {
+    let v = Validator::new("command line");
+    let pair = shpb_input::specimen::resolve_pair(specimen, Path::new("."), &v, "--specimen")?;
+    v.in_range("--rate", rate, 0.0, 1e9, "1/s")?;
+    v.positive(
+        "--to",
+        to,
+        0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+        "m",
+    )?;
+    if !(2..=10_000_000).contains(&points) {
+        return Err(v.error(
+            "--points",
+            format!("{points} is out of range"),
+            "2 to 10000000",
+        ));
+    }
+    let law = law.build(pair.contact_properties());
+    Ok(shpb_core::solver::loading_curve(
+        law.as_ref(),
+        to,
+        points as usize,
+        rate,
+    ))
+}
+
+/// Where a scene comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum Scene<'a> {
+    /// A scene file, or a run file (`.h5` written by `shpb run -o`) whose stored scene and
+    /// inputs are run again.
+    File(&'a Path),
+    /// Scene TOML text named `name` (e.g. a scene given as a Python dict); relative paths in it
+    /// are resolved against the working directory.
+    Text {
+        /// The scene's name in messages and in the provenance.
+        name: &'a str,
+        /// The TOML text.
+        text: &'a str,
+    },
+}
+
+/// Reads a scene (recording every input it reads for the run file's `/provenance`), or a run
+/// file's stored scene and inputs, with `overrides` (dotted keys, as `shpb sweep --set`) and the
+/// `fidelity` preset applied. When `overrides` are given, the provenance stores the overridden
+/// scene text, so that the run file reruns the test that was run.
+pub fn load_scene(
+    scene: Scene,
+    fidelity: Option<Fidelity>,
+    overrides: &[(String, Value)],
+    command_line: String,
+) -> Result<(Params, Provenance)> {
+    let mut all = overrides.to_vec();
+    if let Some(f) = fidelity {
+        all.push(("fidelity".to_string(), Value::String(f.name().into())));
+    }
+    let stored_scene = |params: &Params, name: &str, inputs: &mut Vec<InputFile>| {
+        if !overrides.is_empty()
+            && let Some(f) = inputs.iter_mut().find(|f| f.name == name)
+        {
+            f.text = params.text.clone();
+        }
+    };
+    match scene {
+        Scene::File(scene) if scene.is_file() && shpb_output::reduction::is_hdf5(scene)? => {
+            let stored = shpb_output::provenance::read_provenance(scene)?;
+            let fidelity = match fidelity {
+                Some(f) => Some(f),
+                None => match stored.fidelity_override.as_deref() {
+                    Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
+                        file: scene.display().to_string(),
+                        key: "/provenance fidelity_override".into(),
+                        problem: format!("unknown fidelity `{name}`"),
+                        allowed: "fast, standard, reference".into(),
+                    })?),
+                    None => None,
+                },
+            };
+            let mut all = overrides.to_vec();
+            if let Some(f) = fidelity {
+                all.push(("fidelity".to_string(), Value::String(f.name().into())));
+            }
+            let params = files::replay(&stored.inputs, || {
+                Params::from_file_overridden(Path::new(&stored.scene_file), &all)
+            })?;
+            let mut provenance = Provenance {
+                fidelity_override: fidelity.map(|f| f.name().to_string()),
+                command_line,
+                ..stored
+            };
+            let name = provenance.scene_file.clone();
+            stored_scene(&params, &name, &mut provenance.inputs);
+            Ok((params, provenance))
+        }
+        Scene::File(scene) => {
+            let (params, mut inputs) = files::capture(|| Params::from_file_overridden(scene, &all));
+            let params = params?;
+            let name = scene.display().to_string();
+            stored_scene(&params, &name, &mut inputs);
+            Ok((
+                params,
+                Provenance {
+                    scene_file: name,
+                    fidelity_override: fidelity.map(|f| f.name().to_string()),
+                    command_line,
+                    inputs,
+                },
+            ))
+        }
+        Scene::Text { name, text } => {
+            let (params, mut inputs) = files::capture(|| {
+                let text = if all.is_empty() {
+                    text.to_string()
+                } else {
+                    shpb_input::scene::with_overrides(text, name, &all)?
+                };
+                // The base of a scene file named without directory, as a rerun resolves it.
+                Params::from_toml(&text, name, Path::new(""))
+            });
+            let params = params?;
+            inputs.retain(|f| f.name != name);
+            inputs.insert(
+                0,
+                InputFile {
+                    name: name.to_string(),
+                    text: params.text.clone(),
+                },
+            );
+            Ok((
+                params,
+                Provenance {
+                    scene_file: name.to_string(),
+                    fidelity_override: fidelity.map(|f| f.name().to_string()),
+                    command_line,
+                    inputs,
+                },
+            ))
+        }
+    }
+}
+
+/// Runs a loaded scene as `shpb run` does (`progress` gets the fraction done): the output's
+/// warnings start with the scene's own ([`Params::warnings`]).
+pub fn run_scene(params: &Params, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
+    let mut out = params.run_with_progress(progress)?;
+    out.warnings.splice(0..0, params.warnings());
+    Ok(out)
+}
+
+/// A reduction of `shpb reduce` with what it was made from.
+#[derive(Debug, Clone)]
+pub struct Reduced {
+    /// The lab's reduction.
+    pub reduction: Reduction,
+    /// The set-up whose bars and gauges reduced the record.
+    pub apparatus: Apparatus,
+    /// Whether the record was a run file's gauge strains (else raw gauge voltages).
+    pub hdf5_input: bool,
+}
+
+/// `shpb reduce`: reduces a raw record (the authors' CSV) or a run file of `shpb run`
+/// (recognised by its signature, reduced with its own set-up and spheres) with the set-up
+/// `bars_flag` (default [`DEFAULT_BARS`]; for a run file, a set-up that differs from the run's
+/// is refused).
+pub fn reduce_record(
+    record: &Path,
+    bars_flag: Option<&Path>,
+    no_dispersion: bool,
+) -> Result<Reduced> {
+    let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
+    require_bars(bars)?;
+    if !record.is_file() {
+        return Err(input_err(
+            "RECORD",
+            format!("cannot read {}: no such file", record.display()),
+            "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
+        ));
+    }
+    let hdf5_input = shpb_output::reduction::is_hdf5(record)?;
+    let run = if hdf5_input { run_setup(record)? } else { None };
+    let (apparatus, radii) = match run {
+        Some((run_apparatus, radii)) => {
+            if let Some(flag) = bars_flag {
+                let given = load_apparatus(flag)?;
+                if ReductionSetup::from_apparatus(&given)?
+                    != ReductionSetup::from_apparatus(&run_apparatus)?
+                {
+                    return Err(input_err(
+                        "--bars",
+                        format!(
+                            "{} was simulated with the set-up {} ({}); --bars {} differs ({})",
+                            record.display(),
+                            run_apparatus.source,
+                            describe(&run_apparatus),
+                            flag.display(),
+                            describe(&given)
+                        ),
+                        "no --bars (the run file's own set-up is used), or a set-up with the same bars and gauge distances",
+                    ));
+                }
+            }
+            (run_apparatus, radii)
+        }
+        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
+    };
+    let options = ReductionOptions {
+        dispersion_correction: !no_dispersion,
+        specimen_radii_m: Some(radii),
+        ..ReductionOptions::default()
+    };
+    let reduction = if hdf5_input {
+        let input = shpb_output::reduction::read_hdf5_strains(record)?;
+        shpb_core::reduce::reduce_named(
+            &input,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &options,
+            &record.display().to_string(),
+        )?
+    } else {
+        shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
+    };
+    Ok(Reduced {
+        reduction,
+        apparatus,
+        hdf5_input,
+    })
+}
+
+/// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored
+/// in its `/provenance` (None for a file without a stored bar scene, e.g. `shpb strain`'s).
+fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
+    let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
+        return Ok(None);
+    };
+    if stored.scene_file.is_empty() {
+        return Ok(None);
+    }
+    let params = files::replay(&stored.inputs, || {
+        Params::from_file_with(Path::new(&stored.scene_file), None)
+    })?;
+    Ok(match params.params {
+        SceneParams::Pulse { apparatus, .. } => Some((
+            *apparatus,
+            (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
+        )),
+        _ => None,
+    })
+}
+
+/// The bar diameters and gauge distances of a set-up, for messages.
+fn describe(a: &Apparatus) -> String {
+    let gauge = |n: &str| {
+        a.gauges.channel(n).map_or("none".to_string(), |c| {
+            format!("{} m", c.distance_from_specimen_m)
+        })
+    };
+    format!(
+        "bars {} / {} mm, gauges at {} / {}",
+        a.incident.diameter_m * 1e3,
+        a.transmission.diameter_m * 1e3,
+        gauge("incident"),
+        gauge("transmission")
+    )
+}
+
+/// A whole sweep of `scene` over the `--set` specifications `set`, on `jobs` threads, without
+/// checkpoint or outputs: every point is validated first, then run; the rows come back in point
+/// order.
+pub fn sweep_rows(
+    scene: &Path,
+    set: &[String],
+    jobs: usize,
+) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
+    if !scene.is_file() {
+        return Err(input_err(
+            "SCENE",
+            format!("cannot read {}: no such file", scene.display()),
+            "a scene .toml file",
+        ));
+    }
+    let axes = crate::sweep::parse_axes(set)?;
+    let points = crate::sweep::product(&axes);
+    crate::sweep::check_points(scene, &axes, &points)?;
+    let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;
+    Ok((axes, rows))
+}

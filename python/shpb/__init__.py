@@ -1,0 +1,324 @@
+"""shpb: a split Hopkinson pressure bar simulator, from Python.
+
+The same Rust core as the ``shpb`` command line (``shpb._shpb``); no physics is written in Python.
+Every quantity is a float in SI units, every series a numpy float64 array::
+
+    import shpb
+    r = shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast", set={"pressure": "12psi"})
+    r.summary["peak_contact_force"]      # N
+    r.units["contact/force"]             # "N"
+    r["contact/force"]                   # numpy array
+    r.save("out.h5")                     # the file `shpb run -o out.h5` writes
+
+Errors carry the command line's message: :class:`InputError` (a ``ValueError``) for bad input
+(exit code 2 of ``shpb``), :class:`InstabilityError` (a ``RuntimeError``) for an unstable run
+(exit code 3), ``OSError`` for I/O failures.
+"""
+
+from __future__ import annotations
+
+import html
+import os
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _shpb
+from ._shpb import InputError, InstabilityError
+
+__all__ = [
+    "InputError",
+    "InstabilityError",
+    "Run",
+    "Table",
+    "run",
+    "load",
+    "gun",
+    "curve",
+    "reduce",
+    "sweep",
+    "__version__",
+]
+
+__version__: str = _shpb.version()
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class Run:
+    """One run: a simulated test (:func:`run`), a reduction (:func:`reduce`) or a file read back
+    (:func:`load`).
+
+    ``run[path]`` is the dataset ``path`` of the run file (``"contact/force"``, ``"time"``,
+    ``"gauges/incident/strain"``, ``"reduction/force_back"``, ``"summary/peak_contact_force"``)
+    as a numpy float64 array; :meth:`keys` lists them all, :attr:`units` gives their units.
+    """
+
+    def __init__(self, data: "_shpb.RunData") -> None:
+        self._data = data
+        self._info = {p: (tuple(shape), unit) for p, shape, unit in data.dataset_info()}
+        items = data.summary()
+        self.summary: Dict[str, float] = {k: v for k, v, _ in items}
+        """Scalar results (key → value in SI units), in the order ``shpb run`` prints them."""
+        units = {p: u for p, (_, u) in self._info.items()}
+        units.update({k: u for k, _, u in items})
+        self.units: Dict[str, str] = units
+        """Units of every dataset path and summary key."""
+
+    @property
+    def origin(self) -> str:
+        """``"run"`` (simulated here), ``"reduction"`` or ``"file"`` (read back)."""
+        return self._data.origin
+
+    @property
+    def warnings(self) -> List[str]:
+        """What the user should know about the run (range of validity, reduction windows)."""
+        return self._data.warnings()
+
+    @property
+    def scene(self) -> str:
+        """The scene TOML text the run was made from (a reduction: its command line)."""
+        return self._data.scene()
+
+    @property
+    def provenance(self) -> Optional[Dict[str, Any]]:
+        """What the run read (``/provenance``): scene file, fidelity override, command line and
+        the text of every input; ``None`` for a reduction."""
+        p = self._data.provenance()
+        if p is None:
+            return None
+        scene_file, fidelity, command_line, inputs = p
+        return {
+            "scene_file": scene_file,
+            "fidelity_override": fidelity,
+            "command_line": command_line,
+            "inputs": dict(inputs),
+        }
+
+    def keys(self) -> List[str]:
+        """Every numeric dataset path of the run file, sorted."""
+        return list(self._info)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._info)
+
+    def __contains__(self, path: object) -> bool:
+        return isinstance(path, str) and path.lstrip("/") in self._info
+
+    def __len__(self) -> int:
+        return len(self._info)
+
+    def __getitem__(self, path: str) -> np.ndarray:
+        """The dataset ``path`` as a new numpy float64 array (0-d for a summary value)."""
+        key = path.lstrip("/")
+        if key not in self._info:
+            raise KeyError(path)
+        shape, _ = self._info[key]
+        return self._data.array(key).reshape(shape)
+
+    def save(self, path: PathLike, force: bool = False) -> None:
+        """Writes the run file ``shpb run -o PATH`` writes (with ``/provenance``), or for a
+        reduction the file of ``shpb reduce -o PATH``; a run read by :func:`load` is copied.
+        An existing file is refused unless ``force``."""
+        self._data.save(os.fspath(path), force)
+
+    def plot(self, path: Optional[PathLike] = None):
+        """The figure of ``shpb run --plot``, drawn with matplotlib: force–displacement, and for
+        bar tests the gauge signals and the reduced forces. Returns the matplotlib figure."""
+        try:
+            import matplotlib.pyplot as plt
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("Run.plot needs matplotlib: pip install matplotlib") from e
+        panels = []
+        if "contact/force" in self:
+            panels.append("contact")
+        if "time" in self and any(k.startswith("gauges/") for k in self):
+            panels.append("gauges")
+        if "reduction/force_back" in self:
+            panels.append("reduction")
+        fig, axes = plt.subplots(1, max(1, len(panels)), figsize=(5 * max(1, len(panels)), 4))
+        axes = np.atleast_1d(axes)
+        for ax, panel in zip(axes, panels):
+            if panel == "contact":
+                ax.plot(self["contact/displacement"] * 1e6, self["contact/force"] * 1e-3)
+                ax.set_xlabel("approach δ (µm)")
+                ax.set_ylabel("contact force (kN)")
+            elif panel == "gauges":
+                t = self["time"] * 1e6
+                for k in self:
+                    if k.startswith("gauges/") and k.endswith("/strain"):
+                        ax.plot(t, self[k], label=k.split("/")[1])
+                ax.set_xlabel("time (µs)")
+                ax.set_ylabel("strain")
+                ax.legend()
+            else:
+                t = self["reduction/time"] * 1e6
+                ax.plot(t, self["reduction/force_front"] * 1e-3, label="front")
+                ax.plot(t, self["reduction/force_back"] * 1e-3, label="back")
+                ax.set_xlabel("time (µs)")
+                ax.set_ylabel("reduced force (kN)")
+                ax.legend()
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(os.fspath(path))
+        return fig
+
+    def _repr_html_(self) -> str:
+        rows = "".join(
+            f"<tr><td>{html.escape(k)}</td><td style='text-align:right'>{v:.6g}</td>"
+            f"<td>{html.escape(self.units.get(k, ''))}</td></tr>"
+            for k, v in self.summary.items()
+        )
+        warnings = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        return (
+            f"<b>shpb.Run</b> ({html.escape(self.origin)}, {len(self)} datasets)"
+            f"<table><tr><th>quantity</th><th>value</th><th>units</th></tr>{rows}</table>"
+            + (f"<ul>{warnings}</ul>" if warnings else "")
+        )
+
+    def __repr__(self) -> str:
+        return f"<shpb.Run {self.origin}: {len(self.summary)} summary values, {len(self)} datasets>"
+
+
+class Table:
+    """The summary table of a sweep: ``table[name]`` is a numpy array with one value per run
+    (``peak_force``, ``displacement_at_peak``, ``peak_strain_rate``,
+    ``equilibrium_ratio_at_peak``, ``time_to_equilibrium``); :attr:`inputs` holds each swept key's
+    values in SI units (or as written, for names), :attr:`labels` the values as written."""
+
+    def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
+        keys, labels, inputs, columns = raw
+        self.keys_swept: List[str] = list(keys)
+        self.labels: Dict[str, List[str]] = {
+            k: [row[i] for row in labels] for i, k in enumerate(keys)
+        }
+        self.inputs: Dict[str, np.ndarray] = {}
+        self.units: Dict[str, str] = {}
+        for k, col in zip(keys, inputs):
+            if col is None:
+                self.inputs[k] = np.array(self.labels[k], dtype=object)
+            else:
+                unit, values = col
+                self.inputs[k] = np.asarray(values, dtype=np.float64)
+                self.units[k] = unit
+        self.columns: Dict[str, np.ndarray] = {}
+        for name, unit, values in columns:
+            self.columns[name] = np.asarray(values, dtype=np.float64)
+            self.units[name] = unit
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name in self.columns:
+            return self.columns[name]
+        return self.inputs[name]
+
+    def keys(self) -> List[str]:
+        """The summary columns."""
+        return list(self.columns)
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values()))) if self.columns else 0
+
+    def _repr_html_(self) -> str:
+        head = "".join(
+            f"<th>{html.escape(k)} ({html.escape(self.units.get(k, ''))})</th>"
+            for k in [*self.keys_swept, *self.columns]
+        )
+        body = ""
+        for i in range(len(self)):
+            cells = [html.escape(self.labels[k][i]) for k in self.keys_swept]
+            cells += [f"{self.columns[c][i]:.6g}" for c in self.columns]
+            body += "<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>"
+        return f"<table><tr>{head}</tr>{body}</table>"
+
+    def __repr__(self) -> str:
+        return f"<shpb.Table: {len(self)} runs over {', '.join(self.keys_swept)}>"
+
+
+def _call(name: str, *args: Any, **kwargs: Any) -> str:
+    parts = [repr(a) for a in args] + [f"{k}={v!r}" for k, v in kwargs.items() if v is not None]
+    return f"python: shpb.{name}({', '.join(parts)})"
+
+
+def run(
+    scene: Union[PathLike, Mapping[str, Any]],
+    fidelity: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+) -> Run:
+    """Runs a virtual test as ``shpb run`` does and returns its :class:`Run`.
+
+    ``scene``: a scene ``.toml`` file, a run file (``.h5``) to run again from its stored inputs,
+    or a dict with the keys of a scene file (relative paths in it are relative to the working
+    directory). ``fidelity``: ``"fast"``, ``"standard"`` or ``"reference"`` (wins over the
+    scene's). ``set``: scene keys to replace, e.g. ``{"pressure": "12psi"}`` (a string is read
+    with its units as ``shpb sweep --set`` reads it; dotted keys reach into tables).
+    The GIL is released while the test runs.
+    """
+    if not isinstance(scene, Mapping):
+        scene = os.fspath(scene)
+    else:
+        scene = dict(scene)
+    line = _call("run", scene if isinstance(scene, str) else "<dict>", fidelity=fidelity, set=set)
+    return Run(_shpb.run(scene, fidelity, dict(set) if set else None, line))
+
+
+def load(path: PathLike) -> Run:
+    """Reads a run file written by ``shpb run -o`` or :meth:`Run.save` (or a reduction file of
+    ``shpb reduce -o``)."""
+    return Run(_shpb.load(os.fspath(path)))
+
+
+def gun(pressure: Union[str, float], bars: PathLike = "authors") -> float:
+    """The striker velocity (m/s) the gas gun of the set-up ``bars`` (a built-in set-up or a
+    set-up file) gives at ``pressure`` (text with units, e.g. ``"10psi"``, or a float in Pa)."""
+    if not isinstance(pressure, str):
+        pressure = f"{float(pressure)!r}Pa"
+    return _shpb.gun(pressure, os.fspath(bars))
+
+
+def curve(
+    pair: str = "ss440c",
+    rate: float = 0.0,
+    to: float = 250e-6,
+    points: int = 101,
+    law: str = "burgoyne-daraio",
+) -> Tuple[np.ndarray, np.ndarray]:
+    """The loading curve F(δ) of a specimen (``shpb curve``): ``(displacement_m, force_N)`` on
+    ``points`` approaches from 0 to ``to`` (m) at the global strain rate ``rate`` (1/s)."""
+    return _shpb.curve(pair, float(rate), float(to), int(points), law)
+
+
+def reduce(record: PathLike, bars: Optional[PathLike] = None, dispersion: bool = True) -> Run:
+    """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
+    transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
+    ``bars``: the set-up (default: the run file's own, else ``"authors"``)."""
+    return Run(
+        _shpb.reduce(os.fspath(record), None if bars is None else os.fspath(bars), dispersion)
+    )
+
+
+def _label(v: Any) -> str:
+    if isinstance(v, str):
+        return v
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return repr(float(v))
+
+
+def sweep(
+    scene: PathLike, set: Mapping[str, Union[Sequence[Any], str]], jobs: int = 1
+) -> Table:
+    """Runs ``scene`` over the Cartesian product of the values in ``set`` (``shpb sweep``),
+    on ``jobs`` threads (the GIL is released), and returns the summary :class:`Table`.
+
+    ``set``: scene key → list of values (``{"pressure": ["8psi", "10psi"]}``), or the text of
+    ``shpb sweep --set`` (``{"pressure": "5psi:20psi:16"}``).
+    """
+    specs = []
+    for key, values in set.items():
+        if isinstance(values, str):
+            specs.append(f"{key}={values}")
+        else:
+            specs.append(f"{key}={','.join(_label(v) for v in values)}")
+    return Table(_shpb.sweep(os.fspath(scene), specs, int(jobs)))

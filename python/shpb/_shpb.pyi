@@ -1,0 +1,54 @@
+"""Type stubs of the extension module shpb._shpb (the Rust binding; use the package `shpb`)."""
+
+from typing import List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+class InputError(ValueError):
+    """Bad input (exit code 2 of `shpb`)."""
+
+class InstabilityError(RuntimeError):
+    """A numerically unstable run (exit code 3 of `shpb`)."""
+
+class RunData:
+    """The data of one run; `shpb.Run` wraps it."""
+
+    @property
+    def origin(self) -> str: ...
+    def summary(self) -> List[Tuple[str, float, str]]: ...
+    def dataset_info(self) -> List[Tuple[str, List[int], str]]: ...
+    def array(self, path: str) -> npt.NDArray[np.float64]: ...
+    def warnings(self) -> List[str]: ...
+    def scene(self) -> str: ...
+    def provenance(
+        self,
+    ) -> Optional[Tuple[str, Optional[str], str, List[Tuple[str, str]]]]: ...
+    def save(self, path: str, force: bool = False) -> None: ...
+
+def run(
+    scene: Union[str, dict],
+    fidelity: Optional[str] = None,
+    set: Optional[dict] = None,
+    command_line: str = "",
+) -> RunData: ...
+def load(path: str) -> RunData: ...
+def gun(pressure: str, bars: str = "authors") -> float: ...
+def curve(
+    pair: str = "ss440c",
+    rate: float = 0.0,
+    to: float = 250e-6,
+    points: int = 101,
+    law: str = "burgoyne-daraio",
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def reduce(record: str, bars: Optional[str] = None, dispersion: bool = True) -> RunData: ...
+def sweep(
+    scene: str, set: Sequence[str], jobs: int = 1
+) -> Tuple[
+    List[str],
+    List[List[str]],
+    List[Optional[Tuple[str, List[float]]]],
+    List[Tuple[str, str, List[float]]],
+]: ...
+def version() -> str: ...
+def is_hdf5(path: str) -> bool: ...

@@ -1,0 +1,292 @@
+"""The Python package against the `shpb` binary: same numbers bit for bit, same files, same
+errors (with the command line's message)."""
+
+import pathlib
+
+import h5py
+import numpy as np
+import pytest
+
+import shpb
+
+from conftest import ROOT
+
+SCENES = sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "scenes").glob("*.toml"))
+RECORD = "validation/gauge-records/data/2013-05-22_sample3_ss440c.csv"
+
+
+def h5_datasets(path):
+    """Every float dataset of an HDF5 file: path -> (array, units)."""
+    out = {}
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset) and obj.dtype == np.float64:
+            units = obj.attrs.get("units", "")
+            out[name] = (obj[()], units.decode() if isinstance(units, bytes) else units)
+
+    with h5py.File(path, "r") as f:
+        f.visititems(visit)
+    return out
+
+
+def h5_summary(path):
+    with h5py.File(path, "r") as f:
+        s = f["summary"]
+        return {k: float(v) for k, v in s.attrs.items() if k not in ("units", "warnings")}
+
+
+def same(a, b):
+    """Bit-for-bit equality of two float arrays (NaN included)."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def assert_runs_equal(r1, r2):
+    assert r1.keys() == r2.keys()
+    for k in r1.keys():
+        assert same(r1[k], r2[k]), k
+        assert r1.units[k] == r2.units[k], k
+    assert r1.summary.keys() == r2.summary.keys()
+    for k in r1.summary:
+        assert same(r1.summary[k], r2.summary[k]), k
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_each_scene_equals_the_binary_bit_for_bit(scene, cli, tmp_path):
+    out = tmp_path / "cli.h5"
+    cli("run", scene, "--fidelity", "fast", "-o", out)
+    r = shpb.run(scene, fidelity="fast")
+    file = h5_datasets(out)
+    assert r.keys() == sorted(file)
+    for k, (data, units) in file.items():
+        assert same(r[k], data), k
+        assert r.units[k] == units, k
+    summary = h5_summary(out)
+    assert set(r.summary) == set(summary)
+    for k, v in summary.items():
+        assert same(r.summary[k], v), k
+    # The file read back is the same run.
+    assert_runs_equal(shpb.load(out), r)
+
+
+def test_save_writes_the_file_of_shpb_run(cli, tmp_path):
+    scene = "scenes/shpb-ss440c-10psi.toml"
+    cli("run", scene, "--fidelity", "fast", "-o", tmp_path / "cli.h5")
+    r = shpb.run(scene, fidelity="fast")
+    r.save(tmp_path / "py.h5")
+    a, b = h5_datasets(tmp_path / "cli.h5"), h5_datasets(tmp_path / "py.h5")
+    assert a.keys() == b.keys()
+    for k in a:
+        assert same(a[k][0], b[k][0]) and a[k][1] == b[k][1], k
+    with h5py.File(tmp_path / "cli.h5") as f, h5py.File(tmp_path / "py.h5") as g:
+        assert f.attrs["scene"] == g.attrs["scene"]
+        assert f["summary"].attrs["units"] == g["summary"].attrs["units"]
+        assert f["summary"].attrs["warnings"] == g["summary"].attrs["warnings"]
+        for name in ("scene_file", "fidelity_override"):
+            assert f["provenance"].attrs[name] == g["provenance"].attrs[name]
+        assert list(f["provenance/input_names"]) == list(g["provenance/input_names"])
+        assert list(f["provenance/input_texts"]) == list(g["provenance/input_texts"])
+        assert "shpb.run" in g["provenance"].attrs["command_line"]
+
+
+def test_load_of_save_round_trips(tmp_path):
+    r = shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast", set={"pressure": "12psi"})
+    r.save(tmp_path / "run.h5")
+    back = shpb.load(tmp_path / "run.h5")
+    assert back.origin == "file"
+    assert_runs_equal(back, r)
+    assert back.warnings == r.warnings
+    assert back.scene == r.scene
+    assert back.provenance["inputs"] == r.provenance["inputs"]
+    # A loaded run saves a copy of its file.
+    back.save(tmp_path / "copy.h5")
+    assert (tmp_path / "copy.h5").read_bytes() == (tmp_path / "run.h5").read_bytes()
+
+
+def test_set_overrides_like_the_scene_file_and_the_saved_file_reruns(cli, tmp_path):
+    text = (ROOT / "scenes/shpb-ss440c-10psi.toml").read_text().replace('"10psi"', '"12psi"')
+    (tmp_path / "scenes").mkdir()
+    scene = tmp_path / "scenes" / "s.toml"
+    scene.write_text(text)
+    (tmp_path / "bars").symlink_to(ROOT / "bars")
+    direct = shpb.run(scene, fidelity="fast")
+    overridden = shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast", set={"pressure": "12psi"})
+    assert_runs_equal(direct, overridden)
+    assert overridden.summary["pressure"] != shpb.run(
+        "scenes/shpb-ss440c-10psi.toml", fidelity="fast"
+    ).summary["pressure"]
+    # The saved file stores the overridden scene: `shpb run FILE.h5` and shpb.run(FILE.h5) rerun it.
+    overridden.save(tmp_path / "run.h5")
+    cli("run", tmp_path / "run.h5", "-o", tmp_path / "rerun.h5")
+    assert h5_summary(tmp_path / "rerun.h5") == overridden.summary
+    assert_runs_equal(shpb.run(tmp_path / "run.h5"), overridden)
+
+
+def test_a_dict_scene_equals_the_toml_scene():
+    scene = {
+        "kind": "collision",
+        "law": "burgoyne-daraio",
+        "velocity1_m_s": 5.0,
+        "velocity2_m_s": 0.0,
+        "specimen": {"pair": "ss440c"},
+    }
+    assert_runs_equal(shpb.run(scene), shpb.run("scenes/collision-ss440c-5ms.toml"))
+    # Relative paths of a dict are relative to the working directory.
+    bar_scene = {
+        "kind": "shpb",
+        "bars": "bars/authors.toml",
+        "pressure": "10psi",
+        "law": "burgoyne-daraio",
+        "specimen": {"pair": "ss440c"},
+    }
+    assert_runs_equal(
+        shpb.run(bar_scene, fidelity="fast"),
+        shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast"),
+    )
+
+
+def test_a_saved_dict_scene_reruns_from_its_file(cli, tmp_path):
+    r = shpb.run({"kind": "collision", "velocity1_m_s": 3.0, "specimen": {"pair": "ss440c"}})
+    r.save(tmp_path / "d.h5")
+    cli("run", tmp_path / "d.h5", "-o", tmp_path / "rerun.h5")
+    assert h5_summary(tmp_path / "rerun.h5") == r.summary
+
+
+def test_gun_and_curve_are_the_commands(cli):
+    out = cli("gun", "--pressure", "10psi").stdout
+    line = next(l for l in out.splitlines() if l.startswith("striker velocity"))
+    assert f"{shpb.gun('10psi', bars='authors'):.4f}" in line
+    assert shpb.gun(68947.5729) == pytest.approx(shpb.gun("10psi"), rel=1e-9)
+    delta, force = shpb.curve("ss440c", rate=1000.0, to=250e-6, points=101)
+    text = cli("curve", "--specimen", "ss440c", "--rate", "1000", "--to", "250e-6", "--points", "101").stdout
+    table = np.array([[float(x) for x in l.split(",")] for l in text.splitlines()[1:]])
+    assert same(table[:, 0], delta) and same(table[:, 1], force)
+
+
+def test_reduce_equals_shpb_reduce(cli, tmp_path):
+    cli("reduce", RECORD, "--bars", "authors", "-o", tmp_path / "red.h5")
+    r = shpb.reduce(RECORD, bars="authors")
+    file = h5_datasets(tmp_path / "red.h5")
+    assert r.keys() == sorted(file)
+    for k, (data, units) in file.items():
+        assert same(r[k], data) and r.units[k] == units, k
+    assert r.summary == h5_summary(tmp_path / "red.h5")
+    assert "reduction/force_back" in r
+    r.save(tmp_path / "py.h5")
+    assert_runs_equal(shpb.load(tmp_path / "py.h5"), r)
+
+
+def test_sweep_in_parallel_equals_serial():
+    kw = dict(set={"pressure": ["8psi", "10psi", "12psi"]})
+    scene = "scenes/shpb-ss440c-10psi.toml"
+    t1 = shpb.sweep(scene, jobs=1, **kw)
+    t2 = shpb.sweep(scene, jobs=2, **kw)
+    assert t1.keys() == t2.keys()
+    for k in t1.keys():
+        assert same(t1[k], t2[k]), k
+    assert t1.units["peak_force"] == "N" and t1.units["pressure"] == "Pa"
+    assert same(t1.inputs["pressure"], [shpb.run(scene, set={"pressure": p}).summary["pressure"] for p in kw["set"]["pressure"]])
+    # Each row is the run of its point.
+    r = shpb.run(scene, set={"pressure": "12psi"})
+    assert same(t1["peak_force"][2], r.summary["peak_contact_force"])
+
+
+# --- errors: the exception of the exit code, with the command line's message ---------------
+
+
+def cli_message(cli, *args):
+    p = cli(*args, check=False)
+    assert p.returncode != 0
+    return p.returncode, p.stderr.split("shpb: error: ", 1)[1].strip()
+
+
+BAD_SCENES = {
+    "unknown-kind.toml": 'kind = "bogus"\n',
+    "missing-kind.toml": "velocity1_m_s = 5.0\n",
+    "syntax.toml": "kind = \n",
+    "out-of-range.toml": 'kind = "collision"\nvelocity1_m_s = -5.0\n[specimen]\npair = "ss440c"\n',
+    "unknown-pair.toml": 'kind = "collision"\nvelocity1_m_s = 5.0\n[specimen]\npair = "unobtainium"\n',
+    "bad-fidelity.toml": 'kind = "collision"\nvelocity1_m_s = 5.0\nfidelity = "ultra"\n[specimen]\npair = "ss440c"\n',
+    "missing-bars.toml": 'kind = "shpb"\nbars = "nope.toml"\npressure = "10psi"\n[specimen]\npair = "ss440c"\n',
+    "bad-pressure.toml": 'kind = "shpb"\nbars = "authors"\npressure = "10 parsecs"\n[specimen]\npair = "ss440c"\n',
+}
+
+
+@pytest.mark.parametrize("name", sorted(BAD_SCENES))
+def test_bad_scenes_raise_input_error_with_the_cli_message(name, cli, tmp_path):
+    path = tmp_path / name
+    path.write_text(BAD_SCENES[name])
+    code, message = cli_message(cli, "run", path)
+    assert code == 2
+    with pytest.raises(shpb.InputError) as e:
+        shpb.run(path)
+    assert str(e.value).strip() == message
+    assert isinstance(e.value, ValueError)
+
+
+def test_a_missing_scene_is_an_os_error(cli):
+    code, message = cli_message(cli, "run", "no/such/scene.toml")
+    with pytest.raises(FileNotFoundError) as e:
+        shpb.run("no/such/scene.toml")
+    assert e.value.strerror == message
+    assert isinstance(e.value, OSError)
+
+
+def test_other_bad_inputs_raise_input_error(cli, tmp_path):
+    with pytest.raises(shpb.InputError):
+        shpb.run("scenes/collision-ss440c-5ms.toml", fidelity="ultra")
+    with pytest.raises(shpb.InputError):
+        shpb.run("scenes/shpb-ss440c-10psi.toml", set={"pressure": "ten psi"})
+    with pytest.raises(shpb.InputError):
+        shpb.run({"kind": "collision", "velocity1_m_s": object()})
+    code, message = cli_message(cli, "gun", "--pressure", "10parsec")
+    with pytest.raises(shpb.InputError, match="--pressure") as e:
+        shpb.gun("10parsec")
+    assert str(e.value).strip() == message
+    code, message = cli_message(cli, "gun", "--pressure", "10psi", "--bars", "nope")
+    with pytest.raises(shpb.InputError) as e:
+        shpb.gun("10psi", bars="nope")
+    assert str(e.value).strip() == message
+    code, message = cli_message(cli, "curve", "--points", "1")
+    with pytest.raises(shpb.InputError) as e:
+        shpb.curve(points=1)
+    assert str(e.value).strip() == message
+    with pytest.raises(shpb.InputError):
+        shpb.curve(law="nope")
+    code, message = cli_message(cli, "reduce", "no-such-record.csv")
+    with pytest.raises(shpb.InputError) as e:
+        shpb.reduce("no-such-record.csv")
+    assert str(e.value).strip() == message
+    with pytest.raises(shpb.InputError):
+        shpb.sweep("scenes/shpb-ss440c-10psi.toml", set={"pressure": []})
+    with pytest.raises(shpb.InputError):
+        shpb.load(ROOT / "README.md")
+    with pytest.raises(KeyError):
+        shpb.run("scenes/collision-ss440c-5ms.toml")["no/such/dataset"]
+
+
+def test_save_refuses_an_existing_file_and_a_wrong_extension(tmp_path):
+    r = shpb.run("scenes/collision-ss440c-5ms.toml")
+    r.save(tmp_path / "a.h5")
+    with pytest.raises(shpb.InputError, match="exists"):
+        r.save(tmp_path / "a.h5")
+    r.save(tmp_path / "a.h5", force=True)
+    with pytest.raises(shpb.InputError):
+        r.save(tmp_path / "a.csv")
+
+
+def test_instability_error_is_a_runtime_error():
+    assert issubclass(shpb.InstabilityError, RuntimeError)
+    assert issubclass(shpb.InputError, ValueError)
+
+
+def test_summary_html_and_units():
+    r = shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast")
+    assert r.units["contact/force"] == "N"
+    assert r.units["peak_contact_force"] == "N"
+    assert isinstance(r.summary["peak_contact_force"], float)
+    html = r._repr_html_()
+    assert "peak_contact_force" in html and "<table>" in html
+    assert r["summary/peak_contact_force"].shape == ()
+    snap = r["bars/incident/snapshots"]
+    assert snap.ndim == 2 and snap.shape == (len(r["bars/incident/time"]), len(r["bars/incident/x"]))
