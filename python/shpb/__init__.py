@@ -183,7 +183,9 @@ class Run:
 class Table:
     """The summary table of a sweep: ``table[name]`` is a numpy array with one value per run
     (``peak_force``, ``displacement_at_peak``, ``peak_strain_rate``,
-    ``equilibrium_ratio_at_peak``, ``time_to_equilibrium``); :attr:`inputs` holds each swept key's
+    ``equilibrium_ratio_at_peak``, ``time_to_equilibrium``; ``peak_contact_force`` and
+    ``displacement_at_peak_contact_force``, the names of a run's summary, are accepted too);
+    :attr:`inputs` holds each swept key's
     values in SI units (or as written, for names), :attr:`labels` the values as written."""
 
     def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
@@ -206,7 +208,14 @@ class Table:
             self.columns[name] = np.asarray(values, dtype=np.float64)
             self.units[name] = unit
 
+    #: The names of `Run.summary` that a sweep column holds (``table["peak_contact_force"]``).
+    ALIASES: Dict[str, str] = {
+        "peak_contact_force": "peak_force",
+        "displacement_at_peak_contact_force": "displacement_at_peak",
+    }
+
     def __getitem__(self, name: str) -> np.ndarray:
+        name = self.ALIASES.get(name, name)
         if name in self.columns:
             return self.columns[name]
         return self.inputs[name]

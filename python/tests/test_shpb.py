@@ -189,6 +189,8 @@ def test_sweep_in_parallel_equals_serial():
     # Each row is the run of its point.
     r = shpb.run(scene, set={"pressure": "12psi"})
     assert same(t1["peak_force"][2], r.summary["peak_contact_force"])
+    # The issue's (and a run's) name for the column reads the same array.
+    assert t1["peak_contact_force"] is t1["peak_force"]
 
 
 # --- errors: the exception of the exit code, with the command line's message ---------------
@@ -290,3 +292,25 @@ def test_summary_html_and_units():
     assert r["summary/peak_contact_force"].shape == ()
     snap = r["bars/incident/snapshots"]
     assert snap.ndim == 2 and snap.shape == (len(r["bars/incident/time"]), len(r["bars/incident/x"]))
+
+
+def test_ctrl_c_stops_a_long_run_cleanly():
+    """SIGINT during a run raises KeyboardInterrupt within about 1 % of the run, and the
+    interpreter (and the next run) carry on normally."""
+    import os
+    import signal
+    import threading
+    import time
+
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt, match="interrupted at step"):
+            # The reference preset takes several seconds: stopped long before its end.
+            shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="reference")
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 3.0
+    r = shpb.run("scenes/collision-ss440c-5ms.toml", fidelity="fast")
+    assert r.summary["restitution"] > 0

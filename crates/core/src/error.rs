@@ -18,6 +18,14 @@ pub enum Error {
         /// The allowed range or set of values.
         allowed: String,
     },
+    /// A run was stopped by its caller (the progress callback asked to stop, e.g. on Ctrl-C).
+    #[error("run stopped by the caller at step {step} (t = {time_s:.6e} s)")]
+    Cancelled {
+        /// Steps done.
+        step: usize,
+        /// Simulated time reached, s.
+        time_s: f64,
+    },
     /// A run became numerically unstable; names the step, time and quantity.
     #[error("numerical instability at step {step} (t = {time_s:.6e} s): {quantity} = {value:e}")]
     Unstable {

@@ -109,12 +109,13 @@ impl Params {
     /// Runs the scene; the output's warnings say where the run left the model's range of
     /// validity ([`Params::validity_warnings`]).
     pub fn run(&self) -> Result<RunOutput> {
-        self.run_with_progress(&mut |_| {})
+        self.run_with_progress(&mut |_| true)
     }
 
     /// Runs the scene, calling `progress` with the fraction done (0 to 1) now and then during
-    /// long solves (bar scenes: every 1 % of the steps).
-    pub fn run_with_progress(&self, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
+    /// long solves (bar scenes: every 1 % of the steps); `progress` returning false stops the
+    /// run with [`crate::Error::Cancelled`].
+    pub fn run_with_progress(&self, progress: &mut dyn FnMut(f64) -> bool) -> Result<RunOutput> {
         let mut out = self.run_kind(progress)?;
         let validity = self.validity_warnings(&out);
         out.warnings.extend(validity);
@@ -201,7 +202,7 @@ impl Params {
     }
 
     /// Runs the scene's kind (without the validity warnings).
-    fn run_kind(&self, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
+    fn run_kind(&self, progress: &mut dyn FnMut(f64) -> bool) -> Result<RunOutput> {
         let law = self.contact_law();
         let law = law.as_ref();
         match &self.params {
@@ -375,7 +376,7 @@ fn run_pulse(
     apparatus: &Apparatus,
     pressure_pa: f64,
     options: &PulseOptions,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<RunOutput> {
     let chain = apparatus.pulse_chain(options);
     let steps = (chain.end_time_s / chain.dt_s).ceil() as usize;

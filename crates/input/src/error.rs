@@ -60,6 +60,14 @@ pub enum Error {
         /// Its value.
         value: f64,
     },
+    /// A run stopped by its caller (Ctrl-C in Python, a progress callback that said stop).
+    #[error("run interrupted at step {step} (t = {time_s:.6e} s)")]
+    Interrupted {
+        /// Steps done.
+        step: usize,
+        /// Simulated time reached, s.
+        time_s: f64,
+    },
     /// A run that cannot finish on this machine (too many steps, too much memory), refused before
     /// it starts (`crate::resources`).
     #[error(
@@ -112,6 +120,7 @@ impl From<shpb_core::Error> for Error {
                 problem,
                 allowed,
             },
+            shpb_core::Error::Cancelled { step, time_s } => Error::Interrupted { step, time_s },
             shpb_core::Error::Unstable {
                 step,
                 time_s,
@@ -132,8 +141,8 @@ pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
     /// Process exit code for this error: 2 for bad input (a missing input file included,
-    /// wherever it is read, and a run too large for the machine), 3 for an unstable run, 1
-    /// otherwise.
+    /// wherever it is read, and a run too large for the machine), 3 for an unstable run, 130 for
+    /// a run interrupted by its caller (as SIGINT), 1 otherwise.
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Input { .. }
@@ -143,6 +152,7 @@ impl Error {
             | Error::Invalid { .. } => 2,
             Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => 2,
             Error::Unstable { .. } => 3,
+            Error::Interrupted { .. } => 130,
             Error::Io { .. } | Error::Hdf5 { .. } => 1,
         }
     }

@@ -9,7 +9,7 @@
 
 use numpy::PyArray1;
 use pyo3::create_exception;
-use pyo3::exceptions::{PyKeyError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyError, PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use shpb_core::contact::LawKind;
@@ -49,6 +49,7 @@ fn py_err(e: Error) -> PyErr {
         },
         Error::Hdf5 { .. } => PyOSError::new_err(message),
         Error::Unstable { .. } => InstabilityError::new_err(message),
+        Error::Interrupted { .. } => PyKeyboardInterrupt::new_err(message),
         _ => InputError::new_err(message),
     }
 }
@@ -389,7 +390,10 @@ fn run(
             (None, None) => unreachable!("a path or a text"),
         };
         let (params, provenance) = api::load_scene(scene, fidelity, &overrides, command_line)?;
-        let out = api::run_scene(&params, &mut |_| {})?;
+        // Every 1 % of a long run: a pending Ctrl-C (SIGINT) stops it with KeyboardInterrupt.
+        let out = api::run_scene(&params, &mut |_| {
+            Python::with_gil(|py| py.check_signals().is_ok())
+        })?;
         Ok((params, out, provenance))
     })?;
     Ok(RunData {

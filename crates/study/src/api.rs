@@ -221,7 +221,7 @@ pub fn load_scene(
 
 /// Runs a loaded scene as `shpb run` does (`progress` gets the fraction done): the output's
 /// warnings start with the scene's own ([`Params::warnings`]).
-pub fn run_scene(params: &Params, progress: &mut dyn FnMut(f64)) -> Result<RunOutput> {
+pub fn run_scene(params: &Params, progress: &mut dyn FnMut(f64) -> bool) -> Result<RunOutput> {
     let mut out = params.run_with_progress(progress)?;
     out.warnings.splice(0..0, params.warnings());
     Ok(out)

@@ -51,7 +51,10 @@ pub fn run(
     }
     check_disk(&[(output, "--output")], params.estimate().output_bytes)?;
     let mut progress = ProgressLine::new(&params.source);
-    let out = shpb_study::api::run_scene(&params, &mut |f| progress.update(f))?;
+    let out = shpb_study::api::run_scene(&params, &mut |f| {
+        progress.update(f);
+        true
+    })?;
     progress.finish();
     for w in &out.warnings {
         warn(w);

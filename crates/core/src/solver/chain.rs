@@ -182,7 +182,8 @@ impl Chain {
         Ok(())
     }
 
-    /// Runs `steps` steps, calling every recorder before the first and after each step.
+    /// Runs `steps` steps, calling every recorder before the first and after each step; stops
+    /// with [`Error::Cancelled`] when a recorder asks to ([`Recorder::stop`]).
     pub fn run(&mut self, steps: usize, recorders: &mut [&mut dyn Recorder]) -> Result<()> {
         for r in recorders.iter_mut() {
             r.record(self.step_index, self.time_s(), &self.bodies, &self.joints);
@@ -191,6 +192,12 @@ impl Chain {
             self.step()?;
             for r in recorders.iter_mut() {
                 r.record(self.step_index, self.time_s(), &self.bodies, &self.joints);
+            }
+            if recorders.iter().any(|r| r.stop()) {
+                return Err(Error::Cancelled {
+                    step: self.step_index,
+                    time_s: self.time_s(),
+                });
             }
         }
         Ok(())

@@ -11,6 +11,12 @@ use crate::solver::ContactSeries;
 pub trait Recorder {
     /// Called before the first step (`step` 0) and after every step `step` = 1, 2, …, at time `time_s`.
     fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]);
+
+    /// Whether the run should stop now (checked after every record; the run then ends with
+    /// [`crate::Error::Cancelled`]).
+    fn stop(&self) -> bool {
+        false
+    }
 }
 
 /// Which bar of the chain a gauge sits on, and where.
@@ -225,20 +231,23 @@ impl Recorder for SnapshotRecorder {
     }
 }
 
-/// Reports the fraction of the run done to a callback, every 1 % of the steps.
+/// Reports the fraction of the run done to a callback, every 1 % of the steps; the callback
+/// returns whether to go on (false stops the run: [`crate::Error::Cancelled`]).
 pub struct Progress<'a> {
     steps: usize,
     every: usize,
-    callback: &'a mut dyn FnMut(f64),
+    callback: &'a mut dyn FnMut(f64) -> bool,
+    stop: bool,
 }
 
 impl<'a> Progress<'a> {
     /// Progress of a run of `steps` steps, reported to `callback`.
-    pub fn new(steps: usize, callback: &'a mut dyn FnMut(f64)) -> Progress<'a> {
+    pub fn new(steps: usize, callback: &'a mut dyn FnMut(f64) -> bool) -> Progress<'a> {
         Progress {
             steps: steps.max(1),
             every: (steps / 100).max(1),
             callback,
+            stop: false,
         }
     }
 }
@@ -246,8 +255,12 @@ impl<'a> Progress<'a> {
 impl Recorder for Progress<'_> {
     fn record(&mut self, step: usize, _time_s: f64, _bodies: &[Body], _joints: &[JointState]) {
         if step.is_multiple_of(self.every) || step == self.steps {
-            (self.callback)(step as f64 / self.steps as f64);
+            self.stop = !(self.callback)(step as f64 / self.steps as f64);
         }
+    }
+
+    fn stop(&self) -> bool {
+        self.stop
     }
 }
 
@@ -258,7 +271,10 @@ mod tests {
     #[test]
     fn progress_reports_rising_fractions_up_to_one() {
         let mut seen = Vec::new();
-        let mut callback = |f: f64| seen.push(f);
+        let mut callback = |f: f64| {
+            seen.push(f);
+            true
+        };
         let mut p = Progress::new(1000, &mut callback);
         for step in 0..=1000 {
             p.record(step, 0.0, &[], &[]);
