@@ -314,3 +314,10 @@ def test_ctrl_c_stops_a_long_run_cleanly():
     assert time.monotonic() - start < 3.0
     r = shpb.run("scenes/collision-ss440c-5ms.toml", fidelity="fast")
     assert r.summary["restitution"] > 0
+
+
+def test_a_sweep_too_large_for_the_machine_is_refused_before_it_allocates():
+    """As `shpb sweep`: 10^10 runs are refused with the estimate and the limit (InputError)."""
+    grid = {"pressure": "7psi:22psi:100000", "shaper.thickness_m": "0.1mm:1mm:100000"}
+    with pytest.raises(shpb.InputError, match="cannot finish on this machine: 10000000000 runs"):
+        shpb.sweep("scenes/shpb-ss440c-10psi.toml", set=grid)

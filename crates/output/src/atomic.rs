@@ -53,6 +53,18 @@ pub fn check_output(path: &Path, force: bool) -> Result<()> {
     check_output_flag(path, force, "output")
 }
 
+/// Bytes free for an unprivileged user on the file system of `dir` (`statvfs`).
+pub fn free_space(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    // SAFETY: `c` is a valid NUL-terminated path and `s` a valid out-pointer.
+    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
+    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
+        return None;
+    }
+    Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
+}
+
 /// Whether `path` is `-`: the output goes to standard output.
 pub fn is_stdout(path: &Path) -> bool {
     path == Path::new("-")

@@ -359,6 +359,9 @@ pub fn sweep_rows(
         ));
     }
     let axes = crate::sweep::parse_axes(set)?;
+    // Before anything is allocated: can the sweep finish on this machine? (as `shpb sweep`)
+    crate::sweep::estimate(&axes, (1, 1), crate::sweep::Outputs::default())
+        .check(&crate::sweep::Limits::of_machine(&[]))?;
     let points = crate::sweep::product(&axes);
     crate::sweep::check_points(scene, &axes, &points)?;
     let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;

@@ -562,6 +562,53 @@ pub struct Limits {
     pub disk_basis: String,
 }
 
+impl Limits {
+    /// What the machine allows a sweep: half the memory available (MemAvailable in /proc/meminfo,
+    /// or what the cgroup still allows if less; the runs themselves need the rest) and the free disk
+    /// space where the outputs go.
+    pub fn of_machine(outputs: &[&std::path::Path]) -> Limits {
+        let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+            t.lines()
+                .find_map(|l| l.strip_prefix("MemAvailable:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+                .map(|kb| kb * 1024)
+        });
+        let read =
+            |p: &str| -> Option<u64> { std::fs::read_to_string(p).ok()?.trim().parse().ok() };
+        let cgroup = read("/sys/fs/cgroup/memory.max")
+            .zip(read("/sys/fs/cgroup/memory.current"))
+            .or_else(|| {
+                read("/sys/fs/cgroup/memory/memory.limit_in_bytes")
+                    .zip(read("/sys/fs/cgroup/memory/memory.usage_in_bytes"))
+            })
+            .map(|(max, used)| max.saturating_sub(used));
+        let (available, basis) = match (meminfo, cgroup) {
+            (Some(m), Some(c)) if c < m => (c, "half of what the memory cgroup still allows"),
+            (Some(m), _) => (m, "half of MemAvailable in /proc/meminfo"),
+            (None, Some(c)) => (c, "half of what the memory cgroup still allows"),
+            (None, None) => (8 << 30, "half of an assumed 8 GiB (no /proc/meminfo)"),
+        };
+        let mut disk: Option<(u64, String)> = None;
+        for p in outputs {
+            let dir = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(std::path::Path::new("."));
+            if let Some(free) = shpb_output::atomic::free_space(dir)
+                && disk.as_ref().is_none_or(|(d, _)| free < *d)
+            {
+                disk = Some((free, format!("free space in {}", dir.display())));
+            }
+        }
+        Limits {
+            memory_bytes: available / 2,
+            memory_basis: basis.to_string(),
+            disk_bytes: disk.as_ref().map(|(d, _)| *d),
+            disk_basis: disk.map(|(_, b)| b).unwrap_or_default(),
+        }
+    }
+}
+
 /// Estimates a sweep of `axes`, shard `k` of `n`, writing `outputs`.
 pub fn estimate(axes: &[Axis], (k, n): (usize, usize), outputs: Outputs) -> Estimate {
     let runs_total = run_count(axes);

@@ -179,18 +179,7 @@ pub fn stdout_once(outputs: &[Option<&Path>]) -> Result<bool> {
     Ok(to_stdout == 1)
 }
 
-/// Bytes free for an unprivileged user on the file system of `dir` (`statvfs`).
-pub fn free_space(dir: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
-    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
-    // SAFETY: `c` is a valid NUL-terminated path and `s` a valid out-pointer.
-    let mut s: libc::statvfs = unsafe { std::mem::zeroed() };
-    if unsafe { libc::statvfs(c.as_ptr(), &mut s) } != 0 {
-        return None;
-    }
-    Some((s.f_bavail as u64).saturating_mul(s.f_frsize as u64))
-}
-
+pub use shpb_output::atomic::free_space;
 pub use shpb_study::api::DEFAULT_BARS;
 
 /// An input error (exit code 2) naming the file (or "command line"), the key, the problem and
