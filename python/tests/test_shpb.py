@@ -321,3 +321,42 @@ def test_a_sweep_too_large_for_the_machine_is_refused_before_it_allocates():
     grid = {"pressure": "7psi:22psi:100000", "shaper.thickness_m": "0.1mm:1mm:100000"}
     with pytest.raises(shpb.InputError, match="cannot finish on this machine: 10000000000 runs"):
         shpb.sweep("scenes/shpb-ss440c-10psi.toml", set=grid)
+
+
+def test_an_unstable_run_raises_instability_error_with_the_cli_message(cli, tmp_path):
+    """A collision of spheres so soft (σy = 10 kPa) that the contact outlasts the solver's
+    limit of 100 Hertz contact times ends as exit 3 in the CLI and InstabilityError in Python,
+    with the same message."""
+    soft = (ROOT / "specimens/ss440c.toml").read_text()
+    soft = soft.replace("yield_stress_pa = 1900e6", "yield_stress_pa = 1e4")
+    (tmp_path / "soft.toml").write_text(soft)
+    sphere = {"material": str(tmp_path / "soft.toml"), "diameter_m": 6.35e-3}
+    scene = {
+        "kind": "collision",
+        "velocity1_m_s": 5.0,
+        "law": "rate-independent",
+        "fidelity": "fast",
+        "specimen": {"sphere1": sphere, "sphere2": sphere},
+    }
+    with pytest.raises(shpb.InstabilityError) as err:
+        shpb.run(scene)
+    assert "contact did not end before the time limit" in str(err.value)
+    text = "\n".join(
+        [
+            'kind = "collision"',
+            "velocity1_m_s = 5.0",
+            'law = "rate-independent"',
+            'fidelity = "fast"',
+            "[specimen.sphere1]",
+            f'material = "{tmp_path / "soft.toml"}"',
+            "diameter_m = 6.35e-3",
+            "[specimen.sphere2]",
+            f'material = "{tmp_path / "soft.toml"}"',
+            "diameter_m = 6.35e-3",
+            "",
+        ]
+    )
+    (tmp_path / "soft-collision.toml").write_text(text)
+    code, message = cli_message(cli, "run", tmp_path / "soft-collision.toml")
+    assert code == 3
+    assert message == str(err.value)
