@@ -226,6 +226,23 @@ def test_bad_scenes_raise_input_error_with_the_cli_message(name, cli, tmp_path):
     assert isinstance(e.value, ValueError)
 
 
+CORPUS = sorted((ROOT / "tests/corpus/bad").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", CORPUS, ids=[p.name for p in CORPUS])
+def test_the_bad_input_corpus_raises_the_exception_of_its_exit_code(path, cli):
+    """Every scene of `tests/corpus/bad/` (also run by the Rust CLI tests): the exception of
+    the exit code its first line expects (2: InputError), with exactly the CLI's message."""
+    expect = path.read_text().splitlines()[0].removeprefix("# expect: ")
+    code, fragment = expect.split(" | ", 1)
+    cli_code, message = cli_message(cli, "run", path)
+    assert cli_code == int(code) == 2
+    with pytest.raises(shpb.InputError) as e:
+        shpb.run(path)
+    assert str(e.value).strip() == message
+    assert fragment in message
+
+
 def test_a_missing_scene_is_an_os_error(cli):
     code, message = cli_message(cli, "run", "no/such/scene.toml")
     with pytest.raises(FileNotFoundError) as e:
