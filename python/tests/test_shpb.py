@@ -377,3 +377,55 @@ def test_an_unstable_run_raises_instability_error_with_the_cli_message(cli, tmp_
     code, message = cli_message(cli, "run", tmp_path / "soft-collision.toml")
     assert code == 3
     assert message == str(err.value)
+
+
+def test_plot_draws_the_three_panels_or_says_what_is_missing(tmp_path):
+    """`Run.plot()`: with matplotlib, the three panels of a full test (F–δ, gauges, reduced
+    forces); without it, an ImportError that says how to get it."""
+    r = shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="fast")
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+    except ImportError:
+        with pytest.raises(ImportError, match="pip install matplotlib"):
+            r.plot()
+        return
+    fig = r.plot(tmp_path / "run.png")
+    assert len(fig.axes) == 3
+    assert (tmp_path / "run.png").stat().st_size > 0
+
+
+def test_a_run_shows_its_summary_as_a_table_in_jupyter():
+    r = shpb.run("scenes/collision-ss440c-5ms.toml", fidelity="fast")
+    page = r._repr_html_()
+    assert "<table" in page and "restitution" in page
+
+
+def _records(tmp_path):
+    """Bad gauge records: inverted polarity, a binary file, a missing column."""
+    source = (ROOT / "validation/gauge-records/data/2013-05-22_sample2_ss440c.csv").read_text()
+    lines = source.splitlines()
+    out = []
+    for line in lines:
+        cells = line.split(",")
+        if line.startswith("#") or not cells[0][:1].isdigit() and not cells[0][:1] == "-":
+            out.append(line)
+        else:
+            out.append(",".join([cells[0]] + [repr(-float(c)) for c in cells[1:]]))
+    inverted = tmp_path / "inverted.csv"
+    inverted.write_text("\n".join(out) + "\n")
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"time_s,incident_V,transmission_V\n\x00\x01\xff\n")
+    missing = tmp_path / "missing-column.csv"
+    missing.write_text("time_s,incident_V\n0,0\n1e-7,0\n")
+    return [inverted, binary, missing]
+
+
+def test_bad_records_raise_input_error_with_the_cli_message(cli, tmp_path):
+    for record in _records(tmp_path):
+        code, message = cli_message(cli, "reduce", record)
+        assert code == 2, record
+        with pytest.raises(shpb.InputError) as e:
+            shpb.reduce(record)
+        assert str(e.value).strip() == message, record
