@@ -1,15 +1,9 @@
 //! `kind = "collision"`: two free spheres with initial velocities (restitution, contact time, peak
 //! force, energy dissipated).
 
-use super::{
-    Key, LAW, LawKindToml, OUTPUT_EVERY, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind,
-    check_every, one,
-};
+use super::{Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, check_every, one};
 use crate::error::{Result, Validator};
-use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
-use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use shpb_core::solver::{self, CollisionSetup};
@@ -54,25 +48,16 @@ pub(super) const KIND: SceneKind = SceneKind {
     parse,
 };
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CollisionFile {
-    #[allow(dead_code)]
-    kind: String,
-    #[allow(dead_code)]
-    fidelity: Option<String>,
-    specimen: SpecimenSpec,
-    #[serde(default, with = "LawKindToml")]
-    law: LawKind,
-    #[serde(default, with = "Region2Toml")]
-    region2: Region2Form,
-    velocity1_m_s: f64,
-    #[serde(default)]
-    velocity2_m_s: f64,
-    time_step_s: Option<f64>,
-    steps_per_contact: Option<f64>,
-    #[serde(default = "one")]
-    output_every: usize,
+super::sphere_scene_file! {
+    struct CollisionFile {
+        velocity1_m_s: f64,
+        #[serde(default)]
+        velocity2_m_s: f64,
+        time_step_s: Option<f64>,
+        steps_per_contact: Option<f64>,
+        #[serde(default = "one")]
+        output_every: usize,
+    }
 }
 
 fn parse(

@@ -1,15 +1,9 @@
 //! `kind = "constant-rate"`: the spheres pressed together at a constant approach speed, with rate
 //! hardening (paper Fig. 3).
 
-use super::{
-    Key, LAW, LawKindToml, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind, check_points,
-    default_points,
-};
+use super::{Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_points, default_points};
 use crate::error::{Result, Validator};
-use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
-use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use std::path::Path;
@@ -46,22 +40,13 @@ pub(super) const KIND: SceneKind = SceneKind {
     parse,
 };
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ConstantRateFile {
-    #[allow(dead_code)]
-    kind: String,
-    #[allow(dead_code)]
-    fidelity: Option<String>,
-    specimen: SpecimenSpec,
-    #[serde(default, with = "LawKindToml")]
-    law: LawKind,
-    #[serde(default, with = "Region2Toml")]
-    region2: Region2Form,
-    strain_rate_per_s: f64,
-    max_displacement_m: f64,
-    #[serde(default = "default_points")]
-    points: usize,
+super::sphere_scene_file! {
+    struct ConstantRateFile {
+        strain_rate_per_s: f64,
+        max_displacement_m: f64,
+        #[serde(default = "default_points")]
+        points: usize,
+    }
 }
 
 fn parse(

@@ -1,16 +1,10 @@
 //! `kind = "force-driven"`: the paper's Fig. 4 DEM, a measured force history (CSV) drives sphere 1
 //! and sphere 2 rests on a medium of impedance Z.
 
-use super::{
-    Key, LAW, LawKindToml, OUTPUT_EVERY, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind,
-    check_every, one,
-};
+use super::{Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, check_every, one};
 use crate::csv::{CsvTable, SignConvention};
 use crate::error::{Error, Result, Validator};
-use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
-use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form};
 use shpb_core::error::format_si;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::{AUTHORS_TRANSMISSION_BAR_IMPEDANCE_KG_S, SceneParams};
@@ -80,31 +74,22 @@ pub(super) const KIND: SceneKind = SceneKind {
     parse,
 };
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ForceDrivenFile {
-    #[allow(dead_code)]
-    kind: String,
-    #[allow(dead_code)]
-    fidelity: Option<String>,
-    specimen: SpecimenSpec,
-    #[serde(default, with = "LawKindToml")]
-    law: LawKind,
-    #[serde(default, with = "Region2Toml")]
-    region2: Region2Form,
-    force_csv: String,
-    #[serde(default = "default_time_column")]
-    time_column: String,
-    #[serde(default = "default_force_column")]
-    force_column: String,
-    force_sign: Option<String>,
-    #[serde(default = "default_impedance")]
-    medium_impedance_kg_s: f64,
-    time_step_s: Option<f64>,
-    steps_per_period: Option<f64>,
-    end_time_s: Option<f64>,
-    #[serde(default = "one")]
-    output_every: usize,
+super::sphere_scene_file! {
+    struct ForceDrivenFile {
+        force_csv: String,
+        #[serde(default = "default_time_column")]
+        time_column: String,
+        #[serde(default = "default_force_column")]
+        force_column: String,
+        force_sign: Option<String>,
+        #[serde(default = "default_impedance")]
+        medium_impedance_kg_s: f64,
+        time_step_s: Option<f64>,
+        steps_per_period: Option<f64>,
+        end_time_s: Option<f64>,
+        #[serde(default = "one")]
+        output_every: usize,
+    }
 }
 
 fn default_time_column() -> String {

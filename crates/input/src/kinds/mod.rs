@@ -22,6 +22,31 @@ mod pulse;
 mod quasistatic;
 mod shpb;
 
+/// The schema of a sphere scene file: the keys every sphere scene has (`kind`, `fidelity`,
+/// `specimen`, `law`, `region2`), then the kind's own fields; unknown keys are refused. (serde's
+/// `flatten` cannot be combined with `deny_unknown_fields`, so the common keys are written once
+/// here instead.)
+macro_rules! sphere_scene_file {
+    ($(#[$meta:meta])* struct $name:ident { $($(#[$fmeta:meta])* $field:ident : $ty:ty),* $(,)? }) => {
+        $(#[$meta])*
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct $name {
+            #[allow(dead_code)]
+            kind: String,
+            #[allow(dead_code)]
+            fidelity: Option<String>,
+            specimen: crate::specimen::SpecimenSpec,
+            #[serde(default, with = "super::LawKindToml")]
+            law: shpb_core::contact::LawKind,
+            #[serde(default, with = "super::Region2Toml")]
+            region2: shpb_core::contact::Region2Form,
+            $($(#[$fmeta])* $field: $ty,)*
+        }
+    };
+}
+pub(crate) use sphere_scene_file;
+
 /// What a kind's parser returns: the specimen, the contact law, the form of region II and the
 /// kind-specific parameters (the rest of [`shpb_core::scene::Params`] is common to all kinds).
 pub type Parsed = (SpherePair, LawKind, Region2Form, SceneParams);

@@ -1,14 +1,8 @@
 //! `kind = "quasistatic"`: the loading curve F(δ) of the contact law on a grid (paper Fig. 2).
 
-use super::{
-    Key, LAW, LawKindToml, Parsed, REGION2, Region2Toml, SPECIMEN, SceneKind, check_points,
-    default_points,
-};
+use super::{Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_points, default_points};
 use crate::error::{Result, Validator};
-use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
-use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use std::path::Path;
@@ -45,23 +39,14 @@ pub(super) const KIND: SceneKind = SceneKind {
     parse,
 };
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct QuasistaticFile {
-    #[allow(dead_code)]
-    kind: String,
-    #[allow(dead_code)]
-    fidelity: Option<String>,
-    specimen: SpecimenSpec,
-    #[serde(default, with = "LawKindToml")]
-    law: LawKind,
-    #[serde(default, with = "Region2Toml")]
-    region2: Region2Form,
-    max_displacement_m: f64,
-    #[serde(default = "default_points")]
-    points: usize,
-    #[serde(default)]
-    strain_rate_per_s: f64,
+super::sphere_scene_file! {
+    struct QuasistaticFile {
+        max_displacement_m: f64,
+        #[serde(default = "default_points")]
+        points: usize,
+        #[serde(default)]
+        strain_rate_per_s: f64,
+    }
 }
 
 fn parse(
@@ -90,6 +75,7 @@ fn parse(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shpb_core::contact::{LawKind, Region2Form};
 
     #[test]
     fn registry_entry() {
