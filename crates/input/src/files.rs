@@ -58,23 +58,6 @@ fn replayed(name: &str) -> Option<Option<String>> {
     })
 }
 
-/// Reads a text file (or, while replaying, its stored copy), noting it while capturing.
-pub fn read_to_string(path: &Path) -> std::io::Result<String> {
-    let name = path.display().to_string();
-    let text = match replayed(&name) {
-        Some(Some(text)) => text,
-        Some(None) => {
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                "not among the inputs stored in the run file",
-            ));
-        }
-        None => std::fs::read_to_string(path)?,
-    };
-    note(&name, &text);
-    Ok(text)
-}
-
 /// Reads a file's bytes (or, while replaying, its stored copy), noting it while capturing (as
 /// text: the inputs shpb reads are text; a binary file is refused by its reader anyway).
 pub fn read(path: &Path) -> std::io::Result<Vec<u8>> {
@@ -91,6 +74,12 @@ pub fn read(path: &Path) -> std::io::Result<Vec<u8>> {
     };
     note(&name, &String::from_utf8_lossy(&bytes));
     Ok(bytes)
+}
+
+/// Reads a text file (or, while replaying, its stored copy), noting it while capturing.
+pub fn read_to_string(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read(path)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
 /// Whether `path` is a readable file (while replaying: whether the run file stored it).

@@ -113,6 +113,13 @@ pub fn check_output_flag(path: &Path, force: bool, flag: &str) -> Result<()> {
     }
 }
 
+/// [`check_output_flag`] and then [`check_extension`]: every check of an output path given by
+/// `flag` that needs no knowledge of the run's inputs.
+pub fn check_output_path(path: &Path, force: bool, flag: &str, extensions: &[&str]) -> Result<()> {
+    check_output_flag(path, force, flag)?;
+    check_extension(path, flag, extensions)
+}
+
 /// Refuses an output whose extension is not one of `extensions` (lower case, without dot).
 pub fn check_extension(path: &Path, flag: &str, extensions: &[&str]) -> Result<()> {
     if is_stdout(path) {

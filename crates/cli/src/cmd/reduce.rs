@@ -2,7 +2,7 @@
 
 use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, warn, wrote};
 use shpb_input::Result;
-use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
+use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::reduction::{write_reduction_csv, write_reduction_hdf5};
 use std::path::Path;
 
@@ -27,8 +27,7 @@ pub fn reduce_command(
     ];
     for (p, flag, extensions) in outputs {
         if let Some(p) = p {
-            check_output_flag(p, force, flag)?;
-            check_extension(p, flag, extensions)?;
+            check_output_path(p, force, flag, extensions)?;
             check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
         }
     }

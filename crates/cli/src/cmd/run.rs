@@ -7,7 +7,7 @@ use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::Result;
 use shpb_input::files::Provenance;
-use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
+use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::writer::{Csv, Hdf5, Png, Writer};
 use std::path::{Path, PathBuf};
 
@@ -29,8 +29,7 @@ pub fn run(
     ];
     for (p, flag, extensions) in outputs {
         if let Some(p) = p {
-            check_output_flag(p, force, flag)?;
-            check_extension(p, flag, extensions)?;
+            check_output_path(p, force, flag, extensions)?;
         }
     }
     let data_on_stdout = stdout_once(&[output, csv, plot])?;

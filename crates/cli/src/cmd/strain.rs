@@ -4,7 +4,7 @@ use super::common::{load_apparatus, say};
 use shpb_core::run::RunOutput;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
-use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
+use shpb_output::atomic::{check_not_input, check_output_path};
 use std::path::Path;
 
 /// `shpb strain RECORD [--bars SET-UP] [-o OUT.h5] [--csv OUT.csv] [--force]`.
@@ -21,8 +21,7 @@ pub fn strain(
     ];
     for (p, flag, extensions) in outputs {
         if let Some(p) = p {
-            check_output_flag(p, force, flag)?;
-            check_extension(p, flag, extensions)?;
+            check_output_path(p, force, flag, extensions)?;
             check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
         }
     }

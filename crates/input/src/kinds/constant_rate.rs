@@ -1,7 +1,10 @@
 //! `kind = "constant-rate"`: the spheres pressed together at a constant approach speed, with rate
 //! hardening (paper Fig. 3).
 
-use super::{Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_points, default_points};
+use super::{
+    Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_max_displacement, check_points,
+    default_points,
+};
 use crate::error::{Result, Validator};
 use crate::toml_file::parse_as;
 use shpb_core::fidelity::Fidelity;
@@ -61,12 +64,7 @@ fn parse(
     let pair = f.specimen.build(base_dir, &sv)?;
     let p = SceneParams::ConstantRate {
         strain_rate_per_s: v.positive("strain_rate_per_s", f.strain_rate_per_s, 1e9, "1/s")?,
-        max_displacement_m: v.positive(
-            "max_displacement_m",
-            f.max_displacement_m,
-            0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
-            "m",
-        )?,
+        max_displacement_m: check_max_displacement(v, f.max_displacement_m, &pair)?,
         points: check_points(v, f.points)?,
     };
     Ok((pair, f.law, f.region2, p))

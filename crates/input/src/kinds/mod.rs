@@ -324,6 +324,17 @@ enum LawKindToml {
     Hertz,
 }
 
+/// Checks `max_displacement_m` of a loading scene: positive and at most half the smaller sphere
+/// radius, the bound both loading scenes (quasistatic, constant-rate) apply.
+fn check_max_displacement(v: &Validator, value_m: f64, pair: &SpherePair) -> Result<f64> {
+    v.positive(
+        "max_displacement_m",
+        value_m,
+        0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+        "m",
+    )
+}
+
 /// `region2 = "..."`: the scene names of [`Region2Form`].
 #[derive(Deserialize)]
 #[serde(remote = "Region2Form", rename_all = "kebab-case")]

@@ -1,6 +1,9 @@
 //! `kind = "quasistatic"`: the loading curve F(δ) of the contact law on a grid (paper Fig. 2).
 
-use super::{Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_points, default_points};
+use super::{
+    Key, LAW, Parsed, REGION2, SPECIMEN, SceneKind, check_max_displacement, check_points,
+    default_points,
+};
 use crate::error::{Result, Validator};
 use crate::toml_file::parse_as;
 use shpb_core::fidelity::Fidelity;
@@ -60,12 +63,7 @@ fn parse(
     let f: QuasistaticFile = parse_as(text, file)?;
     let pair = f.specimen.build(base_dir, &sv)?;
     let p = SceneParams::Quasistatic {
-        max_displacement_m: v.positive(
-            "max_displacement_m",
-            f.max_displacement_m,
-            0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
-            "m",
-        )?,
+        max_displacement_m: check_max_displacement(v, f.max_displacement_m, &pair)?,
         points: check_points(v, f.points)?,
         strain_rate_per_s: v.in_range("strain_rate_per_s", f.strain_rate_per_s, 0.0, 1e9, "1/s")?,
     };
