@@ -255,7 +255,7 @@ impl LoadingCurve {
 pub struct ContactHistory {
     /// Largest approach reached so far, m.
     pub delta_max_m: f64,
-    /// Loading force at that approach, N.
+    /// Force the unloading curve passes through at δmax (its peak), N.
     pub force_max_n: f64,
     /// Whether loading ever left region I (then unloading is plastic, else Hertz).
     pub yielded: bool,
@@ -263,6 +263,57 @@ pub struct ContactHistory {
     pub unloading_radius_m: f64,
     /// Residual approach δr at which the unloading force vanishes, m.
     pub residual_delta_m: f64,
+    /// Largest force reached on the virgin (loading) curve, N.
+    pub peak_force_n: f64,
+    /// Yield stress in effect (σy*, rate-hardened) when that force was reached, Pa.
+    pub peak_yield_stress_pa: f64,
+    /// Largest approach speed δ̇ while loading on the virgin curve, m/s.
+    pub peak_loading_speed_m_s: f64,
+    /// Net work done on the contact so far, ∮F dδ by the trapezoidal rule over committed steps, J.
+    pub work_j: f64,
+    /// Work done while loading on the virgin curve since the last turning point, J.
+    pub loading_work_j: f64,
+    /// Approach of the last committed evaluation, m.
+    pub last_delta_m: f64,
+    /// Force of the last committed evaluation, N.
+    pub last_force_n: f64,
+}
+
+/// How the elastoplastic law unloads after loading (docs/physics.md §3), scene key `unloading`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Unloading {
+    /// Thornton's curve from the dynamic state: Fmax the largest force reached, Rp and δr with the
+    /// rate-hardened yield stress in effect at that force, less the energy left in elastic
+    /// vibrations of the spheres (Hunter's scaling, [`VIBRATION_LOSS_COEFFICIENT`]). Default.
+    #[default]
+    Dynamic,
+    /// Thornton's curve from the static loading curve at δmax (σy* = σy at the turning point):
+    /// shpb's rule before issue 17.
+    Static,
+    /// As the authors' `f_contact.m`: Fmax the largest force reached, Rp with the static σy and Fy.
+    Authors,
+}
+
+impl Unloading {
+    /// All rules with their scene names.
+    pub const ALL: [(&'static str, Unloading); 3] = [
+        ("dynamic", Unloading::Dynamic),
+        ("static", Unloading::Static),
+        ("authors", Unloading::Authors),
+    ];
+}
+
+/// Coefficient k of the energy an impact leaves in elastic vibrations of the spheres,
+/// W = k (u/c0)^{3/5} W_load (u the largest loading approach speed, c0 = √(E/ρ)): the exponent is
+/// Hunter's (J. Mech. Phys. Solids 5, 162 (1957), whose half-space value is k = 1.04); k = 0.65 is
+/// fitted on the authors' eight dynamic-FEM restitution values (`tests/data/dynamic_fem/restitution.csv`,
+/// 1–100 m/s, plastic and Johnson–Cook; docs/physics.md §3).
+pub const VIBRATION_LOSS_COEFFICIENT: f64 = 0.65;
+
+/// Energy returned by the Hertz-shaped unloading curve through (δmax, Fmax) with elastic recovery
+/// δe = δmax − δr: ∫ (4/3) E* √Rp x^{3/2} dx from 0 to δe = (2/5) Fmax δe, J.
+fn unloading_energy_j(force_max_n: f64, recovery_m: f64) -> f64 {
+    0.4 * force_max_n * recovery_m
 }
 
 /// What a contact law returns for one evaluation.
@@ -458,6 +509,8 @@ pub struct BurgoyneDaraio {
     pub rate_dependent: bool,
     /// Form of region II.
     pub region2: Region2Form,
+    /// Unloading rule.
+    pub unloading: Unloading,
     static_curve: LoadingCurve,
 }
 
@@ -467,16 +520,27 @@ impl BurgoyneDaraio {
         BurgoyneDaraio::with_form(props, rate_dependent, Region2Form::Smooth)
     }
 
-    /// The law with the chosen form of region II.
+    /// The law with the chosen form of region II (default unloading).
     pub fn with_form(
         props: ContactProperties,
         rate_dependent: bool,
         region2: Region2Form,
     ) -> BurgoyneDaraio {
+        BurgoyneDaraio::with_options(props, rate_dependent, region2, Unloading::default())
+    }
+
+    /// The law with the chosen form of region II and unloading rule.
+    pub fn with_options(
+        props: ContactProperties,
+        rate_dependent: bool,
+        region2: Region2Form,
+        unloading: Unloading,
+    ) -> BurgoyneDaraio {
         BurgoyneDaraio {
             props,
             rate_dependent,
             region2,
+            unloading,
             static_curve: LoadingCurve::with_form(
                 props.e_star_pa,
                 props.radius_m,
@@ -521,16 +585,93 @@ impl BurgoyneDaraio {
         }
     }
 
-    /// Thornton's unloading radius Rp and residual approach δr from (δmax, Fmax) (docs/physics.md §3).
+    /// Thornton's unloading radius Rp and residual approach δr from (δmax, Fmax) with the static σy
+    /// (docs/physics.md §3).
     pub fn thornton_unloading(&self, delta_max_m: f64, force_max_n: f64) -> (f64, f64) {
+        self.thornton_unloading_at(delta_max_m, force_max_n, self.props.yield_stress_pa)
+    }
+
+    /// Thornton's Rp and δr from (δmax, Fmax) for the yield stress `yield_stress_pa` (σy, or the
+    /// rate-hardened σy* of the dynamic rule), with Fy of that yield stress (docs/physics.md §3).
+    pub fn thornton_unloading_at(
+        &self,
+        delta_max_m: f64,
+        force_max_n: f64,
+        yield_stress_pa: f64,
+    ) -> (f64, f64) {
         let e = self.props.e_star_pa;
-        let sy = self.props.yield_stress_pa;
-        let fy = self.static_curve.force_y_n;
-        let rp =
-            4.0 * e * ((2.0 * force_max_n + fy) / (2.0 * PI * YIELD_ONSET_FACTOR * sy)).powf(1.5)
-                / (3.0 * force_max_n);
+        let k = YIELD_ONSET_FACTOR * PI * yield_stress_pa;
+        let fy = (1.0 / 6.0) * (self.props.radius_m / e).powi(2) * k * k * k;
+        let rp = 4.0 * e * ((2.0 * force_max_n + fy) / (2.0 * k)).powf(1.5) / (3.0 * force_max_n);
         let dr = delta_max_m - (3.0 * force_max_n / (4.0 * e * rp.sqrt())).powf(2.0 / 3.0);
         (rp, dr.max(0.0))
+    }
+
+    /// Energy left in elastic vibrations by a loading that did `loading_work_j` at approach speeds up
+    /// to `speed_m_s`: k (u/c0)^{3/5} W_load ([`VIBRATION_LOSS_COEFFICIENT`]), J.
+    pub fn vibration_loss_j(&self, speed_m_s: f64, loading_work_j: f64) -> f64 {
+        if self.unloading != Unloading::Dynamic || speed_m_s <= 0.0 || loading_work_j <= 0.0 {
+            return 0.0;
+        }
+        VIBRATION_LOSS_COEFFICIENT
+            * (speed_m_s / self.props.wave_speed_m_s).powf(0.6)
+            * loading_work_j
+    }
+
+    /// Sets up the unloading curve at a turning point (docs/physics.md §3): the peak it starts
+    /// from and the elastic recovery δe by the chosen rule, then δe shortened by the vibration
+    /// loss and so that the curve returns no more than the contact has absorbed (passivity).
+    fn turn(&self, h: &mut ContactHistory) {
+        let (fmax, recovery) = match self.unloading {
+            Unloading::Static => {
+                let f = self.static_curve.force(h.delta_max_m);
+                h.yielded = self.static_curve.region(h.delta_max_m) != Region::Hertz;
+                if h.yielded {
+                    let (_, dr) = self.thornton_unloading(h.delta_max_m, f);
+                    (f, h.delta_max_m - dr)
+                } else {
+                    // Elastic: back down the Hertz curve, exactly conservative.
+                    h.force_max_n = f;
+                    h.unloading_radius_m = self.props.radius_m;
+                    h.residual_delta_m = 0.0;
+                    return;
+                }
+            }
+            Unloading::Authors | Unloading::Dynamic => {
+                let f = h.peak_force_n.max(h.force_max_n);
+                let sy = if self.unloading == Unloading::Dynamic {
+                    h.peak_yield_stress_pa
+                } else {
+                    self.props.yield_stress_pa
+                };
+                if h.yielded {
+                    let (_, dr) = self.thornton_unloading_at(h.delta_max_m, f, sy);
+                    (f, h.delta_max_m - dr)
+                } else if self.unloading == Unloading::Authors {
+                    h.force_max_n = h.force_max_n.max(f);
+                    h.unloading_radius_m = self.props.radius_m;
+                    h.residual_delta_m = 0.0;
+                    return;
+                } else {
+                    // Never yielded: Hertzian recovery of the whole approach, from the peak force.
+                    (f, h.delta_max_m)
+                }
+            }
+        };
+        // The vibration loss comes out of the returned energy; what is returned never exceeds
+        // what the contact absorbed (passivity for any region II and rate history).
+        let loss = self.vibration_loss_j(h.peak_loading_speed_m_s, h.loading_work_j);
+        let returned = (unloading_energy_j(fmax, recovery.min(h.delta_max_m)) - loss)
+            .min(h.work_j - loss)
+            .max(0.0);
+        let recovery = returned / (0.4 * fmax);
+        // Keep a curve (a vanishing recovery would be a vertical drop of the force).
+        let recovery = recovery.max(1e-6 * h.delta_max_m);
+        h.force_max_n = fmax;
+        h.residual_delta_m = h.delta_max_m - recovery;
+        // F = (4/3) E* √Rp δe^{3/2} = Fmax.
+        let sqrt_rp = 3.0 * fmax / (4.0 * self.props.e_star_pa * recovery.powf(1.5));
+        h.unloading_radius_m = sqrt_rp * sqrt_rp;
     }
 }
 
@@ -552,53 +693,54 @@ impl ContactLaw for BurgoyneDaraio {
         approach_speed_m_s: f64,
     ) -> ContactEval {
         let rate = self.strain_rate(approach_speed_m_s);
-        if delta_m >= h.delta_max_m && delta_m > 0.0 {
+        let eval = if delta_m >= h.delta_max_m && delta_m > 0.0 {
             // Loading on the virgin curve at the current rate.
             let curve = self.curve_at(rate);
             let f = curve.force(delta_m);
             h.delta_max_m = delta_m;
             h.force_max_n = f;
+            if f > h.peak_force_n {
+                h.peak_force_n = f;
+                h.peak_yield_stress_pa = curve.yield_stress_pa;
+            }
+            h.peak_loading_speed_m_s = h.peak_loading_speed_m_s.max(approach_speed_m_s);
             if curve.region(delta_m) != Region::Hertz {
                 h.yielded = true;
             }
             h.unloading_radius_m = 0.0;
             h.residual_delta_m = 0.0;
-            return ContactEval {
+            h.loading_work_j += 0.5 * (h.last_force_n + f) * (delta_m - h.last_delta_m);
+            ContactEval {
                 force_n: f,
                 yield_stress_pa: curve.yield_stress_pa,
                 strain_rate_per_s: rate,
-            };
-        }
-        // Unloading or reloading below δmax: elastic on the unloading curve.
-        if h.unloading_radius_m == 0.0 && h.force_max_n > 0.0 {
-            // At the turning point the approach speed is zero, so σy* = σy there (paper Eq. 2):
-            // unloading starts from the static loading curve at δmax. (The last loading step's
-            // rate is an arbitrary small number whose logarithm would make Fmax depend on Δt.)
-            h.force_max_n = self.static_curve.force(h.delta_max_m);
-            h.yielded = self.static_curve.region(h.delta_max_m) != Region::Hertz;
-            if h.yielded {
-                let (rp, dr) = self.thornton_unloading(h.delta_max_m, h.force_max_n);
-                h.unloading_radius_m = rp;
-                h.residual_delta_m = dr;
-            } else {
-                h.unloading_radius_m = self.props.radius_m;
-                h.residual_delta_m = 0.0;
             }
-        }
-        let f = if h.unloading_radius_m > 0.0 {
-            hertz_force(
-                self.props.e_star_pa,
-                h.unloading_radius_m,
-                delta_m - h.residual_delta_m,
-            )
         } else {
-            0.0
+            // Unloading or reloading below δmax: elastic on the unloading curve.
+            if h.unloading_radius_m == 0.0 && h.delta_max_m > 0.0 {
+                self.turn(h);
+                h.loading_work_j = 0.0;
+                h.peak_loading_speed_m_s = 0.0;
+            }
+            let f = if h.unloading_radius_m > 0.0 {
+                hertz_force(
+                    self.props.e_star_pa,
+                    h.unloading_radius_m,
+                    delta_m - h.residual_delta_m,
+                )
+            } else {
+                0.0
+            };
+            ContactEval {
+                force_n: f,
+                yield_stress_pa: self.props.yield_stress_pa,
+                strain_rate_per_s: rate,
+            }
         };
-        ContactEval {
-            force_n: f,
-            yield_stress_pa: self.props.yield_stress_pa,
-            strain_rate_per_s: rate,
-        }
+        h.work_j += 0.5 * (h.last_force_n + eval.force_n) * (delta_m.max(0.0) - h.last_delta_m);
+        h.last_delta_m = delta_m.max(0.0);
+        h.last_force_n = eval.force_n;
+        eval
     }
 
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64 {
@@ -643,14 +785,24 @@ impl LawKind {
         self.build_with(props, Region2Form::Smooth)
     }
 
-    /// Builds the law with the chosen form of region II (ignored by Hertz).
+    /// Builds the law with the chosen form of region II (ignored by Hertz) and default unloading.
     pub fn build_with(self, props: ContactProperties, region2: Region2Form) -> Box<dyn Contact> {
+        self.build_options(props, region2, Unloading::default())
+    }
+
+    /// Builds the law with the chosen form of region II and unloading rule (both ignored by Hertz).
+    pub fn build_options(
+        self,
+        props: ContactProperties,
+        region2: Region2Form,
+        unloading: Unloading,
+    ) -> Box<dyn Contact> {
         match self {
-            LawKind::BurgoyneDaraio => Box::new(Stateful::new(BurgoyneDaraio::with_form(
-                props, true, region2,
+            LawKind::BurgoyneDaraio => Box::new(Stateful::new(BurgoyneDaraio::with_options(
+                props, true, region2, unloading,
             ))),
-            LawKind::RateIndependent => Box::new(Stateful::new(BurgoyneDaraio::with_form(
-                props, false, region2,
+            LawKind::RateIndependent => Box::new(Stateful::new(BurgoyneDaraio::with_options(
+                props, false, region2, unloading,
             ))),
             LawKind::Hertz => Box::new(Stateful::new(Hertz {
                 e_star_pa: props.e_star_pa,
@@ -681,6 +833,7 @@ mod tests {
                 c: 0.035,
                 reference_rate_per_s: 1e-3,
             },
+            wave_speed_m_s: (204e9f64 / 7800.0).sqrt(),
         }
     }
 
@@ -777,7 +930,8 @@ mod tests {
 
     #[test]
     fn thornton_unloading_starts_at_the_peak_force_and_ends_at_the_residual_approach() {
-        let law = BurgoyneDaraio::new(ss440c(), false);
+        let law =
+            BurgoyneDaraio::with_options(ss440c(), false, Region2Form::Smooth, Unloading::Static);
         let mut h = ContactHistory::default();
         let dmax = 2.0 * law.static_curve().fit.delta_p_m;
         let fmax = law.evaluate(&mut h, dmax, 1.0).force_n;
@@ -793,5 +947,187 @@ mod tests {
         assert!(down < law.loading_force(d, 0.0));
         assert_eq!(law.evaluate(&mut h, 0.9 * dr, -1.0).force_n, 0.0);
         assert_relative_eq!(law.zero_force_approach(&h), dr, max_relative = 1e-12);
+    }
+
+    /// The authors' dynamic-FEM sphere material (E 200 GPa, ν 0.3, ρ 7650 kg/m³, σy 1896 MPa,
+    /// Johnson–Cook C = 0.05 at 1e-3 1/s), 6.35 mm spheres: `restitution.csv`'s set-up.
+    fn fem_steel() -> crate::specimen::SpherePair {
+        crate::specimen::SpherePair::paper(crate::material::Material {
+            name: "fem-steel".into(),
+            density_kg_m3: 7650.0,
+            youngs_modulus_pa: 200e9,
+            poisson_ratio: 0.3,
+            yield_stress_pa: 1896e6,
+            rate: JohnsonCook {
+                c: 0.05,
+                reference_rate_per_s: 1e-3,
+            },
+        })
+    }
+
+    /// A free collision at `speed` with 2000 steps per Hertz contact time: (e, KE before, ∮F dδ).
+    fn collide(
+        pair: &crate::specimen::SpherePair,
+        law: &dyn Contact,
+        speed: f64,
+    ) -> (f64, f64, f64) {
+        let p = pair.contact_properties();
+        let tc = crate::solver::hertz_impact_duration(
+            pair.reduced_mass_kg(),
+            p.e_star_pa,
+            p.radius_m,
+            speed,
+        );
+        let setup = crate::solver::CollisionSetup {
+            velocity1_m_s: speed,
+            velocity2_m_s: 0.0,
+            dt_s: tc / 2000.0,
+            max_time_s: 1000.0 * tc,
+            output_every: 1000,
+        };
+        let r = crate::solver::collision(law, pair, &setup).expect("collision runs");
+        (r.restitution, r.kinetic_energy_before_j, r.dissipated_j)
+    }
+
+    #[test]
+    fn below_yield_the_dynamic_rule_loses_exactly_the_vibration_energy_and_static_none() {
+        // An impact that stays in region I: the static rule unloads down the Hertz curve (e = 1
+        // to round-off); the dynamic rule returns the loading work less k (v/c0)^{3/5} of it,
+        // so e² = 1 − k (v/c0)^{3/5} (the largest approach speed is the impact speed).
+        let pair = fem_steel();
+        let p = pair.contact_properties();
+        let speed = 0.05;
+        let stat = LawKind::BurgoyneDaraio.build_options(p, Region2Form::Smooth, Unloading::Static);
+        let (e, _, _) = collide(&pair, stat.as_ref(), speed);
+        assert_relative_eq!(e, 1.0, max_relative = 1e-9);
+        let dynamic = LawKind::BurgoyneDaraio.build(p);
+        let (e, _, _) = collide(&pair, dynamic.as_ref(), speed);
+        let expected =
+            (1.0 - VIBRATION_LOSS_COEFFICIENT * (speed / p.wave_speed_m_s).powf(0.6)).sqrt();
+        // The loading work is integrated over steps (second order at 2000 steps a contact).
+        assert_relative_eq!(e, expected, max_relative = 1e-6);
+    }
+
+    #[test]
+    fn rate_hardening_raises_restitution_under_the_dynamic_rule_as_in_the_fem() {
+        // The authors' dynamic FEM: Johnson–Cook raises e over the plastic run by 0.11–0.13 at
+        // 10–100 m/s. The static rule (shpb before issue 17) lowered it.
+        let pair = fem_steel();
+        let p = pair.contact_properties();
+        for speed in [10.0, 50.0] {
+            let e = |kind: LawKind, rule| {
+                collide(
+                    &pair,
+                    kind.build_options(p, Region2Form::Smooth, rule).as_ref(),
+                    speed,
+                )
+                .0
+            };
+            let dynamic = e(LawKind::BurgoyneDaraio, Unloading::Dynamic)
+                - e(LawKind::RateIndependent, Unloading::Dynamic);
+            assert!(dynamic > 0.08, "{speed} m/s: rise {dynamic}");
+            let old = e(LawKind::BurgoyneDaraio, Unloading::Static)
+                - e(LawKind::RateIndependent, Unloading::Static);
+            assert!(old < 0.0, "{speed} m/s: static rule rise {old}");
+        }
+    }
+
+    /// A material drawn by the passivity property tests.
+    fn any_material() -> impl proptest::strategy::Strategy<Value = crate::material::Material> {
+        use proptest::prelude::*;
+        (
+            1e3f64..2e4,
+            50e9f64..400e9,
+            0.2f64..0.4,
+            100e6f64..3e9,
+            0.0f64..0.1,
+        )
+            .prop_map(|(rho, e, nu, sy, c)| crate::material::Material {
+                name: "drawn".into(),
+                density_kg_m3: rho,
+                youngs_modulus_pa: e,
+                poisson_ratio: nu,
+                yield_stress_pa: sy,
+                rate: JohnsonCook {
+                    c,
+                    reference_rate_per_s: 1e-3,
+                },
+            })
+    }
+
+    fn any_options() -> impl proptest::strategy::Strategy<Value = (LawKind, Region2Form, Unloading)>
+    {
+        use proptest::prelude::*;
+        (
+            prop::sample::select(LawKind::ALL.map(|(_, k)| k).to_vec()),
+            prop::sample::select(vec![Region2Form::Smooth, Region2Form::Published]),
+            prop::sample::select(Unloading::ALL.map(|(_, u)| u).to_vec()),
+        )
+    }
+
+    /// How far a collision may appear to exceed e = 1: when the passivity guard makes a contact
+    /// return exactly what it absorbed, the trapezoidal sum of the discrete unloading differs from
+    /// the curve's integral by O((Δt/tc)²) = 2.5e-7 at 2000 steps per contact (largest seen
+    /// 3e-7). The unguarded published region II gave 7e-3 to 2.6e-2 (issue 17).
+    const PASSIVE_WITHIN: f64 = 1e-6;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(96))]
+
+        /// Passivity of every law, region-II form and unloading rule in free collisions of two
+        /// spheres (same or different materials and sizes) from 0.05 to 150 m/s: restitution
+        /// ≤ 1 and dissipated energy ≥ 0, within [`PASSIVE_WITHIN`].
+        #[test]
+        fn every_law_is_passive_in_collisions(
+            m1 in any_material(),
+            m2 in any_material(),
+            d1 in 1e-3f64..2e-2,
+            d2 in 1e-3f64..2e-2,
+            log_speed in (0.05f64).ln()..(150f64).ln(),
+            (kind, form, rule) in any_options(),
+        ) {
+            let pair = crate::specimen::SpherePair {
+                sphere1: crate::specimen::Sphere::full(m1, d1 / 2.0),
+                sphere2: crate::specimen::Sphere::full(m2, d2 / 2.0),
+            };
+            let law = kind.build_options(pair.contact_properties(), form, rule);
+            let (e, ke, dissipated) = collide(&pair, law.as_ref(), log_speed.exp());
+            proptest::prop_assert!(e <= 1.0 + PASSIVE_WITHIN, "restitution {e}");
+            proptest::prop_assert!(dissipated >= -PASSIVE_WITHIN * ke, "dissipated {dissipated} of {ke}");
+        }
+
+        /// Passivity under any history: along a random zig-zag of the approach (loading,
+        /// unloading, reloading past δmax, at random rates) the net work ∮F dδ done on the
+        /// contact never falls below zero beyond the trapezoidal rule's error (1e-6 of the work
+        /// put in): a contact never returns more energy than it received.
+        #[test]
+        fn no_history_makes_a_contact_return_more_than_it_received(
+            m in any_material(),
+            (kind, form, rule) in any_options(),
+            turns in proptest::collection::vec((0.0f64..1.0, -5.0f64..2.0), 1..8),
+        ) {
+            let pair = crate::specimen::SpherePair::paper(m);
+            let p = pair.contact_properties();
+            let mut law = kind.build_options(p, form, rule);
+            let scale = 40.0 * LoadingCurve::new(p.e_star_pa, p.radius_m, p.yield_stress_pa).delta_y_m;
+            let (mut delta, mut force, mut work, mut put_in) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+            for (target, log_speed) in turns {
+                let target = target * scale;
+                let speed = 10f64.powf(log_speed);
+                // 2000 steps a leg: the trapezoidal rule's error is then below 1e-7 of the work.
+                let n = 2000;
+                let step = (target - delta) / n as f64;
+                for _ in 0..n {
+                    let next = delta + step;
+                    let f = law.evaluate(next, step.signum() * speed).force_n;
+                    let dw = 0.5 * (force + f) * (next - delta);
+                    work += dw;
+                    put_in += dw.max(0.0);
+                    delta = next;
+                    force = f;
+                    proptest::prop_assert!(work >= -1e-6 * put_in, "net work {work} of {put_in}");
+                }
+            }
+        }
     }
 }

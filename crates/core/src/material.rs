@@ -56,4 +56,9 @@ impl Material {
     pub fn plane_strain_modulus_pa(&self) -> f64 {
         self.youngs_modulus_pa / (1.0 - self.poisson_ratio * self.poisson_ratio)
     }
+
+    /// Bar wave speed c0 = √(E/ρ), m/s.
+    pub fn wave_speed_m_s(&self) -> f64 {
+        (self.youngs_modulus_pa / self.density_kg_m3).sqrt()
+    }
 }

@@ -40,6 +40,8 @@ pub struct ContactProperties {
     pub yield_stress_pa: f64,
     /// Rate hardening of the sphere with the smaller yield stress (paper Eq. 2).
     pub rate: JohnsonCook,
+    /// Bar wave speed c0 = √(E/ρ) of the slower sphere, m/s (vibration loss, docs/physics.md §3).
+    pub wave_speed_m_s: f64,
 }
 
 /// Largest approach δ, as a fraction of the smaller sphere radius, over which the contact law
@@ -85,6 +87,7 @@ impl SpherePair {
             sum_of_radii_m: a.radius_m + b.radius_m,
             yield_stress_pa: weaker.material.yield_stress_pa,
             rate: weaker.material.rate,
+            wave_speed_m_s: a.material.wave_speed_m_s().min(b.material.wave_speed_m_s()),
         }
     }
 
