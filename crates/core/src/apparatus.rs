@@ -107,6 +107,8 @@ pub struct SpecimenSetup {
     pub law: crate::contact::LawKind,
     /// Form of region II of the loading law.
     pub region2: crate::contact::Region2Form,
+    /// Unloading rule of the contact law.
+    pub unloading: crate::contact::Unloading,
 }
 
 /// Options of a bar run (what a `pulse` or `shpb` scene sets).
@@ -184,6 +186,7 @@ impl Apparatus {
                         props: sp.pair.contact_properties(),
                         law: sp.law,
                         region2: sp.region2,
+                        unloading: sp.unloading,
                     });
                     // Each sphere's mass joins its bar's end node (the paper's DEM).
                     end_masses.push((1, true, sp.pair.sphere1.mass_kg));

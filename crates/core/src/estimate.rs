@@ -195,7 +195,7 @@ pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{LawKind, Region2Form};
+    use crate::contact::{LawKind, Region2Form, Unloading};
     use crate::fidelity::Fidelity;
     use crate::solver::{CollisionSetup, ForceDrivenSetup, ForceHistory};
 
@@ -208,6 +208,7 @@ mod tests {
             law: LawKind::BurgoyneDaraio,
             fidelity: Fidelity::Standard,
             region2: Region2Form::Smooth,
+            unloading: Unloading::default(),
             params: p,
         }
     }

@@ -4,7 +4,7 @@
 
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::bar::Dispersion;
-use crate::contact::{Contact, Degenerate, LawKind, LoadingCurve, Region2Form};
+use crate::contact::{Contact, Degenerate, LawKind, LoadingCurve, Region2Form, Unloading};
 use crate::error::{Result, format_si};
 use crate::fidelity::Fidelity;
 use crate::material::JOHNSON_COOK_RATE_LIMIT_PER_S;
@@ -77,6 +77,8 @@ pub struct Params {
     pub fidelity: Fidelity,
     /// Form of region II of the loading law (`smooth` C¹ default, or `published`).
     pub region2: Region2Form,
+    /// Unloading rule of the contact law (`dynamic` default, `static`, `authors`).
+    pub unloading: Unloading,
     /// Kind-specific parameters.
     pub params: SceneParams,
 }
@@ -85,7 +87,7 @@ impl Params {
     /// The contact law of this scene.
     pub fn contact_law(&self) -> Box<dyn Contact> {
         self.law
-            .build_with(self.pair.contact_properties(), self.region2)
+            .build_options(self.pair.contact_properties(), self.region2, self.unloading)
     }
 
     /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).

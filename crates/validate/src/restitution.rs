@@ -415,7 +415,7 @@ fn fem_section(md: &mut String, checks: &mut Vec<Check>) -> Result<Vec<Series>> 
     let _ = writeln!(
         md,
         "\nThe FEM's elastic runs lose 1.4–2.8 % of the impact energy at 5–50 m/s (`restitution_elastic` \
-         of the history file), the same order as the vibration loss k (v/c0)^{{3/5}} = 1.0–4.0 %: \
+         of the history file), the same order as the vibration loss W_vib/(W_el + W_vib) = 1.1–4.2 %: \
          independent support for the term, which the plastic runs alone could not separate from \
          the unloading curve.\n"
     );

@@ -290,7 +290,7 @@ mod tests {
     //! Chains of rigid spheres through the general chain solver, against Hertz impact theory
     //! (Johnson, Contact Mechanics §11.4) and the conservation of momentum and energy.
     use super::*;
-    use crate::contact::{LawKind, Region2Form};
+    use crate::contact::{LawKind, Region2Form, Unloading};
     use crate::solver::body::MassSpec;
     use crate::solver::{hertz_impact_duration, record::Recorder};
 
@@ -336,6 +336,7 @@ mod tests {
                     props: p,
                     law: LawKind::Hertz,
                     region2: Region2Form::Smooth,
+                    unloading: Unloading::Static,
                 };
                 n - 1
             ],

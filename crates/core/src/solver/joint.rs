@@ -14,7 +14,7 @@
 //!   average approach and the centred approach rate (the law's memory is committed once a step).
 
 use super::body::Body;
-use crate::contact::{Contact, ContactEval, LawKind, Region2Form};
+use crate::contact::{Contact, ContactEval, LawKind, Region2Form, Unloading};
 use crate::shaper::{PulseShaper, ShaperState};
 use crate::specimen::ContactProperties;
 
@@ -34,6 +34,8 @@ pub enum Joint {
         law: LawKind,
         /// Form of region II.
         region2: Region2Form,
+        /// Unloading rule.
+        unloading: Unloading,
     },
 }
 
@@ -63,7 +65,8 @@ impl JointState {
                 props,
                 law,
                 region2,
-            } => Some(law.build_with(props, region2)),
+                unloading,
+            } => Some(law.build_options(props, region2, unloading)),
             _ => None,
         };
         let contact = match &law {

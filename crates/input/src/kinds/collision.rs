@@ -1,7 +1,9 @@
 //! `kind = "collision"`: two free spheres with initial velocities (restitution, contact time, peak
 //! force, energy dissipated).
 
-use super::{Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, check_every, one};
+use super::{
+    Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, UNLOADING, check_every, one,
+};
 use crate::error::{Result, Validator};
 use crate::toml_file::parse_as;
 use shpb_core::fidelity::Fidelity;
@@ -17,6 +19,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         SPECIMEN,
         LAW,
         REGION2,
+        UNLOADING,
         Key {
             key: "velocity1_m_s",
             unit: "m/s",
@@ -125,7 +128,7 @@ mod tests {
     fn registry_entry() {
         super::super::check_kind(&KIND, &[]);
         let steps = Fidelity::ALL.map(|f| f.dem_steps().to_string()).join(", ");
-        assert_eq!(KIND.keys[6].default, format!("fidelity: {steps}"));
+        assert_eq!(KIND.keys[7].default, format!("fidelity: {steps}"));
     }
 
     #[test]

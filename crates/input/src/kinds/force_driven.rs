@@ -1,7 +1,9 @@
 //! `kind = "force-driven"`: the paper's Fig. 4 DEM, a measured force history (CSV) drives sphere 1
 //! and sphere 2 rests on a medium of impedance Z.
 
-use super::{Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, check_every, one};
+use super::{
+    Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SPECIMEN, SceneKind, UNLOADING, check_every, one,
+};
 use crate::csv::{CsvTable, SignConvention};
 use crate::error::{Error, Result, Validator};
 use crate::toml_file::parse_as;
@@ -19,6 +21,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         SPECIMEN,
         LAW,
         REGION2,
+        UNLOADING,
         Key {
             key: "force_csv",
             unit: "",
@@ -221,17 +224,17 @@ mod tests {
     fn registry_entry() {
         super::super::check_kind(&KIND, &[]);
         let steps = Fidelity::ALL.map(|f| f.dem_steps().to_string()).join(", ");
-        assert_eq!(KIND.keys[9].default, format!("fidelity: {steps}"));
+        assert_eq!(KIND.keys[10].default, format!("fidelity: {steps}"));
         assert!(
-            KIND.keys[7]
+            KIND.keys[8]
                 .default
                 .starts_with(&format!("{:.2e} ", default_impedance()))
         );
-        assert_eq!(KIND.keys[4].default, default_time_column());
-        assert_eq!(KIND.keys[5].default, default_force_column());
-        assert_eq!(KIND.keys[6].default, SignConvention::NAMES[0].0);
+        assert_eq!(KIND.keys[5].default, default_time_column());
+        assert_eq!(KIND.keys[6].default, default_force_column());
+        assert_eq!(KIND.keys[7].default, SignConvention::NAMES[0].0);
         for (name, _) in SignConvention::NAMES {
-            assert!(KIND.keys[6].meaning.contains(name));
+            assert!(KIND.keys[7].meaning.contains(name));
         }
     }
 

@@ -9,7 +9,7 @@
 
 use crate::error::{Result, Validator};
 use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::contact::{LawKind, Region2Form, Unloading};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use shpb_core::specimen::SpherePair;
@@ -41,6 +41,10 @@ macro_rules! sphere_scene_file {
             law: shpb_core::contact::LawKind,
             #[serde(default, with = "super::Region2Toml")]
             region2: shpb_core::contact::Region2Form,
+            /// Read again by `Params::from_toml` (common to every sphere scene).
+            #[allow(dead_code)]
+            #[serde(default, with = "super::UnloadingToml")]
+            unloading: shpb_core::contact::Unloading,
             $($(#[$fmeta])* $field: $ty,)*
         }
     };
@@ -307,6 +311,14 @@ const REGION2: Key = Key {
     meaning: "region II of the loading law: smooth (C¹ at the yield point) or published (as printed in the paper)",
 };
 
+/// `unloading = "..."`.
+const UNLOADING: Key = Key {
+    key: "unloading",
+    unit: "",
+    default: "dynamic",
+    meaning: "unloading after yield: dynamic (from the largest force reached and the rate-hardened yield stress, less vibration loss), static (from the static curve at the largest approach) or authors (as the authors' code)",
+};
+
 /// `output_every = n`.
 const OUTPUT_EVERY: Key = Key {
     key: "output_every",
@@ -333,6 +345,15 @@ fn check_max_displacement(v: &Validator, value_m: f64, pair: &SpherePair) -> Res
         0.5 * pair.sphere1.radius_m.min(pair.sphere2.radius_m),
         "m",
     )
+}
+
+/// `unloading = "..."`: the scene names of [`Unloading`].
+#[derive(Deserialize)]
+#[serde(remote = "Unloading", rename_all = "kebab-case")]
+enum UnloadingToml {
+    Dynamic,
+    Static,
+    Authors,
 }
 
 /// `region2 = "..."`: the scene names of [`Region2Form`].

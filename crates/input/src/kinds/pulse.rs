@@ -2,7 +2,7 @@
 //! set-up). Also the parser of [`super::shpb`], which is the same scene with spheres between the
 //! bars: [`parse_bars`] with `is_test`.
 
-use super::{Key, LawKindToml, Parsed, Region2Toml, SceneKind};
+use super::{Key, LawKindToml, Parsed, Region2Toml, SceneKind, UnloadingToml};
 use crate::error::{Result, Validator};
 use crate::material::MaterialFile;
 use crate::setup::{ApparatusFile, ShaperOverride};
@@ -11,7 +11,7 @@ use crate::toml_file::parse_as;
 use serde::Deserialize;
 use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb_core::bar::Dispersion;
-use shpb_core::contact::{LawKind, Region2Form};
+use shpb_core::contact::{LawKind, Region2Form, Unloading};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use shpb_core::specimen::SpherePair;
@@ -109,6 +109,8 @@ struct PulseFile {
     law: LawKind,
     #[serde(default, with = "Region2Toml")]
     region2: Region2Form,
+    #[serde(default, with = "UnloadingToml")]
+    unloading: Unloading,
     bars: String,
     pressure: String,
     #[serde(default)]
@@ -157,6 +159,7 @@ pub(super) fn parse_bars(
             pair: spec.build(base_dir, &sv)?,
             law: f.law,
             region2: f.region2,
+            unloading: f.unloading,
         }),
         (None, true) => {
             return Err(v.error(
@@ -315,8 +318,9 @@ mod tests {
 
     #[test]
     fn registry_entry() {
-        // A pulse scene accepts but refuses `specimen`, and has no use for `law` and `region2`.
-        super::super::check_kind(&KIND, &["specimen", "law", "region2"]);
+        // A pulse scene accepts but refuses `specimen`, and has no use for `law`, `region2` and
+        // `unloading`.
+        super::super::check_kind(&KIND, &["specimen", "law", "region2", "unloading"]);
         check_bar_key_docs();
         assert_eq!(KIND.keys[4].default, default_incident_end());
     }

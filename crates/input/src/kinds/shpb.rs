@@ -2,7 +2,7 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
-use super::{LAW, Parsed, REGION2, SPECIMEN, SceneKind};
+use super::{LAW, Parsed, REGION2, SPECIMEN, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
 use shpb_core::fidelity::Fidelity;
 use std::path::Path;
@@ -15,6 +15,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         SPECIMEN,
         LAW,
         REGION2,
+        UNLOADING,
         BARS,
         PRESSURE,
         SHAPER,
