@@ -329,6 +329,10 @@ pub fn run(_ctx: &Context) -> Result<CaseResult> {
     })
 }
 
+/// One row of the FEM table: speed, source, FEM (plastic, Johnson–Cook), the model with the
+/// dynamic rule and with the static rule (rate-independent, rate-dependent).
+type FemRow = (f64, &'static str, [f64; 2], [f64; 2], [f64; 2]);
+
 /// The comparison with the authors' dynamic FEM (issue 17): checks at the four speeds of
 /// `fem_restitution.csv`, information rows for the speeds of the force histories and for the
 /// static rule, a table in `md`; returns the series of panel (c).
@@ -369,7 +373,7 @@ fn fem_section(md: &mut String, checks: &mut Vec<Check>) -> Result<Vec<Series>> 
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|");
     let mut points: Vec<(Vec<f64>, Vec<f64>)> = vec![(vec![], vec![]), (vec![], vec![])];
-    let mut table: Vec<(f64, &str, [f64; 2], [f64; 2], [f64; 2])> = Vec::new();
+    let mut table: Vec<FemRow> = Vec::new();
     let sources = fem.iter().map(|r| (r[0], [r[1], r[2]], "FEM")).chain(
         history
             .iter()
