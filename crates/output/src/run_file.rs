@@ -189,6 +189,7 @@ mod tests {
             summary: vec![item("peak_contact_force", 7.5, "N")],
             reduction: None,
             warnings: vec!["a warning".into()],
+            chain: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.h5");
