@@ -151,7 +151,7 @@ impl Params {
                     ));
                 }
                 match &options.specimen {
-                    Some(sp) => (&sp.pair, sp.law),
+                    Some(sp) => (&sp.spheres.pair(0), sp.law),
                     None => return w,
                 }
             }
@@ -649,7 +649,7 @@ fn reduce_simulated_records(
     };
     let reduction_options = crate::reduce::ReductionOptions {
         dispersion_correction: options.dispersion != Dispersion::None,
-        specimen_radii_m: Some((spec.pair.sphere1.radius_m, spec.pair.sphere2.radius_m)),
+        specimen_radii_m: Some(specimen_radii_m(&spec.spheres)),
         smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
         ..Default::default()
     };
@@ -658,6 +658,14 @@ fn reduce_simulated_records(
         &crate::reduce::ReductionSetup::from_apparatus(apparatus)?,
         &reduction_options,
     )
+}
+
+/// The two lengths whose sum divides the reduced approach rate into the global strain rate:
+/// (r1, r2) of a pair; for a longer chain (r1, r2 + … + rN), so that the rate is δ̇/Σ rᵢ over
+/// the whole specimen (docs/physics.md §10).
+pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
+    let r = &chain.spheres;
+    (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
 }
 
 /// Summary items of the reduction of a simulated test (`reduced_*`).
