@@ -1,4 +1,4 @@
-//! Chains of spheres (issue 17 part 2, docs/physics.md §10): the `chain` scene against the
+//! Chains of spheres (issue 17 part 2, docs/physics.md §8): the `chain` scene against the
 //! `collision` scene for two spheres, the full SHPB test with a chain specimen against the pair
 //! test, a longer chain between the bars, and the `/chain` layout of the run file.
 

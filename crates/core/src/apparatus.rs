@@ -185,7 +185,7 @@ impl Apparatus {
                 Some(sp) if end == IncidentEnd::Specimen => {
                     // The first and last spheres' masses join their bars' end nodes (the
                     // paper's DEM); the spheres between are rigid masses, every two neighbours
-                    // joined by a contact (docs/physics.md §10).
+                    // joined by a contact (docs/physics.md §8).
                     let n = sp.spheres.len();
                     let transmission = bars.pop().expect("the transmission bar was pushed");
                     let mut bodies: Vec<crate::solver::BodySpec> =

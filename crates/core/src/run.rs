@@ -48,7 +48,7 @@ pub struct RunOutput {
     pub chain: Option<ChainSeries>,
 }
 
-/// The series of a chain of spheres, as written to `/chain` (docs/physics.md §10): contact k
+/// The series of a chain of spheres, as written to `/chain` (docs/physics.md §8): contact k
 /// (1-based) is between spheres k and k + 1.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ChainSeries {

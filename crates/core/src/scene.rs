@@ -42,7 +42,7 @@ pub enum SceneParams {
     },
     /// Free collision.
     Collision(CollisionSetup),
-    /// A free chain of N ≥ 2 spheres struck by its first sphere or a striker (docs/physics.md §10).
+    /// A free chain of N ≥ 2 spheres struck by its first sphere or a striker (docs/physics.md §8).
     Chain(Box<solver::FreeChainSetup>),
     /// Striker, shaper and bars: the gauge signals of a bar test without specimen.
     Pulse {
@@ -662,7 +662,7 @@ fn reduce_simulated_records(
 
 /// The two lengths whose sum divides the reduced approach rate into the global strain rate:
 /// (r1, r2) of a pair; for a longer chain (r1, r2 + … + rN), so that the rate is δ̇/Σ rᵢ over
-/// the whole specimen (docs/physics.md §10).
+/// the whole specimen (docs/physics.md §8).
 pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
     let r = &chain.spheres;
     (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())

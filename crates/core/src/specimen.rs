@@ -96,7 +96,7 @@ impl SpherePair {
 }
 
 /// Reduced mass m1 m2 / (m1 + m2) of two bodies, kg; an infinite mass (a fixed wall) gives the
-/// other mass (docs/physics.md §10).
+/// other mass (docs/physics.md §8).
 pub fn reduced_mass_kg(m1_kg: f64, m2_kg: f64) -> f64 {
     if m2_kg.is_infinite() {
         m1_kg
@@ -109,7 +109,7 @@ pub fn reduced_mass_kg(m1_kg: f64, m2_kg: f64) -> f64 {
 
 impl Sphere {
     /// Effective properties of this sphere pressed on a flat face (a wall or a striker) of
-    /// `flat` (None: rigid), docs/physics.md §10: E* from both moduli (the rigid flat adds no
+    /// `flat` (None: rigid), docs/physics.md §8: E* from both moduli (the rigid flat adds no
     /// compliance), r = the sphere's radius, the strain-rate length r (the sphere alone
     /// deforms over its radius), yield stress and rate hardening of the weaker material.
     pub fn against_flat(&self, flat: Option<&Material>) -> ContactProperties {
@@ -129,7 +129,7 @@ impl Sphere {
     }
 }
 
-/// N ≥ 2 spheres in a line, touching, sphere 1 first (docs/physics.md §10): each neighbouring
+/// N ≥ 2 spheres in a line, touching, sphere 1 first (docs/physics.md §8): each neighbouring
 /// two form a contact with the effective properties of a [`SpherePair`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct SphereChain {

@@ -1,4 +1,4 @@
-//! A free chain of N ≥ 2 rigid spheres in a line (docs/physics.md §10): the first sphere (or a
+//! A free chain of N ≥ 2 rigid spheres in a line (docs/physics.md §8): the first sphere (or a
 //! striker mass) strikes the others, optionally against a wall at the far end.
 //!
 //! Scheme: the two-sphere stepper's ([`super::PairStepper`]) generalised to N bodies: explicit
@@ -30,7 +30,7 @@ use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::specimen::{ContactProperties, SphereChain, reduced_mass_kg};
 
-/// A rigid striker mass with a flat face that hits sphere 1 (docs/physics.md §10).
+/// A rigid striker mass with a flat face that hits sphere 1 (docs/physics.md §8).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StrikerMass {
     /// Mass, kg.
@@ -41,7 +41,7 @@ pub struct StrikerMass {
     pub material: Option<Material>,
 }
 
-/// A fixed wall after the last sphere (docs/physics.md §10).
+/// A fixed wall after the last sphere (docs/physics.md §8).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Wall {
     /// A rigid flat: the sphere alone deforms.

@@ -1,5 +1,5 @@
 //! `kind = "chain"`: a free chain of N ≥ 2 spheres in a line, struck by its first sphere or a
-//! striker mass, optionally against a wall (docs/physics.md §10).
+//! striker mass, optionally against a wall (docs/physics.md §8).
 
 use super::{CHAIN_SPECIMEN, Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SceneKind, check_every, one};
 use crate::error::{Result, Validator};
