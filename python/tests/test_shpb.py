@@ -145,6 +145,34 @@ def test_a_dict_scene_equals_the_toml_scene():
     )
 
 
+def test_a_chain_scene_runs_from_python_with_the_numbers_of_the_cli(cli):
+    """Issue 17: a `chain` scene through `shpb.run` (file and dict) gives the summary the
+    command line prints (`--json`) and the /chain datasets, contact × time and sphere × time."""
+    import json
+
+    scene = "scenes/chain-ss440c-10.toml"
+    r = shpb.run(scene)
+    printed = json.loads(cli("run", scene, "--json").stdout)["summary"]
+    assert set(r.summary) == set(printed)
+    for k, v in printed.items():
+        assert r.summary[k] == v["value"], k
+    t = r["chain/time"]
+    assert r["chain/contact_force"].shape == (9, t.size)
+    assert r["chain/contact_approach"].shape == (9, t.size)
+    assert r["chain/velocity"].shape == (10, t.size)
+    assert (r.units["chain/contact_force"], r.units["chain/velocity"]) == ("N", "m/s")
+    # Momentum of the free chain: sphere 1's initial 5 m/s shared by ten equal spheres.
+    assert abs(r["chain/final_velocity"].sum() - 5.0) < 1e-10
+    scene_dict = {
+        "kind": "chain",
+        "law": "burgoyne-daraio",
+        "velocity1_m_s": 5.0,
+        "end_time_s": 75e-6,
+        "specimen": {"count": 10, "material": "ss440c", "diameter_m": 6.35e-3},
+    }
+    assert_runs_equal(shpb.run(scene_dict), r)
+
+
 def test_a_saved_dict_scene_reruns_from_its_file(cli, tmp_path):
     r = shpb.run({"kind": "collision", "velocity1_m_s": 3.0, "specimen": {"pair": "ss440c"}})
     r.save(tmp_path / "d.h5")

@@ -334,7 +334,9 @@ fn run_if_cheap(p: &Params) -> Result<(), TestCaseError> {
             );
             tc.is_finite() && tc / setup.dt_s <= 5e4
         }
-        SceneParams::Pulse { .. } | SceneParams::ForceDriven { .. } => false,
+        SceneParams::Pulse { .. } | SceneParams::ForceDriven { .. } | SceneParams::Chain(_) => {
+            false
+        }
     };
     if cheap && let Err(e) = p.run() {
         prop_assert!(!e.to_string().trim().is_empty(), "empty run error");

@@ -895,6 +895,7 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
         summary: Vec::new(),
         reduction: None,
         warnings: Vec::new(),
+        chain: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run.h5");

@@ -98,11 +98,12 @@ pub enum IncidentEnd {
     Specimen,
 }
 
-/// The specimen of a full test: the sphere pair and its contact law.
+/// The specimen of a full test: two or more spheres in a line and their contact law.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpecimenSetup {
-    /// The spheres (sphere 1 on the incident bar).
-    pub pair: crate::specimen::SpherePair,
+    /// The spheres (sphere 1 on the incident bar, the last on the transmission bar; a pair is
+    /// the chain of two).
+    pub spheres: crate::specimen::SphereChain,
     /// Contact law.
     pub law: crate::contact::LawKind,
     /// Form of region II of the loading law.
@@ -167,6 +168,8 @@ impl Apparatus {
             None => Joint::Butt,
         }];
         let mut end_masses = Vec::new();
+        let mut transmission_index = 2;
+        let mut chain_bodies = None;
         if with_transmission {
             let far = if self.transmission_absorbing {
                 EndCondition::Absorbing
@@ -182,15 +185,32 @@ impl Apparatus {
             ));
             match &o.specimen {
                 Some(sp) if end == IncidentEnd::Specimen => {
-                    joints.push(Joint::Spheres {
-                        props: sp.pair.contact_properties(),
-                        law: sp.law,
-                        region2: sp.region2,
-                        unloading: sp.unloading,
-                    });
-                    // Each sphere's mass joins its bar's end node (the paper's DEM).
-                    end_masses.push((1, true, sp.pair.sphere1.mass_kg));
-                    end_masses.push((2, false, sp.pair.sphere2.mass_kg));
+                    // The first and last spheres' masses join their bars' end nodes (the
+                    // paper's DEM); the spheres between are rigid masses, every two neighbours
+                    // joined by a contact (docs/physics.md §8).
+                    let n = sp.spheres.len();
+                    let transmission = bars.pop().expect("the transmission bar was pushed");
+                    let mut bodies: Vec<crate::solver::BodySpec> =
+                        bars.drain(..).map(Into::into).collect();
+                    for k in 0..n - 1 {
+                        joints.push(Joint::Spheres {
+                            props: sp.spheres.contact_properties(k),
+                            law: sp.law,
+                            region2: sp.region2,
+                            unloading: sp.unloading,
+                        });
+                        if k + 2 < n {
+                            bodies.push(crate::solver::BodySpec::Mass(crate::solver::MassSpec {
+                                name: format!("sphere {}", k + 2),
+                                mass_kg: sp.spheres.spheres[k + 1].mass_kg,
+                            }));
+                        }
+                    }
+                    bodies.push(transmission.into());
+                    transmission_index = bodies.len() - 1;
+                    end_masses.push((1, true, sp.spheres.spheres[0].mass_kg));
+                    end_masses.push((transmission_index, false, sp.spheres.spheres[n - 1].mass_kg));
+                    chain_bodies = Some(bodies);
                 }
                 _ => joints.push(Joint::Butt),
             }
@@ -199,7 +219,9 @@ impl Apparatus {
         for ch in &self.gauges.channels {
             let (bar, x) = match ch.bar.as_str() {
                 "incident" => (1, self.incident.length_m - ch.distance_from_specimen_m),
-                "transmission" if with_transmission => (2, ch.distance_from_specimen_m),
+                "transmission" if with_transmission => {
+                    (transmission_index, ch.distance_from_specimen_m)
+                }
                 _ => continue,
             };
             gauges.push(GaugeProbe {
@@ -211,7 +233,7 @@ impl Apparatus {
         }
         let record_every = ((1.0 / 10e6) / dt).floor().max(1.0) as usize;
         ChainSetup {
-            bodies: bars.into_iter().map(Into::into).collect(),
+            bodies: chain_bodies.unwrap_or_else(|| bars.into_iter().map(Into::into).collect()),
             joints,
             striker_velocity_m_s: o.striker_velocity_m_s,
             dt_s: dt,

@@ -15,6 +15,8 @@
 //!   a vector grows).
 //! * `force-driven`: `⌈end_time_s/Δt⌉` steps, every `output_every`-th kept (5 columns,
 //!   allocated once).
+//! * `chain`: `⌈end_time_s/Δt⌉` steps, every `output_every`-th kept: N − 1 contact forces and
+//!   approaches, N velocities, the time, the first contact's 5 series and 3 end series.
 //! * `pulse`, `shpb`: `⌈end_time_s/Δt⌉` steps of Δt = Δx/c0 over every node of the bars (the
 //!   state of a node, with the Love rod's tridiagonal factors, is counted as 256 bytes); gauges,
 //!   energies and the contact recorded at 10 MHz; x–t snapshots every `snapshot_interval_s` at
@@ -122,6 +124,22 @@ impl Params {
             SceneParams::Pulse {
                 apparatus, options, ..
             } => bar_run(apparatus, options),
+            SceneParams::Chain(setup) => {
+                // Every output_every-th step of N − 1 forces and approaches, N velocities, the
+                // time, the first contact's 5 series and 3 end series, allocated once.
+                let steps = (setup.end_time_s / setup.dt_s).ceil();
+                let samples = (steps / setup.output_every as f64).floor() + 2.0;
+                let n = setup.chain.len() as f64;
+                let columns = 3.0 * n + 7.0;
+                let bodies = n + 2.0;
+                RunEstimate {
+                    steps,
+                    degrees_of_freedom: bodies,
+                    samples_stored: samples,
+                    memory_bytes: samples * F64 * columns + bodies * 64.0,
+                    output_bytes: samples * F64 * columns,
+                }
+            }
         }
     }
 }

@@ -44,6 +44,26 @@ pub struct RunOutput {
     pub reduction: Option<crate::reduce::Reduction>,
     /// Things the user should know about the run (`/summary` attribute `warnings`, one per line).
     pub warnings: Vec<String>,
+    /// `/chain/*`: every contact and sphere of a chain of spheres (chain scenes).
+    pub chain: Option<ChainSeries>,
+}
+
+/// The series of a chain of spheres, as written to `/chain` (docs/physics.md §8): contact k
+/// (1-based) is between spheres k and k + 1.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ChainSeries {
+    /// Recording times, s.
+    pub time_s: Vec<f64>,
+    /// Force of each contact (rows: contact, columns: time), N.
+    pub contact_force_n: Vec<Vec<f64>>,
+    /// Approach δ of each contact (rows: contact, columns: time), m.
+    pub contact_approach_m: Vec<Vec<f64>>,
+    /// Velocity of each sphere (rows: sphere, columns: time), m/s.
+    pub velocity_m_s: Vec<Vec<f64>>,
+    /// Velocity of each sphere at the end, m/s.
+    pub final_velocity_m_s: Vec<f64>,
+    /// Further 1-D series on the same time axis: (name, data, units), e.g. `wall_force`.
+    pub extra: Vec<(String, Vec<f64>, &'static str)>,
 }
 
 /// One recorded gauge channel: bar strain and the digitised voltage on the `/time` axis.
@@ -69,6 +89,7 @@ impl RunOutput {
             summary,
             reduction: None,
             warnings: Vec::new(),
+            chain: None,
         }
     }
 }

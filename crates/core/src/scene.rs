@@ -42,6 +42,8 @@ pub enum SceneParams {
     },
     /// Free collision.
     Collision(CollisionSetup),
+    /// A free chain of N ≥ 2 spheres struck by its first sphere or a striker (docs/physics.md §8).
+    Chain(Box<solver::FreeChainSetup>),
     /// Striker, shaper and bars: the gauge signals of a bar test without specimen.
     Pulse {
         /// The bar set-up.
@@ -151,7 +153,7 @@ impl Params {
                     ));
                 }
                 match &options.specimen {
-                    Some(sp) => (&sp.pair, sp.law),
+                    Some(sp) => (&sp.spheres.pair(0), sp.law),
                     None => return w,
                 }
             }
@@ -269,6 +271,7 @@ impl Params {
                 pressure_pa,
                 options,
             } => run_pulse(apparatus, *pressure_pa, options, progress),
+            SceneParams::Chain(setup) => run_free_chain(setup, progress),
             SceneParams::ForceDriven {
                 setup,
                 measured_displacement_m,
@@ -524,7 +527,95 @@ fn run_pulse(
         summary,
         reduction,
         warnings,
+        chain: None,
     })
+}
+
+/// Runs a `chain` scene: the free chain, its `/chain` series and its summary (restitution of
+/// the first contact, kinetic-energy ratio, final velocities, the energy ledger).
+fn run_free_chain(
+    setup: &solver::FreeChainSetup,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<RunOutput> {
+    let r = solver::spheres::free_chain_with_progress(setup, progress)?;
+    let first = setup.first_sphere();
+    let n = setup.chain.len();
+    let spheres = first..first + n - 1;
+    let (peak_contact, peak) =
+        r.peak_force_n[spheres.clone()]
+            .iter()
+            .enumerate()
+            .fold(
+                (0, 0.0f64),
+                |(k, f), (j, &g)| if g > f { (j, g) } else { (k, f) },
+            );
+    let max_approach = r.max_approach_m[spheres.clone()]
+        .iter()
+        .copied()
+        .fold(0.0f64, f64::max);
+    let dissipated: f64 = r.contact_work_j[spheres].iter().sum();
+    let mut summary = vec![
+        item("restitution", r.first_restitution(), "1"),
+        item("kinetic_energy_ratio", r.kinetic_energy_ratio(), "1"),
+        item("peak_force", peak, "N"),
+        item("peak_force_contact", (peak_contact + 1) as f64, "1"),
+        item("max_approach", max_approach, "m"),
+        item("kinetic_energy_before", r.kinetic_energy_before_j, "J"),
+        item("kinetic_energy_after", r.kinetic_energy_after_j, "J"),
+        item("energy_dissipated", dissipated, "J"),
+    ];
+    if setup.striker.is_some() {
+        summary.push(item("striker_contact_work", r.contact_work_j[0], "J"));
+        summary.push(item(
+            "striker_final_velocity",
+            r.final_velocity_m_s[0],
+            "m/s",
+        ));
+    }
+    if setup.wall.is_some() {
+        let w = *r.contact_work_j.last().unwrap_or(&0.0);
+        summary.push(item("wall_work", w, "J"));
+        let f = *r.peak_force_n.last().unwrap_or(&0.0);
+        summary.push(item("wall_peak_force", f, "N"));
+    }
+    summary.push(item(
+        "energy_balance_max_relative_error",
+        r.energy_balance_max_relative_error,
+        "1",
+    ));
+    if setup.wall.is_none() {
+        summary.push(item(
+            "momentum_max_relative_drift",
+            r.momentum_max_relative_drift,
+            "1",
+        ));
+    }
+    summary.push(item("time_step", setup.dt_s, "s"));
+    let final_velocity: Vec<f64> = r.final_velocity_m_s[first..].to_vec();
+    for (k, v) in final_velocity.iter().enumerate() {
+        summary.push(item(&format!("final_velocity_{}", k + 1), *v, "m/s"));
+    }
+    let mut extra = Vec::new();
+    if let Some(v) = &r.striker_velocity_m_s {
+        extra.push(("striker_velocity".to_string(), v.clone(), "m/s"));
+    }
+    if let Some(f) = &r.striker_force_n {
+        extra.push(("striker_contact_force".to_string(), f.clone(), "N"));
+    }
+    if let Some(f) = &r.wall_force_n {
+        extra.push(("wall_contact_force".to_string(), f.clone(), "N"));
+    }
+    let chain = crate::run::ChainSeries {
+        time_s: r.time_s,
+        contact_force_n: r.contact_force_n,
+        contact_approach_m: r.contact_approach_m,
+        velocity_m_s: r.velocity_m_s,
+        final_velocity_m_s: final_velocity,
+        extra,
+    };
+    let mut out = RunOutput::contact_only(r.first_contact, summary);
+    out.chain = Some(chain);
+    Ok(out)
 }
 
 /// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
@@ -560,7 +651,7 @@ fn reduce_simulated_records(
     };
     let reduction_options = crate::reduce::ReductionOptions {
         dispersion_correction: options.dispersion != Dispersion::None,
-        specimen_radii_m: Some((spec.pair.sphere1.radius_m, spec.pair.sphere2.radius_m)),
+        specimen_radii_m: Some(specimen_radii_m(&spec.spheres)),
         smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
         ..Default::default()
     };
@@ -569,6 +660,14 @@ fn reduce_simulated_records(
         &crate::reduce::ReductionSetup::from_apparatus(apparatus)?,
         &reduction_options,
     )
+}
+
+/// The two lengths whose sum divides the reduced approach rate into the global strain rate:
+/// (r1, r2) of a pair; for a longer chain (r1, r2 + … + rN), so that the rate is δ̇/Σ rᵢ over
+/// the whole specimen (docs/physics.md §8).
+pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
+    let r = &chain.spheres;
+    (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
 }
 
 /// Summary items of the reduction of a simulated test (`reduced_*`).

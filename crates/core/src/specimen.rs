@@ -97,3 +97,99 @@ impl SpherePair {
         m1 * m2 / (m1 + m2)
     }
 }
+
+/// Reduced mass m1 m2 / (m1 + m2) of two bodies, kg; an infinite mass (a fixed wall) gives the
+/// other mass (docs/physics.md §8).
+pub fn reduced_mass_kg(m1_kg: f64, m2_kg: f64) -> f64 {
+    if m2_kg.is_infinite() {
+        m1_kg
+    } else if m1_kg.is_infinite() {
+        m2_kg
+    } else {
+        m1_kg * m2_kg / (m1_kg + m2_kg)
+    }
+}
+
+impl Sphere {
+    /// Effective properties of this sphere pressed on a flat face (a wall or a striker) of
+    /// `flat` (None: rigid), docs/physics.md §8: E* from both moduli (the rigid flat adds no
+    /// compliance), r = the sphere's radius, the strain-rate length r (the sphere alone
+    /// deforms over its radius), yield stress and rate hardening of the weaker material.
+    pub fn against_flat(&self, flat: Option<&Material>) -> ContactProperties {
+        let flat_compliance = flat.map_or(0.0, |m| 1.0 / m.plane_strain_modulus_pa());
+        let e_star_pa = 1.0 / (1.0 / self.material.plane_strain_modulus_pa() + flat_compliance);
+        let weaker = match flat {
+            Some(m) if m.yield_stress_pa < self.material.yield_stress_pa => m,
+            _ => &self.material,
+        };
+        ContactProperties {
+            e_star_pa,
+            radius_m: self.radius_m,
+            sum_of_radii_m: self.radius_m,
+            yield_stress_pa: weaker.yield_stress_pa,
+            rate: weaker.rate,
+            wave_speed_m_s: flat.map_or(self.material.wave_speed_m_s(), |m| {
+                m.wave_speed_m_s().min(self.material.wave_speed_m_s())
+            }),
+        }
+    }
+}
+
+/// N ≥ 2 spheres in a line, touching, sphere 1 first (docs/physics.md §8): each neighbouring
+/// two form a contact with the effective properties of a [`SpherePair`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereChain {
+    /// The spheres, in order (sphere 1 first: the struck or incident-side end).
+    pub spheres: Vec<Sphere>,
+}
+
+impl SphereChain {
+    /// The chain of a pair: sphere 1, then sphere 2.
+    pub fn from_pair(pair: &SpherePair) -> SphereChain {
+        SphereChain {
+            spheres: vec![pair.sphere1.clone(), pair.sphere2.clone()],
+        }
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.spheres.len()
+    }
+
+    /// Whether the chain has no sphere (never for a validated chain).
+    pub fn is_empty(&self) -> bool {
+        self.spheres.is_empty()
+    }
+
+    /// Number of sphere–sphere contacts, N − 1.
+    pub fn contacts(&self) -> usize {
+        self.spheres.len().saturating_sub(1)
+    }
+
+    /// Contact `k` (0-based: between spheres k + 1 and k + 2) as a pair.
+    pub fn pair(&self, k: usize) -> SpherePair {
+        SpherePair {
+            sphere1: self.spheres[k].clone(),
+            sphere2: self.spheres[k + 1].clone(),
+        }
+    }
+
+    /// Effective properties of contact `k`, exactly as the pair of its two spheres (§1).
+    pub fn contact_properties(&self, k: usize) -> ContactProperties {
+        self.pair(k).contact_properties()
+    }
+
+    /// Σ rᵢ: half the chain's length, the length of the global strain rate δ̇/Σ rᵢ of the whole
+    /// specimen (r1 + r2 for a pair, paper Eq. 3), m.
+    pub fn half_length_m(&self) -> f64 {
+        self.spheres.iter().map(|s| s.radius_m).sum()
+    }
+
+    /// The smallest sphere radius, m.
+    pub fn min_radius_m(&self) -> f64 {
+        self.spheres
+            .iter()
+            .map(|s| s.radius_m)
+            .fold(f64::INFINITY, f64::min)
+    }
+}

@@ -5,7 +5,7 @@ use crate::error::{Error, Result, Validator};
 use crate::material::MaterialFile;
 use serde::Deserialize;
 use shpb_core::material::Material;
-use shpb_core::specimen::{Sphere, SpherePair};
+use shpb_core::specimen::{Sphere, SphereChain, SpherePair};
 use std::path::Path;
 
 /// One sphere as written in a pair file or a scene's `[specimen]` table.
@@ -32,7 +32,9 @@ pub struct PairSpec {
     pub sphere2: SphereSpec,
 }
 
-/// A scene's `[specimen]` table: either `pair = "name or file"` or explicit `sphere1`/`sphere2`.
+/// A scene's `[specimen]` table: either `pair = "name or file"` or explicit `sphere1`/`sphere2`;
+/// for a chain of spheres (`chain` and `shpb` scenes) also `count` identical spheres of
+/// `material` and `diameter_m`, or one `[[specimen.sphere]]` table per sphere.
 #[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SpecimenSpec {
@@ -42,7 +44,21 @@ pub struct SpecimenSpec {
     pub sphere1: Option<SphereSpec>,
     /// Transmission-side sphere.
     pub sphere2: Option<SphereSpec>,
+    /// Number of identical spheres of a chain (2 or more).
+    pub count: Option<i64>,
+    /// Material of the `count` spheres: a built-in name or a material `.toml`.
+    pub material: Option<String>,
+    /// Diameter of the `count` spheres, m.
+    pub diameter_m: Option<f64>,
+    /// One table per sphere of a chain, sphere 1 first.
+    pub sphere: Option<Vec<SphereSpec>>,
 }
+
+/// Most spheres a chain may have.
+pub const MAX_CHAIN_SPHERES: i64 = 100_000;
+
+/// What a chain specimen may be given as, for messages.
+pub const CHAIN_FORMS: &str = "count = N (2 to 100000) with material and diameter_m, or one [[specimen.sphere]] table per sphere (2 or more, each with material and diameter_m), or pair = \"ss440c\" / [specimen.sphere1] and [specimen.sphere2] for two";
 
 impl SphereSpec {
     /// Validates this sphere; `v` reports keys under its table.
@@ -111,8 +127,110 @@ pub fn resolve_pair(
 }
 
 impl SpecimenSpec {
+    /// Whether the table gives a chain (`count`, `material`, `diameter_m` or `sphere`) rather
+    /// than a pair.
+    pub fn is_chain_form(&self) -> bool {
+        self.count.is_some()
+            || self.material.is_some()
+            || self.diameter_m.is_some()
+            || self.sphere.is_some()
+    }
+
+    /// Validates the specimen of a chain (`chain` and `shpb` scenes): any of [`CHAIN_FORMS`].
+    pub fn build_chain(&self, base_dir: &Path, v: &Validator) -> Result<SphereChain> {
+        if !self.is_chain_form() {
+            return self.build(base_dir, v).map(|p| SphereChain::from_pair(&p));
+        }
+        for (key, given) in [
+            ("pair", self.pair.is_some()),
+            ("sphere1", self.sphere1.is_some()),
+            ("sphere2", self.sphere2.is_some()),
+        ] {
+            if given {
+                return Err(v.error(
+                    key,
+                    format!("`{key}` cannot be combined with count/material/diameter_m/sphere"),
+                    CHAIN_FORMS,
+                ));
+            }
+        }
+        match (self.count, &self.sphere) {
+            (Some(_), Some(_)) => Err(v.error(
+                "count",
+                "give either `count` (with material and diameter_m) or [[specimen.sphere]] tables, not both",
+                CHAIN_FORMS,
+            )),
+            (Some(n), None) => {
+                if !(2..=MAX_CHAIN_SPHERES).contains(&n) {
+                    return Err(v.error(
+                        "count",
+                        format!("{n} is out of range"),
+                        format!("2 to {MAX_CHAIN_SPHERES}"),
+                    ));
+                }
+                let (Some(material), Some(d)) = (&self.material, self.diameter_m) else {
+                    return Err(v.error(
+                        if self.material.is_none() { "material" } else { "diameter_m" },
+                        "missing: `count` spheres need a material and a diameter_m",
+                        CHAIN_FORMS,
+                    ));
+                };
+                let sphere = SphereSpec {
+                    material: material.clone(),
+                    diameter_m: Some(d),
+                    radius_m: None,
+                    mass_kg: None,
+                }
+                .build(base_dir, v)?;
+                Ok(SphereChain {
+                    spheres: vec![sphere; n as usize],
+                })
+            }
+            (None, Some(list)) => {
+                if let Some(key) = [
+                    ("material", self.material.is_some()),
+                    ("diameter_m", self.diameter_m.is_some()),
+                ]
+                .iter()
+                .find_map(|(k, g)| g.then_some(*k))
+                {
+                    return Err(v.error(
+                        key,
+                        format!("`{key}` belongs in each [[specimen.sphere]] table (or use count)"),
+                        CHAIN_FORMS,
+                    ));
+                }
+                if list.len() < 2 || list.len() as i64 > MAX_CHAIN_SPHERES {
+                    return Err(v.error(
+                        "sphere",
+                        format!("{} sphere table(s)", list.len()),
+                        format!("2 to {MAX_CHAIN_SPHERES} [[specimen.sphere]] tables"),
+                    ));
+                }
+                let spheres = list
+                    .iter()
+                    .enumerate()
+                    .map(|(k, s)| s.build(base_dir, &v.table(&format!("sphere[{}]", k + 1))))
+                    .collect::<Result<Vec<_>>>()?;
+                Ok(SphereChain { spheres })
+            }
+            (None, None) => Err(v.error(
+                "count",
+                "missing: `material` and `diameter_m` need a `count`",
+                CHAIN_FORMS,
+            )),
+        }
+    }
+
     /// Validates the specimen table of a scene.
     pub fn build(&self, base_dir: &Path, v: &Validator) -> Result<SpherePair> {
+        if self.is_chain_form() {
+            return Err(v.error(
+                "count",
+                "a chain specimen (count, material, diameter_m, [[specimen.sphere]]) needs kind = \"chain\" or \"shpb\"",
+                "pair = \"ss440c\" (or a pair .toml), or [specimen.sphere1] and [specimen.sphere2] tables",
+            ));
+        }
         match (&self.pair, &self.sphere1, &self.sphere2) {
             (Some(p), None, None) => resolve_pair(p, base_dir, v, "pair"),
             (None, Some(a), Some(b)) => Ok(SpherePair {

@@ -101,6 +101,15 @@ fn every_repository_scene_parses_with_the_values_of_its_file() {
                     assert_eq!(s.dt_s, dt);
                 }
             }
+            SceneParams::Chain(s) => {
+                if let Some(v1) = float(t, "velocity1_m_s") {
+                    assert_eq!(s.velocity1_m_s, v1);
+                }
+                if let Some(end) = float(t, "end_time_s") {
+                    assert_eq!(s.end_time_s, end);
+                }
+                assert!(s.chain.len() >= 2);
+            }
             SceneParams::ForceDriven {
                 setup,
                 measured_displacement_m,
@@ -182,6 +191,7 @@ fn readme_examples_are_the_shipped_scenes_they_abbreviate() {
         ("force-driven", "scenes/force-driven-ss440c-10psi.toml", ""),
         ("pulse", "scenes/pulse-10psi.toml", ""),
         ("shpb", "scenes/shpb-ss440c-10psi.toml", ""),
+        ("chain", "scenes/chain-ss440c-10.toml", ""),
     ];
     assert_eq!(cases.map(|c| c.0).to_vec(), kinds::names());
     for (name, scene, extra) in cases {

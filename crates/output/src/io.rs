@@ -1,7 +1,7 @@
 //! Input and output: CSV tables in, HDF5 and CSV results out, written atomically
 //! (temporary name, then rename; never overwriting without `--force`).
 
-use shpb_core::run::RunOutput;
+use shpb_core::run::{ChainSeries, RunOutput};
 use shpb_core::solver::ContactSeries;
 use shpb_input::{Error, Result};
 
@@ -24,6 +24,42 @@ pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static
         cols.push(("strain_rate", v.as_slice(), "1/s"));
     }
     cols
+}
+
+/// The `/chain` datasets of a chain run: (name, shape, data row-major, units). 2-D ones have
+/// one row per contact (`contact_force`, `contact_approach`: contact k between spheres k and
+/// k + 1) or per sphere (`velocity`), one column per time of `time`.
+pub fn chain_datasets(c: &ChainSeries) -> Vec<(String, Vec<usize>, Vec<f64>, &'static str)> {
+    let two_d = |rows: &[Vec<f64>]| -> (Vec<usize>, Vec<f64>) {
+        (
+            vec![rows.len(), c.time_s.len()],
+            rows.iter().flatten().copied().collect(),
+        )
+    };
+    let mut v = vec![(
+        "time".to_string(),
+        vec![c.time_s.len()],
+        c.time_s.clone(),
+        "s",
+    )];
+    for (name, rows, units) in [
+        ("contact_force", &c.contact_force_n, "N"),
+        ("contact_approach", &c.contact_approach_m, "m"),
+        ("velocity", &c.velocity_m_s, "m/s"),
+    ] {
+        let (shape, data) = two_d(rows);
+        v.push((name.to_string(), shape, data, units));
+    }
+    v.push((
+        "final_velocity".to_string(),
+        vec![c.final_velocity_m_s.len()],
+        c.final_velocity_m_s.clone(),
+        "m/s",
+    ));
+    for (name, data, units) in &c.extra {
+        v.push((name.clone(), vec![data.len()], data.clone(), units));
+    }
+    v
 }
 
 /// Origin of `/time` and `/contact/time` (both on the simulation clock).
@@ -61,6 +97,40 @@ pub fn write_hdf5(
             if contact.time_s.is_some() {
                 origin(&g, "time", TIME_ORIGIN, 0.0)?;
             }
+        }
+        if let Some(c) = &out.chain {
+            let g = f.create_group("chain").map_err(h5err(path))?;
+            for (name, shape, data, units) in chain_datasets(c) {
+                if let [rows, cols] = shape[..] {
+                    let field =
+                        ndarray::Array2::from_shape_vec((rows, cols), data).map_err(|e| {
+                            Error::Hdf5 {
+                                file: path.display().to_string(),
+                                message: e.to_string(),
+                            }
+                        })?;
+                    let ds = g
+                        .new_dataset_builder()
+                        .with_data(&field)
+                        .create(name.as_str())
+                        .map_err(h5err(path))?;
+                    string_attr(&ds, "units", units, path)?;
+                    let rows = if name == "velocity" {
+                        "sphere"
+                    } else {
+                        "contact (k: spheres k and k + 1)"
+                    };
+                    string_attr(
+                        &ds,
+                        "description",
+                        &format!("rows: {rows}, columns: /chain/time"),
+                        path,
+                    )?;
+                } else {
+                    write_dataset(&g, &name, &data, units, path)?;
+                }
+            }
+            origin(&g, "time", TIME_ORIGIN, 0.0)?;
         }
         if let Some(t) = &out.time_s {
             let root = f.group("/").map_err(h5err(path))?;
@@ -154,10 +224,20 @@ pub fn write_hdf5(
 }
 
 /// Writes a run as CSV with one header line (units in the column names): the contact series,
-/// or for bar scenes the time axis with each gauge's strain and voltage.
+/// for chains the time with every contact's force and every sphere's velocity, or for bar
+/// scenes the time axis with each gauge's strain and voltage.
 pub fn write_csv(path: &Path, force: bool, out: &RunOutput) -> Result<()> {
     let mut cols: Vec<(String, &[f64])> = Vec::new();
-    if let Some(c) = &out.contact {
+    if let Some(c) = &out.chain {
+        // A chain: time, the force of every contact, the velocity of every sphere.
+        cols.push(("time_s".into(), &c.time_s));
+        for (k, f) in c.contact_force_n.iter().enumerate() {
+            cols.push((format!("contact{}_force_N", k + 1), f));
+        }
+        for (k, v) in c.velocity_m_s.iter().enumerate() {
+            cols.push((format!("sphere{}_velocity_m_s", k + 1), v));
+        }
+    } else if let Some(c) = &out.contact {
         for (n, d, u) in contact_columns(c) {
             cols.push((csv_name(n, u), d));
         }

@@ -486,6 +486,9 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
     let title = format!("{} — {}", params.kind, name);
+    if let Some(chain) = &out.chain {
+        return chain_figure(path, force, &title, chain);
+    }
     if let (Some(contact), SceneParams::Pulse { apparatus, .. }) = (&out.contact, &params.params) {
         return plot_test(path, force, &title, apparatus, out, contact);
     }
@@ -630,6 +633,132 @@ fn plot_test(
         (&fd_axes, &fd_curves),
         &fields,
     )
+}
+
+/// The colour bar of a sequential map ([`level_colour`]): `lo` (white) to `hi` (dark blue),
+/// labelled `label`.
+fn draw_level_bar(area: &Area, path: &Path, label: &str, lo: f64, hi: f64) -> Result<()> {
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(45)
+        .margin_bottom(65)
+        .margin_right(10)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc(label)
+        .y_labels(7)
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(perr(path))?;
+    let steps = 100;
+    for k in 0..steps {
+        let (a, b) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
+        );
+        chart
+            .plotting_area()
+            .draw(&Rectangle::new(
+                [(0.0, a), (1.0, b)],
+                level_colour(0.5 * (a + b), lo, hi).filled(),
+            ))
+            .map_err(perr(path))?;
+    }
+    Ok(())
+}
+
+/// Rows of the x–t picture of a chain at most: longer series are binned in time, each cell
+/// showing the largest force of its bin (so no peak is lost).
+const CHAIN_PICTURE_ROWS: usize = 600;
+
+/// The figure of a chain run: the x–t picture of the contact forces along the chain (contact
+/// index against time, colour = force, with its colour bar) and the velocities of the first,
+/// middle and last spheres.
+pub fn chain_figure(
+    path: &Path,
+    force: bool,
+    title: &str,
+    chain: &shpb_core::run::ChainSeries,
+) -> Result<()> {
+    let t = &chain.time_s;
+    let nt = t.len();
+    let nc = chain.contact_force_n.len();
+    let bin = nt.div_ceil(CHAIN_PICTURE_ROWS).max(1);
+    let fmax = chain
+        .contact_force_n
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, &f| a.max(f))
+        .max(1e-9);
+    let tmax = t.last().copied().unwrap_or(0.0).max(1e-12);
+    write_atomically(path, force, |tmp| {
+        let root = BitMapBackend::new(tmp, (1700, 800)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let (left, right) = root.split_horizontally(1000);
+        let (field, bar) = left.split_horizontally(870);
+        let mut c = ChartBuilder::on(&field)
+            .caption(
+                format!("{title}: contact forces along the chain"),
+                ("sans-serif", 20),
+            )
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(75)
+            .build_cartesian_2d(0.5..nc as f64 + 0.5, 0.0..tmax * 1e6)
+            .map_err(perr(path))?;
+        c.configure_mesh()
+            .disable_mesh()
+            .x_desc("contact k (between spheres k and k + 1)")
+            .y_desc("time (µs)")
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style(("sans-serif", 16))
+            .draw()
+            .map_err(perr(path))?;
+        draw_level_bar(&bar, path, "contact force (kN)", 0.0, fmax * 1e-3)?;
+        for (k, row) in chain.contact_force_n.iter().enumerate() {
+            let mut i = 0;
+            while i < nt {
+                let j = (i + bin).min(nt);
+                let f = row[i..j].iter().fold(0.0f64, |a, &f| a.max(f));
+                let t0 = if i == 0 { 0.0 } else { t[i - 1] };
+                let x = (k + 1) as f64;
+                c.plotting_area()
+                    .draw(&Rectangle::new(
+                        [(x - 0.5, t0 * 1e6), (x + 0.5, t[j - 1] * 1e6)],
+                        level_colour(f * 1e-3, 0.0, fmax * 1e-3).filled(),
+                    ))
+                    .map_err(perr(path))?;
+                i = j;
+            }
+        }
+        let n = chain.velocity_m_s.len();
+        let mut picks = vec![0, n / 2, n - 1];
+        picks.dedup();
+        let curves: Vec<Curve> = picks
+            .iter()
+            .map(|&k| Curve {
+                label: format!("sphere {}", k + 1),
+                x: t,
+                y: &chain.velocity_m_s[k],
+                measured: false,
+            })
+            .collect();
+        let axes = Axes {
+            title: "sphere velocities",
+            x_label: "time (µs)",
+            y_label: "velocity (m/s)",
+            x_scale: 1e6,
+            y_scale: 1.0,
+        };
+        draw_xy(&right, path, &axes, &curves)?;
+        root.present().map_err(perr(path))
+    })
 }
 
 /// One line of a [`loglog_plot`]: points (x, y > 0) and an RGB colour.

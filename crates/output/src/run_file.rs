@@ -35,13 +35,23 @@ fn one_d<'a>(path: String, data: &'a [f64], units: &'a str) -> Dataset<'a> {
 }
 
 /// The numeric datasets [`crate::io::write_hdf5`] writes for `out`, in the order written:
-/// `contact/*`, `time`, `gauges/<name>/{strain,voltage}`, `bars/<name>/{x,time,snapshots}`,
+/// `contact/*`, `chain/*`, `time`, `gauges/<name>/{strain,voltage}`, `bars/<name>/{x,time,snapshots}`,
 /// `reduction/*`, `energy/*`, `summary/<key>` (scalars).
 pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
     let mut v = Vec::new();
     if let Some(contact) = &out.contact {
         for (name, data, units) in crate::io::contact_columns(contact) {
             v.push(one_d(format!("contact/{name}"), data, units));
+        }
+    }
+    if let Some(c) = &out.chain {
+        for (name, shape, data, units) in crate::io::chain_datasets(c) {
+            v.push(Dataset {
+                path: format!("chain/{name}"),
+                shape,
+                data: Cow::Owned(data),
+                units: Cow::Borrowed(units),
+            });
         }
     }
     if let Some(t) = &out.time_s {
@@ -189,6 +199,7 @@ mod tests {
             summary: vec![item("peak_contact_force", 7.5, "N")],
             reduction: None,
             warnings: vec!["a warning".into()],
+            chain: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.h5");

@@ -319,10 +319,16 @@ fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
         Params::from_file_with(Path::new(&stored.scene_file), None)
     })?;
     Ok(match params.params {
-        SceneParams::Pulse { apparatus, .. } => Some((
-            *apparatus,
-            (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
-        )),
+        SceneParams::Pulse {
+            apparatus, options, ..
+        } => {
+            // A chain specimen's strain rate is δ̇/Σ rᵢ, as the run's own reduction took it.
+            let radii = match &options.specimen {
+                Some(sp) => shpb_core::scene::specimen_radii_m(&sp.spheres),
+                None => (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
+            };
+            Some((*apparatus, radii))
+        }
         _ => None,
     })
 }

@@ -58,6 +58,7 @@ pub fn strain(
         summary: Vec::new(),
         reduction: None,
         warnings: Vec::new(),
+        chain: None,
     };
     let text = format!(
         "record = \"{}\"\nbars = \"{}\"\n",

@@ -36,11 +36,13 @@ pub mod body;
 pub mod chain;
 pub mod joint;
 pub mod record;
+pub mod spheres;
 
 pub use body::{Body, BodySpec, MassSpec};
 pub use chain::{Chain, ChainResult, ChainSetup, simulate_chain, simulate_chain_with};
 pub use joint::Joint;
 pub use record::{BarSnapshots, GaugeProbe, Recorder};
+pub use spheres::{FreeChainResult, FreeChainSetup, StrikerMass, Wall, free_chain};
 
 use crate::contact::{Contact, ContactEval, hertz_force};
 use crate::error::{Error, Result};
@@ -244,44 +246,7 @@ impl PairStepper {
         let k2 = 1.0 + 0.5 * dt * b2.damping_kg_s / b2.mass_kg;
         let a = (v1h + 0.5 * dt * fext_next / b1.mass_kg) / k1 - v2h / k2;
         let b = 0.5 * dt / (b1.mass_kg * k1) + 0.5 * dt / (b2.mass_kg * k2);
-        let force = |u: f64| self.law.trial(delta, u).force_n;
-        // g(u) = u − A + B F(u) is increasing in u (F does not fall with the rate): bracket its root.
-        let g = |u: f64| u - a + b * force(u);
-        let u_hi = a - b * force(0.0);
-        let u_lo = a - b * force(u_hi.max(0.0));
-        let (mut lo, mut hi) = (u_lo.min(u_hi), u_lo.max(u_hi));
-        let (mut glo, mut ghi) = (g(lo), g(hi));
-        if glo >= 0.0 {
-            return lo;
-        }
-        if ghi <= 0.0 {
-            return hi;
-        }
-        // Illinois (modified regula falsi): superlinear, never leaves the bracket.
-        let mut side = 0;
-        for _ in 0..100 {
-            let u = (lo * ghi - hi * glo) / (ghi - glo);
-            let gu = g(u);
-            if gu == 0.0 || (hi - lo) <= 1e-13 * (hi.abs() + lo.abs()) + 1e-18 {
-                return u;
-            }
-            if gu < 0.0 {
-                lo = u;
-                glo = gu;
-                if side == -1 {
-                    ghi *= 0.5;
-                }
-                side = -1;
-            } else {
-                hi = u;
-                ghi = gu;
-                if side == 1 {
-                    glo *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        0.5 * (lo + hi)
+        solve_approach_speed(self.law.as_ref(), delta, a, b)
     }
 
     /// Stops a run whose contact returned more energy than it received (module docs, "Instability").
@@ -325,6 +290,51 @@ impl PairStepper {
         }
         Ok(())
     }
+}
+
+/// The end-of-step approach speed u of a rate-dependent contact at approach `delta`: the root of
+/// u = A − B F(δ, u) (velocity update of velocity Verlet with the force at the end of the step,
+/// module docs), by bracketed Illinois iteration to 1e-13 relative. Shared by the pair and the
+/// chain steppers, so both take exactly the same arithmetic.
+pub fn solve_approach_speed(law: &dyn Contact, delta: f64, a: f64, b: f64) -> f64 {
+    let force = |u: f64| law.trial(delta, u).force_n;
+    // g(u) = u − A + B F(u) is increasing in u (F does not fall with the rate): bracket its root.
+    let g = |u: f64| u - a + b * force(u);
+    let u_hi = a - b * force(0.0);
+    let u_lo = a - b * force(u_hi.max(0.0));
+    let (mut lo, mut hi) = (u_lo.min(u_hi), u_lo.max(u_hi));
+    let (mut glo, mut ghi) = (g(lo), g(hi));
+    if glo >= 0.0 {
+        return lo;
+    }
+    if ghi <= 0.0 {
+        return hi;
+    }
+    // Illinois (modified regula falsi): superlinear, never leaves the bracket.
+    let mut side = 0;
+    for _ in 0..100 {
+        let u = (lo * ghi - hi * glo) / (ghi - glo);
+        let gu = g(u);
+        if gu == 0.0 || (hi - lo) <= 1e-13 * (hi.abs() + lo.abs()) + 1e-18 {
+            return u;
+        }
+        if gu < 0.0 {
+            lo = u;
+            glo = gu;
+            if side == -1 {
+                ghi *= 0.5;
+            }
+            side = -1;
+        } else {
+            hi = u;
+            ghi = gu;
+            if side == 1 {
+                glo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// Time series of the contact, as written to `/contact` (datasets a scene lacks are `None`).

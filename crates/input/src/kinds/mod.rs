@@ -15,6 +15,7 @@ use shpb_core::scene::SceneParams;
 use shpb_core::specimen::SpherePair;
 use std::path::Path;
 
+mod chain;
 mod collision;
 mod constant_rate;
 mod force_driven;
@@ -106,6 +107,7 @@ pub const KINDS: &[SceneKind] = &[
     force_driven::KIND,
     pulse::KIND,
     shpb::KIND,
+    chain::KIND,
 ];
 
 /// The keys every scene accepts, whatever its kind (read by `from_toml` before dispatching).
@@ -293,6 +295,14 @@ const SPECIMEN: Key = Key {
     unit: "",
     default: "required",
     meaning: "the two spheres: pair = \"ss440c\" (a built-in material's 6.35 mm pair, or a pair .toml file), or [specimen.sphere1] and [specimen.sphere2] tables with material, diameter_m or radius_m, optional mass_kg",
+};
+
+/// `[specimen]` of a scene with a chain of spheres (`chain`, `shpb`).
+const CHAIN_SPECIMEN: Key = Key {
+    key: "specimen",
+    unit: "",
+    default: "required",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2)",
 };
 
 /// `law = "..."`.
@@ -519,7 +529,8 @@ mod tests {
                 "collision",
                 "force-driven",
                 "pulse",
-                "shpb"
+                "shpb",
+                "chain"
             ]
         );
         assert_eq!(names_and_help(), SCENE_KINDS.to_vec());
@@ -532,7 +543,8 @@ mod tests {
 
     #[test]
     fn kind_errors_list_every_registered_kind() {
-        let all = "allowed: quasistatic, constant-rate, collision, force-driven, pulse, shpb";
+        let all =
+            "allowed: quasistatic, constant-rate, collision, force-driven, pulse, shpb, chain";
         let base = Path::new(".");
         for (text, problem) in [
             (

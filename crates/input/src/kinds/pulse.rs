@@ -156,7 +156,7 @@ pub(super) fn parse_bars(
     let f: PulseFile = parse_as(text, file)?;
     let specimen = match (&f.specimen, is_test) {
         (Some(spec), true) => Some(shpb_core::apparatus::SpecimenSetup {
-            pair: spec.build(base_dir, &sv)?,
+            spheres: spec.build_chain(base_dir, &sv)?,
             law: f.law,
             region2: f.region2,
             unloading: f.unloading,
@@ -265,9 +265,10 @@ pub(super) fn parse_bars(
     for spec in &apparatus.pulse_chain(&options).bodies {
         shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
     }
-    // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads.
+    // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads (a test's
+    // `pair` is its first contact).
     let pair = match specimen {
-        Some(sp) => sp.pair,
+        Some(sp) => sp.spheres.pair(0),
         None => {
             SpherePair::paper(shpb_core::material::Material::builtin("ss440c").expect("built-in"))
         }

@@ -2,7 +2,7 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
-use super::{LAW, Parsed, REGION2, SPECIMEN, SceneKind, UNLOADING};
+use super::{CHAIN_SPECIMEN, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
 use shpb_core::fidelity::Fidelity;
 use std::path::Path;
@@ -10,9 +10,9 @@ use std::path::Path;
 /// The registry entry.
 pub(super) const KIND: SceneKind = SceneKind {
     name: "shpb",
-    help: "the whole virtual test: gun, striker, shaper, bars, two spheres, gauges and the lab's reduction",
+    help: "the whole virtual test: gun, striker, shaper, bars, two (or more) spheres, gauges and the lab's reduction",
     keys: &[
-        SPECIMEN,
+        CHAIN_SPECIMEN,
         LAW,
         REGION2,
         UNLOADING,
@@ -62,7 +62,7 @@ mod tests {
         assert_eq!(options.end, IncidentEnd::Specimen);
         let specimen = options.specimen.expect("a specimen");
         assert_eq!(
-            (specimen.pair, specimen.law, specimen.region2),
+            (specimen.spheres.pair(0), specimen.law, specimen.region2),
             (pair, law, region2)
         );
         assert_eq!(options.cell_size_m, 4e-3);

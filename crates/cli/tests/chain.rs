@@ -1,0 +1,190 @@
+//! Chains of spheres (issue 17 part 2, docs/physics.md §8): the `chain` scene against the
+//! `collision` scene for two spheres, the full SHPB test with a chain specimen against the pair
+//! test, a longer chain between the bars, and the `/chain` layout of the run file.
+
+mod common;
+
+use common::{repo_path, shpb};
+use shpb::prelude::*;
+use shpb::run::RunOutput;
+use shpb::scene::Params;
+use std::path::Path;
+
+fn run(text: &str) -> RunOutput {
+    Params::from_toml(text, "t.toml", Path::new("."))
+        .unwrap_or_else(|e| panic!("{e}\n{text}"))
+        .run()
+        .unwrap()
+}
+
+fn summary(out: &RunOutput, key: &str) -> f64 {
+    out.summary
+        .iter()
+        .find(|i| i.key == key)
+        .unwrap_or_else(|| panic!("no summary item {key}"))
+        .value
+}
+
+/// Largest |a − b| over the common length, relative to the largest |b|.
+fn series_difference(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / scale
+}
+
+/// Acceptance: a `chain` scene of two spheres gives the `collision` scene's restitution, peak
+/// force, max approach and force series to 1e-12 relative (the same arithmetic: measured 0),
+/// through the scene files, for the three laws and three speeds.
+#[test]
+fn a_chain_scene_of_two_is_the_collision_scene() {
+    for law in ["burgoyne-daraio", "rate-independent", "hertz"] {
+        for speed in [1.0, 5.0, 20.0] {
+            let collision = run(&format!(
+                "kind = \"collision\"\nlaw = \"{law}\"\nvelocity1_m_s = {speed}\nspecimen = {{ pair = \"ss440c\" }}\n"
+            ));
+            let chain = run(&format!(
+                "kind = \"chain\"\nlaw = \"{law}\"\nvelocity1_m_s = {speed}\nspecimen = {{ count = 2, material = \"ss440c\", diameter_m = 6.35e-3 }}\n"
+            ));
+            let mut worst = 0.0f64;
+            for key in ["restitution", "peak_force", "max_approach", "time_step"] {
+                let (a, b) = (summary(&chain, key), summary(&collision, key));
+                worst = worst.max((a - b).abs() / b.abs());
+            }
+            let (c, p) = (
+                chain.contact.as_ref().unwrap(),
+                collision.contact.as_ref().unwrap(),
+            );
+            worst = worst.max(series_difference(&c.force_n, &p.force_n));
+            worst = worst.max(series_difference(&c.displacement_m, &p.displacement_m));
+            println!("{law} at {speed} m/s: chain − collision {worst:e}");
+            assert!(worst <= 1e-12, "{law} at {speed} m/s: {worst:e}");
+            // The ledger: kinetic after + dissipated = before, to the run's own ledger error.
+            let (ke0, ke1, w) = (
+                summary(&chain, "kinetic_energy_before"),
+                summary(&chain, "kinetic_energy_after"),
+                summary(&chain, "energy_dissipated"),
+            );
+            let err = summary(&chain, "energy_balance_max_relative_error");
+            assert!(((ke1 + w - ke0) / ke0).abs() <= err * (1.0 + 1e-9));
+        }
+    }
+}
+
+fn shpb_scene(specimen: &str) -> String {
+    format!(
+        "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nfidelity = \"fast\"\n[specimen]\n{specimen}\n"
+    )
+}
+
+/// Acceptance: the full SHPB test with a chain of two (as `count`, or as two
+/// `[[specimen.sphere]]` tables) reproduces the pair test to 1e-12 on the gauge signals, the
+/// true contact force and the reduced forces (same chain of bodies: measured 0).
+#[test]
+fn an_shpb_test_with_a_chain_of_two_is_the_pair_test() {
+    let pair = run(&shpb_scene("pair = \"ss440c\""));
+    for specimen in [
+        "count = 2\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+        "[[specimen.sphere]]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n[[specimen.sphere]]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+    ] {
+        let chain = run(&shpb_scene(specimen));
+        let mut worst = 0.0f64;
+        for (a, b) in chain.gauges.iter().zip(&pair.gauges) {
+            worst = worst.max(series_difference(&a.strain, &b.strain));
+            worst = worst.max(series_difference(&a.voltage_v, &b.voltage_v));
+        }
+        let (c, p) = (
+            chain.contact.as_ref().unwrap(),
+            pair.contact.as_ref().unwrap(),
+        );
+        worst = worst.max(series_difference(&c.force_n, &p.force_n));
+        let (rc, rp) = (
+            chain.reduction.as_ref().unwrap(),
+            pair.reduction.as_ref().unwrap(),
+        );
+        worst = worst.max(series_difference(&rc.force_back_n, &rp.force_back_n));
+        worst = worst.max(series_difference(&rc.force_front_n, &rp.force_front_n));
+        worst = worst.max(series_difference(&rc.displacement_m, &rp.displacement_m));
+        println!("shpb chain of two − pair: {worst:e}");
+        assert!(worst <= 1e-12, "{worst:e}");
+        assert_eq!(chain.summary, pair.summary);
+    }
+}
+
+/// A chain of five between the bars: the three middle spheres are rigid masses joined by
+/// contacts; the energy ledger of the whole test (striker = bars + absorbed + shaper +
+/// contacts) holds as for a pair (1e-10), and the load passes through the chain to the
+/// transmission bar: a transmitted pulse, smaller than the pair's (four contacts in series are
+/// four times as compliant, so the same incident pulse loads them less) but not negligible.
+#[test]
+fn an_shpb_test_with_a_chain_of_five() {
+    let pair = run(&shpb_scene("pair = \"ss440c\""));
+    let chain = run(&shpb_scene(
+        "count = 5\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+    ));
+    let err = summary(&chain, "energy_balance_max_relative_error");
+    assert!(err < 1e-10, "energy ledger {err:e}");
+    let (fc, fp) = (
+        summary(&chain, "reduced_peak_back_force"),
+        summary(&pair, "reduced_peak_back_force"),
+    );
+    println!("reduced peak back force: chain of five {fc:e} N, pair {fp:e} N");
+    assert!(fc > 0.1 * fp && fc < fp, "{fc} vs {fp}");
+}
+
+/// The run file of the example chain scene: `/chain` datasets with their shapes and units,
+/// and the CSV of per-contact forces.
+#[test]
+fn the_chain_run_file_has_the_documented_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = repo_path("scenes/chain-ss440c-10.toml");
+    let out = shpb(
+        dir.path(),
+        &[
+            "run", &scene, "-o", "c.h5", "--csv", "c.csv", "--plot", "c.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let f = shpb_output::run_file::read_run_file(&dir.path().join("c.h5")).unwrap();
+    let get = |p: &str| {
+        f.datasets
+            .iter()
+            .find(|d| d.path == p)
+            .unwrap_or_else(|| panic!("no {p}"))
+    };
+    let t = get("chain/time");
+    let nt = t.shape[0];
+    assert_eq!(t.units, "s");
+    for (p, rows, units) in [
+        ("chain/contact_force", 9, "N"),
+        ("chain/contact_approach", 9, "m"),
+        ("chain/velocity", 10, "m/s"),
+    ] {
+        let d = get(p);
+        assert_eq!(
+            (d.shape.clone(), d.units.as_ref()),
+            (vec![rows, nt], units),
+            "{p}"
+        );
+    }
+    // Contact 1 is between spheres 1 and 2: the wave from sphere 1 peaks there first, then at
+    // each next contact in turn (rows are contacts, columns times).
+    let force = &get("chain/contact_force").data;
+    let peak_at = |k: usize| {
+        (0..nt)
+            .max_by(|&a, &b| force[k * nt + a].total_cmp(&force[k * nt + b]))
+            .unwrap()
+    };
+    assert!((1..9).all(|k| peak_at(k) > peak_at(k - 1)));
+    let csv = std::fs::read_to_string(dir.path().join("c.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("time_s,contact1_force_N,contact2_force_N"),
+        "{header}"
+    );
+    assert!(header.ends_with("sphere10_velocity_m_s"));
+    assert_eq!(csv.lines().count(), nt + 1);
+    assert!(dir.path().join("c.png").is_file());
+}

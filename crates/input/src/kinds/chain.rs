@@ -1,0 +1,341 @@
+//! `kind = "chain"`: a free chain of N ≥ 2 spheres in a line, struck by its first sphere or a
+//! striker mass, optionally against a wall (docs/physics.md §8).
+
+use super::{
+    CHAIN_SPECIMEN, Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SceneKind, UNLOADING, check_every, one,
+};
+use crate::error::{Result, Validator};
+use crate::material::MaterialFile;
+use crate::toml_file::parse_as;
+use serde::Deserialize;
+use shpb_core::fidelity::Fidelity;
+use shpb_core::material::Material;
+use shpb_core::scene::SceneParams;
+use shpb_core::solver::{FreeChainSetup, StrikerMass, Wall};
+use std::path::Path;
+
+/// The registry entry.
+pub(super) const KIND: SceneKind = SceneKind {
+    name: "chain",
+    help: "N spheres in a line struck by the first (or a striker), optional wall: contact forces, velocities, energy",
+    keys: &[
+        CHAIN_SPECIMEN,
+        LAW,
+        REGION2,
+        UNLOADING,
+        Key {
+            key: "velocity1_m_s",
+            unit: "m/s",
+            default: "required (without striker)",
+            meaning: "initial velocity of sphere 1 toward the others, which rest: greater than 0, at most 1e4",
+        },
+        Key {
+            key: "end_time_s",
+            unit: "s",
+            default: "(N + 2) × the longest Hertz contact time (twice that with a wall)",
+            meaning: "end of the run: greater than 0, at most 1",
+        },
+        Key {
+            key: "striker",
+            unit: "",
+            default: "none",
+            meaning: "a rigid striker with a flat face hitting sphere 1 instead: mass_kg (0 to 1e6), velocity_m_s (0 to 1e4), optional material of its face (built-in or .toml; none: rigid)",
+        },
+        Key {
+            key: "wall",
+            unit: "",
+            default: "none (free end)",
+            meaning: "a fixed flat after the last sphere: kind = \"rigid\", or kind = \"elastic\" with material (built-in or .toml)",
+        },
+        Key {
+            key: "time_step_s",
+            unit: "s",
+            default: "shortest Hertz contact time / steps_per_contact",
+            meaning: "time step; at most the stability limit 1/ω of the stiffest contact",
+        },
+        Key {
+            key: "steps_per_contact",
+            unit: "",
+            default: "fidelity: 200, 2000, 20000",
+            meaning: "time steps per Hertz contact time of the stiffest contact, 20 to 1e8",
+        },
+        OUTPUT_EVERY,
+    ],
+    example: "kind = \"chain\"\nvelocity1_m_s = 5.0\nend_time_s = 75e-6\nspecimen = { count = 10, material = \"ss440c\", diameter_m = 6.35e-3 }\n",
+    example_dir: None,
+    parse,
+};
+
+/// `[striker]` of a chain scene.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StrikerSpec {
+    mass_kg: f64,
+    velocity_m_s: f64,
+    material: Option<String>,
+}
+
+/// `[wall]` of a chain scene.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct WallSpec {
+    kind: String,
+    material: Option<String>,
+}
+
+super::sphere_scene_file! {
+    struct ChainFile {
+        velocity1_m_s: Option<f64>,
+        end_time_s: Option<f64>,
+        striker: Option<StrikerSpec>,
+        wall: Option<WallSpec>,
+        time_step_s: Option<f64>,
+        steps_per_contact: Option<f64>,
+        #[serde(default = "one")]
+        output_every: usize,
+    }
+}
+
+fn parse(
+    text: &str,
+    file: &str,
+    base_dir: &Path,
+    fidelity: Fidelity,
+    v: &Validator,
+) -> Result<Parsed> {
+    let f: ChainFile = parse_as(text, file)?;
+    let chain = f.specimen.build_chain(base_dir, &v.table("specimen"))?;
+    let striker = match &f.striker {
+        Some(s) => {
+            let sv = v.table("striker");
+            if f.velocity1_m_s.is_some() {
+                return Err(v.error(
+                    "velocity1_m_s",
+                    "given with a [striker]: the striker moves, the spheres rest",
+                    "either velocity1_m_s or a [striker] table",
+                ));
+            }
+            Some(StrikerMass {
+                mass_kg: sv.positive("mass_kg", s.mass_kg, 1e6, "kg")?,
+                velocity_m_s: sv.positive("velocity_m_s", s.velocity_m_s, 1e4, "m/s")?,
+                material: s
+                    .material
+                    .as_deref()
+                    .map(|m| Material::resolve(m, base_dir, &sv, "material"))
+                    .transpose()?,
+            })
+        }
+        None => None,
+    };
+    let velocity1_m_s = match (f.velocity1_m_s, &striker) {
+        (Some(v1), None) => {
+            if !(v1.is_finite() && v1 > 0.0) {
+                return Err(v.error(
+                    "velocity1_m_s",
+                    format!("{v1} m/s: sphere 1 never reaches the others, which rest"),
+                    "greater than 0, at most 1e4 m/s",
+                ));
+            }
+            v.positive("velocity1_m_s", v1, 1e4, "m/s")?
+        }
+        (None, None) => {
+            return Err(v.error(
+                "velocity1_m_s",
+                "missing",
+                "the initial velocity of sphere 1 (greater than 0, at most 1e4 m/s), or a [striker] table",
+            ));
+        }
+        (_, Some(_)) => 0.0,
+    };
+    let wall = match &f.wall {
+        None => None,
+        Some(w) => {
+            let wv = v.table("wall");
+            match (w.kind.as_str(), &w.material) {
+                ("rigid", None) => Some(Wall::Rigid),
+                ("elastic", Some(m)) => Some(Wall::Elastic(Material::resolve(
+                    m, base_dir, &wv, "material",
+                )?)),
+                ("rigid", Some(_)) => {
+                    return Err(wv.error(
+                        "material",
+                        "a rigid wall has no material",
+                        "kind = \"elastic\" with a material, or kind = \"rigid\" alone",
+                    ));
+                }
+                ("elastic", None) => {
+                    return Err(wv.error(
+                        "material",
+                        "missing: an elastic wall needs its material",
+                        "a built-in material name or a material .toml file",
+                    ));
+                }
+                (other, _) => {
+                    return Err(wv.error(
+                        "kind",
+                        format!("unknown wall `{other}`"),
+                        "rigid, elastic",
+                    ));
+                }
+            }
+        }
+    };
+    let mut setup = FreeChainSetup {
+        chain,
+        law: f.law,
+        region2: f.region2,
+        unloading: f.unloading,
+        velocity1_m_s,
+        striker,
+        wall,
+        dt_s: 0.0,
+        end_time_s: 0.0,
+        output_every: check_every(v, f.output_every)?,
+    };
+    let times = setup.hertz_contact_times_s();
+    let tc_max = times.iter().copied().fold(0.0, f64::max);
+    if !times.iter().all(|t| t.is_finite() && *t > 0.0) {
+        return Err(v.error(
+            "velocity1_m_s",
+            format!(
+                "striking speed {:e} m/s gives no finite contact time",
+                setup.impact_speed_m_s()
+            ),
+            "a normal (not subnormal) positive number of m/s",
+        ));
+    }
+    let n = v.in_range(
+        "steps_per_contact",
+        f.steps_per_contact.unwrap_or(fidelity.dem_steps()),
+        20.0,
+        1e8,
+        "",
+    )?;
+    setup.dt_s = match f.time_step_s {
+        Some(dt) => v.positive(
+            "time_step_s",
+            dt,
+            setup.stability_limit(),
+            "s (the stability limit 1/ω of the stiffest contact)",
+        )?,
+        None => setup.default_time_step(n),
+    };
+    let walls = if setup.wall.is_some() { 2.0 } else { 1.0 };
+    let default_end = walls * (setup.chain.len() as f64 + 2.0) * tc_max;
+    setup.end_time_s = match f.end_time_s {
+        Some(t) => v.positive("end_time_s", t, 1.0, "s")?,
+        None => default_end,
+    };
+    let pair = setup.chain.pair(0);
+    Ok((pair, f.law, f.region2, SceneParams::Chain(Box::new(setup))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registry_entry() {
+        super::super::check_kind(&KIND, &[]);
+        let steps = Fidelity::ALL.map(|f| f.dem_steps().to_string()).join(", ");
+        assert_eq!(KIND.keys[9].default, format!("fidelity: {steps}"));
+    }
+
+    #[test]
+    fn example_values() {
+        let (pair, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let SceneParams::Chain(s) = p else {
+            panic!("not a chain: {p:?}")
+        };
+        assert_eq!(s.chain.len(), 10);
+        assert_eq!((s.velocity1_m_s, s.end_time_s), (5.0, 75e-6));
+        assert_eq!(s.chain.pair(0), pair);
+        // Identical spheres: every contact has the pair's Hertz time; the step is 1/2000 of it.
+        let c = pair.contact_properties();
+        let tc = shpb_core::solver::hertz_impact_duration(
+            pair.reduced_mass_kg(),
+            c.e_star_pa,
+            c.radius_m,
+            5.0,
+        );
+        assert_eq!(s.dt_s, tc / 2000.0);
+    }
+
+    fn error(extra: &str, specimen: &str) -> String {
+        let v = Validator::new("c.toml");
+        let text = format!("kind = \"chain\"\n{extra}\n[specimen]\n{specimen}\n");
+        parse(&text, "c.toml", Path::new("."), Fidelity::Standard, &v)
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn errors_name_file_key_and_range() {
+        let ten = "count = 10\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3";
+        for (extra, specimen, expected) in [
+            (
+                "velocity1_m_s = 5.0",
+                "count = 1\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+                "c.toml: `specimen.count`: 1 is out of range; allowed: 2 to 100000",
+            ),
+            (
+                "velocity1_m_s = 5.0",
+                "count = 3\nmaterial = \"ss440c\"\ndiameter_m = -6.35e-3",
+                "c.toml: `specimen.diameter_m`",
+            ),
+            (
+                "velocity1_m_s = 5.0",
+                "count = 2\n[[specimen.sphere]]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+                "c.toml: `specimen.count`: give either `count`",
+            ),
+            (
+                "velocity1_m_s = 5.0",
+                "[[specimen.sphere]]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3",
+                "c.toml: `specimen.sphere`: 1 sphere table(s); allowed: 2 to 100000",
+            ),
+            ("velocity1_m_s = 0.0", ten, "c.toml: `velocity1_m_s`: 0 m/s"),
+            ("", ten, "c.toml: `velocity1_m_s`: missing"),
+            (
+                "velocity1_m_s = 5.0\n[striker]\nmass_kg = 1.0\nvelocity_m_s = 2.0",
+                ten,
+                "c.toml: `velocity1_m_s`: given with a [striker]",
+            ),
+            (
+                "velocity1_m_s = 5.0\n[wall]\nkind = \"soft\"",
+                ten,
+                "c.toml: `wall.kind`: unknown wall `soft`; allowed: rigid, elastic",
+            ),
+            (
+                "velocity1_m_s = 5.0\n[wall]\nkind = \"elastic\"",
+                ten,
+                "c.toml: `wall.material`: missing",
+            ),
+            (
+                "velocity1_m_s = 5.0\ntime_step_s = 1e-5",
+                ten,
+                "c.toml: `time_step_s`: ",
+            ),
+        ] {
+            let e = error(extra, specimen);
+            assert!(e.starts_with(expected), "{e}\n  expected: {expected}");
+        }
+    }
+
+    #[test]
+    fn a_striker_and_a_wall() {
+        let v = Validator::new("c.toml");
+        let text = "kind = \"chain\"\n[striker]\nmass_kg = 0.01\nvelocity_m_s = 2.0\nmaterial = \"ss302\"\n[wall]\nkind = \"rigid\"\n[specimen]\ncount = 3\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n";
+        let (_, _, _, p) = parse(text, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let SceneParams::Chain(s) = p else {
+            panic!("not a chain")
+        };
+        assert_eq!(s.impact_speed_m_s(), 2.0);
+        assert_eq!(s.first_sphere(), 1);
+        assert_eq!(s.wall, Some(Wall::Rigid));
+        assert_eq!(
+            s.hertz_contact_times_s().len(),
+            4,
+            "striker, 2 sphere contacts, wall"
+        );
+    }
+}
