@@ -36,6 +36,7 @@ pub mod body;
 pub mod chain;
 pub mod joint;
 pub mod record;
+pub mod solitary;
 
 pub use body::{Body, BodySpec, MassSpec};
 pub use chain::{Chain, ChainResult, ChainSetup, simulate_chain, simulate_chain_with};
