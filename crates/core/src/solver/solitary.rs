@@ -94,7 +94,7 @@ pub fn hertz_chain(
 
 /// Measures a wave in a chain of rigid spheres with identical Hertz contacts while it runs
 /// (docs/physics.md §8.1): each contact's peak force and its time, the largest force each contact
-/// carries once the leading pulse has passed it, the force history of one watched contact at
+/// carries once the leading pulse has passed it and it has opened, the force history of one watched contact at
 /// every step, all contact forces every `every` steps, and the largest departures of momentum
 /// and energy from their initial values.
 ///
@@ -115,7 +115,7 @@ pub struct WaveProbe {
     pub peak_force_n: Vec<f64>,
     /// Time of each contact's largest force (the level the force belongs to), s.
     pub peak_time_s: Vec<f64>,
-    /// Largest force each contact carried after its force fell below 1 % of its peak, N.
+    /// Largest force each contact carried after the leading pulse had passed and the contact opened, N.
     pub trailing_force_n: Vec<f64>,
     /// Times of the watched contact's force history (every step it is loaded), s.
     pub watched_time_s: Vec<f64>,
@@ -237,7 +237,7 @@ impl Recorder for WaveProbe {
                 } else if f > self.peak_force_n[k] {
                     self.peak_force_n[k] = f;
                     self.peak_time_s[k] = level_time_s;
-                } else if f < 0.01 * self.peak_force_n[k] {
+                } else if f <= 0.0 && self.peak_force_n[k] > 0.0 {
                     self.passed[k] = true;
                 }
             }
@@ -271,7 +271,7 @@ pub struct WaveMeasurement {
     pub half_max_width_m: f64,
     /// (largest − smallest)/mean of the peak forces over the amplitude's contacts.
     pub amplitude_spread: f64,
-    /// Largest force any contact carries once the leading pulse has passed it, over the peak force.
+    /// Largest force any contact carries once the leading pulse has passed and it opened, over the peak force.
     pub trailing_force_ratio: f64,
 }
 
@@ -458,8 +458,9 @@ mod tests {
         // 1.08, 1.04, … times the final one at contacts 1, 2, 3) has died out to < 0.1 % by
         // contact 10; a wave shedding a train or breaking up would lose amplitude as it goes.
         assert!(m.amplitude_spread < 5e-3, "{m:?}");
-        // One pulse: once the leading pulse has passed a contact, no later force reaches 1 %
-        // of its peak (the spheres behind separate: a second pulse would load them again).
+        // One pulse: once the leading pulse has passed a contact and it has opened (the spheres
+        // behind separate), no later force reaches 1 % of the peak: a second pulse would load
+        // it again.
         assert!(m.trailing_force_ratio < 0.01, "{m:?}");
         // The energy the pulse leaves behind: a second solitary wave of 10 % of the peak force
         // would carry (0.1)^{5/3} ≈ 2 % of the energy (E ∝ v_m² ∝ F_m^{5/3}); with the peak
