@@ -1,4 +1,4 @@
-//! `shpb validate`: every validation case (paper Figs. 2–4, gauge records, Hertz, restitution)
+//! `shpb validate`: every validation case (paper Figs. 2–4, gauge records, Hertz, restitution, the Hertz chain's solitary wave)
 //! passes its checks, case names are validated, and a report is never overwritten without
 //! `--force`. The PNGs and REPORT.md are not drawn here (`shpb validate --report`).
 
@@ -67,6 +67,11 @@ fn hertz_analytic_passes() {
 #[test]
 fn restitution_passes() {
     passes("restitution");
+}
+
+#[test]
+fn chain_passes() {
+    passes("chain");
 }
 
 #[test]

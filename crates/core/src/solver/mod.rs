@@ -36,6 +36,7 @@ pub mod body;
 pub mod chain;
 pub mod joint;
 pub mod record;
+pub mod solitary;
 pub mod spheres;
 
 pub use body::{Body, BodySpec, MassSpec};
