@@ -181,21 +181,27 @@ fn stress_colour(s: f64, scale: f64) -> RGBColor {
     }
 }
 
-/// The colour bar of the x–t diagram: stress from −`full_mpa` to +`full_mpa` (MPa), with the
-/// colours of [`stress_colour`] (saturated beyond).
-fn draw_colour_bar(area: &Area, path: &Path, full_mpa: f64) -> Result<()> {
+/// A vertical colour bar from `lo` to `hi` labelled `label`, coloured by `colour` (one helper
+/// for the stress bar of the bar x–t diagram and the force bar of the chain picture).
+fn draw_scale_bar(
+    area: &Area,
+    path: &Path,
+    label: &str,
+    (lo, hi): (f64, f64),
+    colour: impl Fn(f64) -> RGBColor,
+) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
         .margin_top(45)
         .margin_bottom(65)
         .margin_right(10)
         .y_label_area_size(70)
-        .build_cartesian_2d(0.0..1.0, -full_mpa..full_mpa)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
         .map_err(perr(path))?;
     chart
         .configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc("stress (MPa)")
+        .y_desc(label)
         .y_labels(7)
         .y_label_formatter(&|v| tick(*v))
         .label_style(("sans-serif", 15))
@@ -203,15 +209,15 @@ fn draw_colour_bar(area: &Area, path: &Path, full_mpa: f64) -> Result<()> {
         .map_err(perr(path))?;
     let steps = 100;
     for k in 0..steps {
-        let (s0, s1) = (
-            -full_mpa + 2.0 * full_mpa * k as f64 / steps as f64,
-            -full_mpa + 2.0 * full_mpa * (k + 1) as f64 / steps as f64,
+        let (a, b) = (
+            lo + (hi - lo) * k as f64 / steps as f64,
+            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
         );
         chart
             .plotting_area()
             .draw(&Rectangle::new(
-                [(0.0, s0), (1.0, s1)],
-                stress_colour(0.5 * (s0 + s1), full_mpa).filled(),
+                [(0.0, a), (1.0, b)],
+                colour(0.5 * (a + b)).filled(),
             ))
             .map_err(perr(path))?;
     }
@@ -261,7 +267,14 @@ fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result
         .label_style(("sans-serif", 16))
         .draw()
         .map_err(perr(path))?;
-    draw_colour_bar(&bar_area, path, smax / 1e6)?;
+    let full_mpa = smax / 1e6;
+    draw_scale_bar(
+        &bar_area,
+        path,
+        "stress (MPa)",
+        (-full_mpa, full_mpa),
+        |v| stress_colour(v, full_mpa),
+    )?;
     for f in fields {
         for (k, row) in f.stress_pa.iter().enumerate() {
             let t0 = if k == 0 { 0.0 } else { f.time_s[k - 1] };
@@ -635,43 +648,6 @@ fn plot_test(
     )
 }
 
-/// The colour bar of a sequential map ([`level_colour`]): `lo` (white) to `hi` (dark blue),
-/// labelled `label`.
-fn draw_level_bar(area: &Area, path: &Path, label: &str, lo: f64, hi: f64) -> Result<()> {
-    let mut chart = ChartBuilder::on(area)
-        .margin_top(45)
-        .margin_bottom(65)
-        .margin_right(10)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(perr(path))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc(label)
-        .y_labels(7)
-        .y_label_formatter(&|v| tick(*v))
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(perr(path))?;
-    let steps = 100;
-    for k in 0..steps {
-        let (a, b) = (
-            lo + (hi - lo) * k as f64 / steps as f64,
-            lo + (hi - lo) * (k + 1) as f64 / steps as f64,
-        );
-        chart
-            .plotting_area()
-            .draw(&Rectangle::new(
-                [(0.0, a), (1.0, b)],
-                level_colour(0.5 * (a + b), lo, hi).filled(),
-            ))
-            .map_err(perr(path))?;
-    }
-    Ok(())
-}
-
 /// Rows of the x–t picture of a chain at most: longer series are binned in time, each cell
 /// showing the largest force of its bin (so no peak is lost).
 const CHAIN_PICTURE_ROWS: usize = 600;
@@ -720,7 +696,10 @@ pub fn chain_figure(
             .label_style(("sans-serif", 16))
             .draw()
             .map_err(perr(path))?;
-        draw_level_bar(&bar, path, "contact force (kN)", 0.0, fmax * 1e-3)?;
+        let kn = fmax * 1e-3;
+        draw_scale_bar(&bar, path, "contact force (kN)", (0.0, kn), |v| {
+            level_colour(v, 0.0, kn)
+        })?;
         for (k, row) in chain.contact_force_n.iter().enumerate() {
             let mut i = 0;
             while i < nt {
