@@ -130,6 +130,29 @@ pub fn load_scene(
     overrides: &[(String, Value)],
     command_line: String,
 ) -> Result<(Params, Provenance)> {
+    // A run file is rerun with its stored inputs and, unless given, its stored fidelity.
+    let stored = match scene {
+        Scene::File(path) if path.is_file() && shpb_output::reduction::is_hdf5(path)? => {
+            Some(shpb_output::provenance::read_provenance(path)?)
+        }
+        _ => None,
+    };
+    let fidelity = match (fidelity, stored.as_ref()) {
+        (Some(f), _) => Some(f),
+        (None, Some(s)) => match s.fidelity_override.as_deref() {
+            Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
+                file: match scene {
+                    Scene::File(path) => path.display().to_string(),
+                    Scene::Text { name, .. } => name.to_string(),
+                },
+                key: "/provenance fidelity_override".into(),
+                problem: format!("unknown fidelity `{name}`"),
+                allowed: "fast, standard, reference".into(),
+            })?),
+            None => None,
+        },
+        (None, None) => None,
+    };
     let mut all = overrides.to_vec();
     if let Some(f) = fidelity {
         all.push(("fidelity".to_string(), Value::String(f.name().into())));
@@ -141,25 +164,8 @@ pub fn load_scene(
             f.text = params.text.clone();
         }
     };
-    match scene {
-        Scene::File(scene) if scene.is_file() && shpb_output::reduction::is_hdf5(scene)? => {
-            let stored = shpb_output::provenance::read_provenance(scene)?;
-            let fidelity = match fidelity {
-                Some(f) => Some(f),
-                None => match stored.fidelity_override.as_deref() {
-                    Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
-                        file: scene.display().to_string(),
-                        key: "/provenance fidelity_override".into(),
-                        problem: format!("unknown fidelity `{name}`"),
-                        allowed: "fast, standard, reference".into(),
-                    })?),
-                    None => None,
-                },
-            };
-            let mut all = overrides.to_vec();
-            if let Some(f) = fidelity {
-                all.push(("fidelity".to_string(), Value::String(f.name().into())));
-            }
+    match (scene, stored) {
+        (_, Some(stored)) => {
             let params = files::replay(&stored.inputs, || {
                 Params::from_file_overridden(Path::new(&stored.scene_file), &all)
             })?;
@@ -172,7 +178,7 @@ pub fn load_scene(
             stored_scene(&params, &name, &mut provenance.inputs);
             Ok((params, provenance))
         }
-        Scene::File(scene) => {
+        (Scene::File(scene), None) => {
             let (params, mut inputs) = files::capture(|| Params::from_file_overridden(scene, &all));
             let params = params?;
             let name = scene.display().to_string();
@@ -187,7 +193,7 @@ pub fn load_scene(
                 },
             ))
         }
-        Scene::Text { name, text } => {
+        (Scene::Text { name, text }, None) => {
             let (params, mut inputs) = files::capture(|| {
                 let text = if all.is_empty() {
                     text.to_string()
@@ -315,9 +321,8 @@ fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
     if stored.scene_file.is_empty() {
         return Ok(None);
     }
-    let params = files::replay(&stored.inputs, || {
-        Params::from_file_with(Path::new(&stored.scene_file), None)
-    })?;
+    // The run's own scene, inputs and fidelity, as `shpb run RUN.h5` reruns it.
+    let (params, _) = load_scene(Scene::File(record), None, &[], String::new())?;
     Ok(match params.params {
         SceneParams::Pulse {
             apparatus, options, ..
