@@ -132,6 +132,38 @@ fn an_shpb_test_with_a_chain_of_five() {
     );
     println!("reduced peak back force: chain of five {fc:e} N, pair {fp:e} N");
     assert!(fc > 0.1 * fp && fc < fp, "{fc} vs {fp}");
+    // Its `/chain` series: four contacts, five spheres on one time axis; contact 1 is the
+    // `/contact` history (the same joint's evaluations), and the spheres end moving toward the
+    // transmission bar or at rest (the bars only push). A pair keeps its output without `/chain`.
+    assert!(pair.chain.is_none());
+    let c = chain
+        .chain
+        .as_ref()
+        .expect("a chain specimen writes /chain");
+    assert_eq!((c.contact_force_n.len(), c.velocity_m_s.len()), (4, 5));
+    let nt = c.time_s.len();
+    assert!(
+        c.contact_force_n
+            .iter()
+            .chain(&c.velocity_m_s)
+            .all(|r| r.len() == nt)
+    );
+    let contact = chain.contact.as_ref().unwrap();
+    let first_peak = c.contact_force_n[0].iter().copied().fold(0.0, f64::max);
+    assert_eq!(first_peak, contact.force_n[contact.peak_index()]);
+    // The bars load the chain over tens of µs, far longer than a contact wave takes through five
+    // spheres, so the chain is nearly in equilibrium: a middle sphere's inertia m δ/t² ≈ 1e-3 kg ×
+    // 7e-5 m / (5e-5 s)² ≈ 30 N is about 1 % of the force. All contacts peak within 5 %.
+    let peaks: Vec<f64> = c
+        .contact_force_n
+        .iter()
+        .map(|r| r.iter().copied().fold(0.0, f64::max))
+        .collect();
+    let (lo, hi) = (
+        peaks.iter().copied().fold(f64::INFINITY, f64::min),
+        peaks.iter().copied().fold(0.0, f64::max),
+    );
+    assert!(hi / lo < 1.05, "contact peaks {peaks:?}");
 }
 
 /// The run file of the example chain scene: `/chain` datasets with their shapes and units,

@@ -406,7 +406,16 @@ fn run_pulse(
     let chain = apparatus.pulse_chain(options);
     let steps = (chain.end_time_s / chain.dt_s).ceil() as usize;
     let mut report = crate::solver::record::Progress::new(steps, progress);
-    let r = crate::solver::simulate_chain_with(&chain, &mut [&mut report])?;
+    // A chain specimen of three or more spheres also gets its `/chain` series (a pair's output
+    // stays as it was: `/contact` holds its one contact).
+    let spheres = options.specimen.as_ref().map_or(0, |sp| sp.spheres.len());
+    let mut spheres_rec = (spheres >= 3).then(|| {
+        crate::solver::record::SphereChainRecorder::new(&chain.joints, chain.record_every)
+    });
+    let r = match spheres_rec.as_mut() {
+        Some(rec) => crate::solver::simulate_chain_with(&chain, &mut [&mut report, rec])?,
+        None => crate::solver::simulate_chain_with(&chain, &mut [&mut report])?,
+    };
     let e = apparatus.material.youngs_modulus_pa;
     let mut summary = vec![
         item("pressure", pressure_pa, "Pa"),
@@ -527,7 +536,7 @@ fn run_pulse(
         summary,
         reduction,
         warnings,
-        chain: None,
+        chain: spheres_rec.map(|rec| rec.series),
     })
 }
 

@@ -171,6 +171,77 @@ impl Recorder for ContactRecorder {
     }
 }
 
+/// Every sphere contact and every sphere of a chain specimen between the bars, every `every`
+/// steps: the `/chain` series of an SHPB test (docs/physics.md §8). Sphere 1 and sphere N are
+/// the end nodes of the incident and transmission bars; the spheres between are rigid masses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereChainRecorder {
+    /// Sampling interval in steps.
+    pub every: usize,
+    /// Indices of the sphere-contact joints, in order along the chain.
+    pub joints: Vec<usize>,
+    /// Each sphere as (body index, end of that body it sits at: `Some(right)` for a bar's end
+    /// node, `None` for a rigid mass).
+    pub spheres: Vec<(usize, Option<bool>)>,
+    /// The series (velocities are at the half step, as the bodies keep them).
+    pub series: crate::run::ChainSeries,
+}
+
+impl SphereChainRecorder {
+    /// A recorder of the sphere contacts of `joints` (the chain's joints), every `every` steps.
+    pub fn new(joints: &[super::joint::Joint], every: usize) -> SphereChainRecorder {
+        let contacts: Vec<usize> = joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| matches!(j, super::joint::Joint::Spheres { .. }))
+            .map(|(k, _)| k)
+            .collect();
+        let mut spheres = Vec::new();
+        if let (Some(&first), Some(&last)) = (contacts.first(), contacts.last()) {
+            // Joint k joins bodies k and k + 1.
+            spheres.push((first, Some(true)));
+            spheres.extend((first + 1..=last).map(|b| (b, None)));
+            spheres.push((last + 1, Some(false)));
+        }
+        SphereChainRecorder {
+            every,
+            series: crate::run::ChainSeries {
+                time_s: Vec::new(),
+                contact_force_n: vec![Vec::new(); contacts.len()],
+                contact_approach_m: vec![Vec::new(); contacts.len()],
+                velocity_m_s: vec![Vec::new(); spheres.len()],
+                final_velocity_m_s: Vec::new(),
+                extra: Vec::new(),
+            },
+            joints: contacts,
+            spheres,
+        }
+    }
+}
+
+impl Recorder for SphereChainRecorder {
+    fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]) {
+        if !step.is_multiple_of(self.every) {
+            return;
+        }
+        self.series.time_s.push(time_s);
+        for (k, &j) in self.joints.iter().enumerate() {
+            self.series.contact_force_n[k].push(joints[j].contact.force_n);
+            self.series.contact_approach_m[k].push(joints[j].approach_m);
+        }
+        for (k, &(b, end)) in self.spheres.iter().enumerate() {
+            let v = bodies[b].end_half_step_velocity_m_s(end.unwrap_or(true));
+            self.series.velocity_m_s[k].push(v);
+        }
+        self.series.final_velocity_m_s = self
+            .series
+            .velocity_m_s
+            .iter()
+            .map(|v| v.last().copied().unwrap_or(0.0))
+            .collect();
+    }
+}
+
 /// The decimated x–t stress field of one bar (for Lagrange diagrams).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BarSnapshots {
