@@ -23,6 +23,64 @@ impl BarGeometry {
     }
 }
 
+/// An insert (platen) pressed between a bar end and the specimen (docs/physics.md §6.8): a short
+/// elastic cylinder joined to its bar by a compression-only butt joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Insert {
+    /// Material (the bars' own unless stated).
+    pub material: BarMaterial,
+    /// Diameter, m.
+    pub diameter_m: f64,
+    /// Length along the bar axis, m (1/4" = 6.35 mm in the authors' tests).
+    pub length_m: f64,
+}
+
+impl Insert {
+    /// The insert as one uniform bar segment.
+    pub fn segment(&self) -> Segment {
+        Segment {
+            length_m: self.length_m,
+            diameter_m: self.diameter_m,
+            material: self.material,
+        }
+    }
+
+    /// Mass ρ A L, kg.
+    pub fn mass_kg(&self) -> f64 {
+        self.material.density_kg_m3 * self.segment().area_m2() * self.length_m
+    }
+
+    /// One-way wave transit L/c0 of the insert, s (docs/physics.md §6.8).
+    pub fn transit_s(&self) -> f64 {
+        self.length_m / self.material.wave_speed_m_s()
+    }
+
+    /// Whether the insert is shorter than one cell of time step `dt_s` (L < c0 Δt): it is then a
+    /// rigid mass, since a sub-cell bar segment would need a smaller step (bar.rs, "Stability").
+    pub fn is_rigid_at(&self, dt_s: f64) -> bool {
+        self.length_m < self.material.wave_speed_m_s() * dt_s * (1.0 - 1e-12)
+    }
+}
+
+/// The inserts of a set-up, on the incident and transmission sides (None: the bar touches the
+/// specimen).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Inserts {
+    /// Between the incident bar and the specimen.
+    pub incident: Option<Insert>,
+    /// Between the specimen and the transmission bar.
+    pub transmission: Option<Insert>,
+}
+
+impl Inserts {
+    /// Extra one-way transit of each side's insert, each as the length of bar of speed
+    /// `c0_m_s` it equals (L_ins c0/c_ins), m: what the reduction adds to the gauge distances.
+    pub fn equivalent_bar_lengths_m(&self, c0_m_s: f64) -> (f64, f64) {
+        let eq = |i: &Option<Insert>| i.map_or(0.0, |i| i.transit_s() * c0_m_s);
+        (eq(&self.incident), eq(&self.transmission))
+    }
+}
+
 /// A validated SHPB set-up.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Apparatus {
@@ -47,6 +105,8 @@ pub struct Apparatus {
     pub shaper: Option<PulseShaper>,
     /// Gauge channels.
     pub gauges: GaugeSetup,
+    /// Inserts (platens) between the bars and the specimen.
+    pub inserts: Inserts,
 }
 
 impl Apparatus {
@@ -183,15 +243,46 @@ impl Apparatus {
                 far,
                 dispersion,
             ));
+            // Inserts: a body each between the bar and the specimen (or the other bar), joined to
+            // its bar by a butt joint; a bar segment, or a rigid mass when shorter than a cell.
+            let insert_body = |name: &str, i: &Insert| -> crate::solver::BodySpec {
+                if i.is_rigid_at(dt) {
+                    crate::solver::BodySpec::Mass(crate::solver::MassSpec {
+                        name: name.to_string(),
+                        mass_kg: i.mass_kg(),
+                    })
+                } else {
+                    crate::solver::BodySpec::Bar(BarSpec {
+                        name: name.to_string(),
+                        segments: vec![i.segment()],
+                        left_end: EndCondition::Free,
+                        right_end: EndCondition::Free,
+                        dispersion,
+                    })
+                }
+            };
+            let transmission = bars.pop().expect("the transmission bar was pushed");
+            let mut bodies: Vec<crate::solver::BodySpec> = bars.drain(..).map(Into::into).collect();
+            if let Some(i) = &self.inserts.incident {
+                bodies.push(insert_body("incident insert", i));
+                joints.push(Joint::Butt);
+            }
+            // The body the specimen (or the transmission side) presses on first.
+            let front = bodies.len() - 1;
+            let mut sphere_masses = Vec::new();
+            let mut tail = Vec::new();
+            let mut tail_joints = Vec::new();
+            if let Some(i) = &self.inserts.transmission {
+                tail.push(insert_body("transmission insert", i));
+                tail_joints.push(Joint::Butt);
+            }
+            tail.push(transmission.into());
             match &o.specimen {
                 Some(sp) if end == IncidentEnd::Specimen => {
-                    // The first and last spheres' masses join their bars' end nodes (the
-                    // paper's DEM); the spheres between are rigid masses, every two neighbours
-                    // joined by a contact (docs/physics.md §8).
+                    // The first and last spheres' masses join the end nodes of the bodies they
+                    // touch (the paper's DEM); the spheres between are rigid masses, every two
+                    // neighbours joined by a contact (docs/physics.md §8).
                     let n = sp.spheres.len();
-                    let transmission = bars.pop().expect("the transmission bar was pushed");
-                    let mut bodies: Vec<crate::solver::BodySpec> =
-                        bars.drain(..).map(Into::into).collect();
                     for k in 0..n - 1 {
                         joints.push(Joint::Spheres {
                             props: sp.spheres.contact_properties(k),
@@ -206,14 +297,23 @@ impl Apparatus {
                             }));
                         }
                     }
-                    bodies.push(transmission.into());
-                    transmission_index = bodies.len() - 1;
-                    end_masses.push((1, true, sp.spheres.spheres[0].mass_kg));
-                    end_masses.push((transmission_index, false, sp.spheres.spheres[n - 1].mass_kg));
-                    chain_bodies = Some(bodies);
+                    let back = bodies.len();
+                    sphere_masses.push((front, true, sp.spheres.spheres[0].mass_kg));
+                    sphere_masses.push((back, false, sp.spheres.spheres[n - 1].mass_kg));
                 }
                 _ => joints.push(Joint::Butt),
             }
+            bodies.extend(tail);
+            // A sphere on a rigid insert adds to its mass; on a bar, to its end node.
+            for (k, right, m) in sphere_masses {
+                match &mut bodies[k] {
+                    crate::solver::BodySpec::Mass(body) => body.mass_kg += m,
+                    crate::solver::BodySpec::Bar(_) => end_masses.push((k, right, m)),
+                }
+            }
+            joints.extend(tail_joints);
+            transmission_index = bodies.len() - 1;
+            chain_bodies = Some(bodies);
         }
         let mut gauges = Vec::new();
         for ch in &self.gauges.channels {

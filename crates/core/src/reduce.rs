@@ -161,7 +161,8 @@ pub struct ReductionSetup {
 }
 
 impl ReductionSetup {
-    /// Bars and gauge distances of a set-up file (its `incident` and `transmission` channels).
+    /// Bars and gauge distances of a set-up file (its `incident` and `transmission` channels);
+    /// an insert adds its transit as bar length L_ins c0/c_ins (docs/physics.md §6.8).
     pub fn from_apparatus(a: &Apparatus) -> Result<ReductionSetup> {
         let m = &a.material;
         let bar = |g: &crate::apparatus::BarGeometry| BarProperties {
@@ -172,11 +173,12 @@ impl ReductionSetup {
             poisson_ratio: m.poisson_ratio,
             length_m: Some(g.length_m),
         };
+        let (ins_i, ins_t) = a.inserts.equivalent_bar_lengths_m(m.wave_speed_m_s());
         Ok(ReductionSetup {
             incident_bar: bar(&a.incident),
             transmission_bar: bar(&a.transmission),
-            incident_gauge_m: channel(a, "incident")?.distance_from_specimen_m,
-            transmission_gauge_m: channel(a, "transmission")?.distance_from_specimen_m,
+            incident_gauge_m: channel(a, "incident")?.distance_from_specimen_m + ins_i,
+            transmission_gauge_m: channel(a, "transmission")?.distance_from_specimen_m + ins_t,
             transmission_absorbing: a.transmission_absorbing,
         })
     }

@@ -5,7 +5,7 @@
 use crate::error::{Error, Result, Validator};
 use crate::gauges::GaugeSetupFile;
 use serde::Deserialize;
-use shpb_core::apparatus::{Apparatus, BarGeometry};
+use shpb_core::apparatus::{Apparatus, BarGeometry, Insert, Inserts};
 use shpb_core::bar::BarMaterial;
 use shpb_core::gauge::GaugeSetup;
 use shpb_core::shaper::PulseShaper;
@@ -58,7 +58,24 @@ struct ShaperToml {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
+struct InsertToml {
+    length_m: f64,
+    diameter_m: Option<f64>,
+    material: Option<MaterialToml>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct InsertsToml {
+    incident: Option<InsertToml>,
+    transmission: Option<InsertToml>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct ApparatusToml {
+    #[serde(default)]
+    inserts: InsertsToml,
     gauges: String,
     material: MaterialToml,
     incident: BarToml,
@@ -66,6 +83,15 @@ struct ApparatusToml {
     striker: BarToml,
     gun: GunToml,
     shaper: Option<ShaperToml>,
+}
+
+/// Validates a bar material table (`[material]`, an insert's `material`).
+fn bar_material(m: &MaterialToml, mv: &Validator) -> Result<BarMaterial> {
+    Ok(BarMaterial {
+        density_kg_m3: mv.positive("density_kg_m3", m.density_kg_m3, 1e5, "kg/m³")?,
+        youngs_modulus_pa: mv.positive("youngs_modulus_pa", m.youngs_modulus_pa, 1e13, "Pa")?,
+        poisson_ratio: mv.in_range("poisson_ratio", m.poisson_ratio, 0.0, 0.4999, "")?,
+    })
 }
 
 fn bar_geometry(b: &BarToml, v: &Validator) -> Result<BarGeometry> {
@@ -144,28 +170,7 @@ impl ApparatusFile for Apparatus {
             message: e.to_string(),
         })?;
         let v = Validator::new(file.clone());
-        let mv = v.table("material");
-        let material = BarMaterial {
-            density_kg_m3: mv.positive(
-                "density_kg_m3",
-                raw.material.density_kg_m3,
-                1e5,
-                "kg/m³",
-            )?,
-            youngs_modulus_pa: mv.positive(
-                "youngs_modulus_pa",
-                raw.material.youngs_modulus_pa,
-                1e13,
-                "Pa",
-            )?,
-            poisson_ratio: mv.in_range(
-                "poisson_ratio",
-                raw.material.poisson_ratio,
-                0.0,
-                0.4999,
-                "",
-            )?,
-        };
+        let material = bar_material(&raw.material, &v.table("material"))?;
         let transmission_absorbing = match raw.transmission.far_end.as_deref() {
             None | Some("absorbing") => true,
             Some("free") => false,
@@ -282,10 +287,31 @@ impl ApparatusFile for Apparatus {
             None => None,
         };
         let gauges = gauges(&raw.gauges)?;
+        let incident = bar_geometry(&raw.incident, &v.table("incident"))?;
+        let insert = |side: &str, t: &Option<InsertToml>| -> Result<Option<Insert>> {
+            let Some(t) = t else { return Ok(None) };
+            let iv = v.table(&format!("inserts.{side}"));
+            Ok(Some(Insert {
+                length_m: iv.positive("length_m", t.length_m, 1.0, "m")?,
+                diameter_m: match t.diameter_m {
+                    Some(d) => iv.positive("diameter_m", d, 1.0, "m")?,
+                    None => incident.diameter_m,
+                },
+                material: match &t.material {
+                    Some(m) => bar_material(m, &iv.table("material"))?,
+                    None => material,
+                },
+            }))
+        };
+        let inserts = Inserts {
+            incident: insert("incident", &raw.inserts.incident)?,
+            transmission: insert("transmission", &raw.inserts.transmission)?,
+        };
         Ok(Apparatus {
+            inserts,
             source: file,
             material,
-            incident: bar_geometry(&raw.incident, &v.table("incident"))?,
+            incident,
             transmission: bar_geometry(&raw.transmission, &v.table("transmission"))?,
             transmission_absorbing,
             striker: bar_geometry(&raw.striker, &v.table("striker"))?,
