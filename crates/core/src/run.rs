@@ -48,23 +48,7 @@ pub struct RunOutput {
     pub chain: Option<ChainSeries>,
 }
 
-/// The series of a chain of spheres, as written to `/chain` (docs/physics.md §8): contact k
-/// (1-based) is between spheres k and k + 1.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ChainSeries {
-    /// Recording times, s.
-    pub time_s: Vec<f64>,
-    /// Force of each contact (rows: contact, columns: time), N.
-    pub contact_force_n: Vec<Vec<f64>>,
-    /// Approach δ of each contact (rows: contact, columns: time), m.
-    pub contact_approach_m: Vec<Vec<f64>>,
-    /// Velocity of each sphere (rows: sphere, columns: time), m/s.
-    pub velocity_m_s: Vec<Vec<f64>>,
-    /// Velocity of each sphere at the end, m/s.
-    pub final_velocity_m_s: Vec<f64>,
-    /// Further 1-D series on the same time axis: (name, data, units), e.g. `wall_force`.
-    pub extra: Vec<(String, Vec<f64>, &'static str)>,
-}
+pub use crate::solver::record::ChainSeries;
 
 /// One recorded gauge channel: bar strain and the digitised voltage on the `/time` axis.
 #[derive(Debug, Clone, PartialEq)]

@@ -171,6 +171,24 @@ impl Recorder for ContactRecorder {
     }
 }
 
+/// The series of a chain of spheres, as written to `/chain` (docs/physics.md §8): contact k
+/// (1-based) is between spheres k and k + 1.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ChainSeries {
+    /// Recording times, s.
+    pub time_s: Vec<f64>,
+    /// Force of each contact (rows: contact, columns: time), N.
+    pub contact_force_n: Vec<Vec<f64>>,
+    /// Approach δ of each contact (rows: contact, columns: time), m.
+    pub contact_approach_m: Vec<Vec<f64>>,
+    /// Velocity of each sphere (rows: sphere, columns: time), m/s.
+    pub velocity_m_s: Vec<Vec<f64>>,
+    /// Velocity of each sphere at the end, m/s.
+    pub final_velocity_m_s: Vec<f64>,
+    /// Further 1-D series on the same time axis: (name, data, units), e.g. `wall_force`.
+    pub extra: Vec<(String, Vec<f64>, &'static str)>,
+}
+
 /// Every sphere contact and every sphere of a chain specimen between the bars, every `every`
 /// steps: the `/chain` series of an SHPB test (docs/physics.md §8). Sphere 1 and sphere N are
 /// the end nodes of the incident and transmission bars; the spheres between are rigid masses.
@@ -184,7 +202,7 @@ pub struct SphereChainRecorder {
     /// node, `None` for a rigid mass).
     pub spheres: Vec<(usize, Option<bool>)>,
     /// The series (velocities are at the half step, as the bodies keep them).
-    pub series: crate::run::ChainSeries,
+    pub series: ChainSeries,
 }
 
 impl SphereChainRecorder {
@@ -205,7 +223,7 @@ impl SphereChainRecorder {
         }
         SphereChainRecorder {
             every,
-            series: crate::run::ChainSeries {
+            series: ChainSeries {
                 time_s: Vec::new(),
                 contact_force_n: vec![Vec::new(); contacts.len()],
                 contact_approach_m: vec![Vec::new(); contacts.len()],
