@@ -1,6 +1,7 @@
 //! The striker and its gas gun: reservoir pressure → striker velocity by adiabatic expansion of
 //! the reservoir gas behind the striker over the barrel (Rohrbach et al., Am. J. Phys. 80, 24
-//! (2012); docs/physics.md §6).
+//! (2012); docs/physics.md §6.4). The gas does the same work on any striker, so a heavier striker
+//! leaves slower: ½ m v² = W(p), independent of m.
 
 use crate::error::{Error, Result, format_range, format_si};
 
@@ -96,23 +97,75 @@ pub fn most_pulse_energy_j(mass_kg: f64, velocity_m_s: f64, impulse_n_s: f64) ->
     0.5 * mass_kg * (velocity_m_s * velocity_m_s - after * after)
 }
 
-/// The simple gun curve v² = k (p − p_loss) (docs/physics.md §6), equivalent to [`GasGun`] for fixed geometry.
+/// The gun's calibration line v² = k (p − p_loss), measured with a striker of mass m_ref
+/// (docs/physics.md §6.4): the adiabatic model's work W(p) = ½ m_ref k (p − p_loss), shared by
+/// any striker, so v² = k (m_ref/m)(p − p_loss) for a striker of mass m.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LinearGun {
-    /// k, m²/s² per Pa of gauge pressure.
+    /// k, m²/s² per Pa of gauge pressure, for the calibration striker.
     pub k_m2_per_s2_per_pa: f64,
-    /// Pressure lost to friction and back-pressure, Pa.
+    /// Pressure lost to back-pressure, reservoir expansion and friction, Pa.
     pub loss_pressure_pa: f64,
+    /// Mass m_ref of the striker the line was measured with, kg.
+    pub calibration_mass_kg: f64,
     /// Smallest usable gauge pressure, Pa.
     pub min_pressure_pa: f64,
     /// Largest rated gauge pressure, Pa.
     pub max_pressure_pa: f64,
 }
 
+impl LinearGun {
+    /// Work the gas does on any striker at gauge pressure `p_gauge_pa`, ½ m_ref k (p − p_loss), J
+    /// (≤ 0: it does not move).
+    pub fn kinetic_energy_j(&self, p_gauge_pa: f64) -> f64 {
+        0.5 * self.calibration_mass_kg
+            * self.k_m2_per_s2_per_pa
+            * (p_gauge_pa - self.loss_pressure_pa)
+    }
+
+    /// The frictionless adiabatic gun (γ = `gamma`, bore `area_m2`, back-pressure `atmospheric_pa`)
+    /// with the same work line: dW/dp = V0/(γ−1)·[1 − (V0/(V0 + A Lb))^{γ−1}] = ½ m_ref k and
+    /// W(p_loss) = 0, i.e. A Lb = ½ m_ref k (1 + p_loss/p_atm) (docs/physics.md §6.4). None if no
+    /// reservoir volume fits.
+    pub fn equivalent_adiabatic(
+        &self,
+        area_m2: f64,
+        gamma: f64,
+        atmospheric_pa: f64,
+    ) -> Option<GasGun> {
+        let slope_m3 = 0.5 * self.calibration_mass_kg * self.k_m2_per_s2_per_pa;
+        let swept_m3 = slope_m3 * (1.0 + self.loss_pressure_pa / atmospheric_pa);
+        let target = slope_m3 / swept_m3;
+        // f(x) = x/(γ−1)·[1 − (x/(x+1))^{γ−1}] rises from 0 to 1 as x = V0/(A Lb) grows.
+        let f = |x: f64| x / (gamma - 1.0) * (1.0 - (x / (x + 1.0)).powf(gamma - 1.0));
+        let (mut lo, mut hi) = (1e-9_f64, 1e9_f64);
+        if !(f(lo) < target && f(hi) > target) {
+            return None;
+        }
+        for _ in 0..200 {
+            let mid = (lo * hi).sqrt();
+            if f(mid) < target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Some(GasGun {
+            reservoir_volume_m3: (lo * hi).sqrt() * swept_m3,
+            barrel_length_m: swept_m3 / area_m2,
+            friction_n: 0.0,
+            gamma,
+            atmospheric_pa,
+            min_pressure_pa: self.min_pressure_pa,
+            max_pressure_pa: self.max_pressure_pa,
+        })
+    }
+}
+
 /// A gas gun model: the linear curve or the adiabatic expansion model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gun {
-    /// v² = k (p − p_loss).
+    /// v² = k (m_ref/m)(p − p_loss): the calibration line, work shared by any striker.
     Linear(LinearGun),
     /// Adiabatic reservoir expansion over the barrel (Rohrbach et al. 2012).
     Adiabatic(GasGun),
@@ -127,14 +180,24 @@ impl Gun {
         }
     }
 
-    /// Striker velocity at gauge pressure `p_gauge_pa` (striker mass and bore for the adiabatic model);
+    /// Work the gas does on a striker of bore `area_m2` at gauge pressure `p_gauge_pa`, whatever
+    /// its mass (½ m v² = W(p), docs/physics.md §6.4), J.
+    pub fn kinetic_energy_j(&self, p_gauge_pa: f64, area_m2: f64) -> f64 {
+        match self {
+            Gun::Linear(g) => g.kinetic_energy_j(p_gauge_pa),
+            Gun::Adiabatic(g) => g.kinetic_energy_j(p_gauge_pa, area_m2),
+        }
+    }
+
+    /// Striker velocity at gauge pressure `p_gauge_pa` for a striker of mass `mass_kg` and bore
+    /// `area_m2`, v = √(2 W(p)/m);
     /// an out-of-range pressure is an [`Error::Invalid`] naming the range.
     pub fn striker_velocity_m_s(&self, p_gauge_pa: f64, mass_kg: f64, area_m2: f64) -> Result<f64> {
         match self {
             Gun::Adiabatic(g) => g.velocity_m_s(p_gauge_pa, mass_kg, area_m2),
             Gun::Linear(g) => {
                 let allowed = check_range(p_gauge_pa, g.min_pressure_pa, g.max_pressure_pa)?;
-                let v2 = g.k_m2_per_s2_per_pa * (p_gauge_pa - g.loss_pressure_pa);
+                let v2 = 2.0 * g.kinetic_energy_j(p_gauge_pa) / mass_kg;
                 if v2 <= 0.0 {
                     return Err(Error::invalid(
                         PRESSURE,
@@ -145,5 +208,98 @@ impl Gun {
                 Ok(v2.sqrt())
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The authors' calibration line (bars/authors.toml): k, p_loss, 10 cm maraging striker.
+    fn authors_line() -> LinearGun {
+        let area_m2 = std::f64::consts::PI / 4.0 * 0.01905_f64.powi(2);
+        LinearGun {
+            k_m2_per_s2_per_pa: 7.163e-4,
+            loss_pressure_pa: 21.76e3,
+            calibration_mass_kg: 8110.0 * area_m2 * 0.10,
+            min_pressure_pa: 44.8e3,
+            max_pressure_pa: 206.8e3,
+        }
+    }
+
+    fn area_m2() -> f64 {
+        std::f64::consts::PI / 4.0 * 0.01905_f64.powi(2)
+    }
+
+    #[test]
+    fn the_calibration_striker_gets_the_calibration_line() {
+        let g = authors_line();
+        let gun = Gun::Linear(g);
+        for psi in [10.0, 12.5, 15.0] {
+            let p = psi * PSI_PA;
+            let v = gun
+                .striker_velocity_m_s(p, g.calibration_mass_kg, area_m2())
+                .unwrap();
+            // Same formula rearranged: only rounding separates them.
+            assert!(
+                (v * v / (g.k_m2_per_s2_per_pa * (p - g.loss_pressure_pa)) - 1.0).abs() < 1e-12
+            );
+        }
+    }
+
+    #[test]
+    fn a_striker_twice_as_long_gets_the_same_energy_and_v_over_root_two() {
+        // ½ m v² = W(p) with W independent of m: doubling m keeps the energy and divides v by √2,
+        // so the momentum grows by √2 (and the unshaped pulse, 2 L/c0, doubles in length).
+        let g = authors_line();
+        let gun = Gun::Linear(g);
+        let m = g.calibration_mass_kg;
+        let p = 10.0 * PSI_PA;
+        let v1 = gun.striker_velocity_m_s(p, m, area_m2()).unwrap();
+        let v2 = gun.striker_velocity_m_s(p, 2.0 * m, area_m2()).unwrap();
+        assert!((v1 / v2 - 2f64.sqrt()).abs() < 1e-12);
+        assert!((0.5 * 2.0 * m * v2 * v2 / (0.5 * m * v1 * v1) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_equivalent_adiabatic_gun_reproduces_the_line_for_any_striker() {
+        // The adiabatic work is linear in p (docs/physics.md §6.4), so the frictionless gun that
+        // matches slope and zero of the line matches it at every pressure and mass.
+        let g = authors_line();
+        let a = g
+            .equivalent_adiabatic(area_m2(), 1.4, ATMOSPHERE_PA)
+            .unwrap();
+        // Fitted geometry: A Lb = ½ m_ref k (1 + p_loss/p_atm), 0.353 m of 19.05 mm bore.
+        assert!((a.barrel_length_m - 0.3528).abs() < 1e-3, "{a:?}");
+        for psi in [7.0, 10.0, 12.5, 15.0, 29.0] {
+            for factor in [0.5, 1.0, 2.0] {
+                let m = factor * g.calibration_mass_kg;
+                let p = psi * PSI_PA;
+                let lin = Gun::Linear(g)
+                    .striker_velocity_m_s(p, m, area_m2())
+                    .unwrap();
+                let adi = Gun::Adiabatic(a)
+                    .striker_velocity_m_s(p, m, area_m2())
+                    .unwrap();
+                // The reservoir volume is bisected to ~1e-15 relative; 1e-9 leaves room.
+                assert!(
+                    (lin / adi - 1.0).abs() < 1e-9,
+                    "{psi} psi ×{factor}: {lin} vs {adi}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_pressure_outside_the_range_is_refused_with_the_range() {
+        let gun = Gun::Linear(authors_line());
+        let e = gun
+            .striker_velocity_m_s(40.0 * PSI_PA, 0.23, area_m2())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("outside the gun's range") && e.contains("6.5"),
+            "{e}"
+        );
     }
 }
