@@ -139,7 +139,7 @@ impl LinearGun {
         // f(x) = x/(γ−1)·[1 − (x/(x+1))^{γ−1}] rises from 0 to 1 as x = V0/(A Lb) grows.
         let f = |x: f64| x / (gamma - 1.0) * (1.0 - (x / (x + 1.0)).powf(gamma - 1.0));
         let (mut lo, mut hi) = (1e-9_f64, 1e9_f64);
-        if !(f(lo) < target && f(hi) > target) {
+        if !target.is_finite() || f(lo) >= target || f(hi) <= target {
             return None;
         }
         for _ in 0..200 {
@@ -324,7 +324,7 @@ pub fn pulse_shape(time_s: &[f64], stress_pa: &[f64]) -> Option<PulseShape> {
         .iter()
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(b.1))?;
-    if !(peak > 0.0) {
+    if peak.is_nan() || peak <= 0.0 {
         return None;
     }
     let y = stress_pa;
