@@ -2,8 +2,8 @@
 #
 #   make deps    install the system libraries the crate links against (only when missing)
 #   make build   release build of the `shpb` binary
-#   make demo    run the paper's Fig. 4 SS440c 10 psi test as it was shot (20 cm striker, no
-#                shaper) and write demo.h5 and demo.png
+#   make demo    run the paper's Fig. 4 SS440c 10 psi test as we infer it was shot (20 cm
+#                striker, no shaper) and write demo.h5 and demo.png
 #   make test    rustfmt check, clippy (warnings are errors), the test suite and `make pytest`
 #   make pytest  the Python package (python/): a virtual environment under target/, the package
 #                built into it by maturin, and its pytest suite against the `shpb` binary
@@ -23,8 +23,9 @@ BIN := $(or $(CARGO_TARGET_DIR),target)/release/shpb
 # read every output with h5dump (hdf5-tools), as a user would.
 APT_PACKAGES := libhdf5-dev pkg-config libfontconfig1-dev hdf5-tools
 
-# The Fig. 4 SS440c 10 psi record (12.28 kN, 228 µm at peak) was shot with a 20 cm striker and no
-# shaper (validation/fig4-virtual-shpb/REPORT.md); scenes/shpb-ss440c-10psi.toml is the same test
+# The Fig. 4 SS440c 10 psi record (12.28 kN, 228 µm at peak) was, we infer from its energy and
+# momentum, shot with a 20 cm striker and no shaper (README "How was a test shot?"; the paper
+# states a 10 cm striker); scenes/shpb-ss440c-10psi.toml is the same test
 # with the 2013-05-22 set-up (10 cm striker, copper shaper).
 DEMO_SCENE := validation/fig4-virtual-shpb/ss440c-10psi-20cm-striker.toml
 DEMO_H5 := demo.h5
@@ -70,7 +71,7 @@ build: deps
 # 6.35 mm spheres, gauges and the data reduction of the simulated records.
 demo: build
 	@$(BIN) run $(DEMO_SCENE) -o $(DEMO_H5) --plot $(DEMO_PNG) --force > demo-summary.txt
-	@echo "demo: SS440c spheres, 10 psi, as the paper's Fig. 4 test was shot ($(DEMO_SCENE))"
+	@echo "demo: SS440c spheres, 10 psi, as we infer the paper's Fig. 4 test was shot ($(DEMO_SCENE))"
 	@grep -E "^result: " demo-summary.txt | sed 's/^result: /  /'
 	@grep -E "^ +energy_balance_max_relative_error " demo-summary.txt
 	@rm -f demo-summary.txt

@@ -233,6 +233,10 @@ pub enum Command {
         law: LawArg,
     },
     /// Print the striker velocity the gas gun gives at a pressure (units psi, kPa, Pa, MPa, bar).
+    ///
+    /// The gas does the same work W(p) on any striker (½ m v² = W, docs/physics.md §6.4): also
+    /// prints W, the striker's energy and momentum, the unshaped pulse, the same gun firing half
+    /// and twice the set-up's striker, and the gun's constants.
     Gun {
         /// Gauge pressure with unit, e.g. 10psi or 68.9kPa.
         #[arg(long, allow_hyphen_values = true)]
@@ -244,10 +248,14 @@ pub enum Command {
     /// Work out the incident pulse that loaded the spheres from a force–approach record.
     ///
     /// Reads a CSV with time_s, displacement_m and force_N (a Fig. 4 record, or `shpb run --csv`
-    /// of a test) and prints the incident stress pulse at the specimen face it implies,
-    /// σI = F/A + ρ c0 δ̇/2 (equal forces on both faces): peak, plateau, width, impulse, energy,
-    /// and the unshaped striker that would give it. With --pressure, also whether the set-up's
-    /// striker at the gun's velocity can deliver that impulse and energy at all.
+    /// of a test; or force_3wave_N, `shpb reduce --csv` of a gauge record, which gives the
+    /// measured incident pulse) and prints the incident stress pulse at the specimen face it
+    /// implies, σI = F/A + ρ c0 δ̇/2 (equal forces on both faces): peak, plateau, width, impulse,
+    /// energy, the unshaped striker that would give it, and which striker its shape points to
+    /// (rise over width: shaped, unshaped, inconclusive, or edge missing). With --pressure, also
+    /// the pulse's energy over the gun's work (shaped or unshaped), whether the set-up's striker
+    /// at the gun's velocity can deliver that impulse and energy at all, and what the gun gives
+    /// the unshaped striker (docs/physics.md §6.4).
     Incident {
         /// The force–approach CSV.
         record: PathBuf,

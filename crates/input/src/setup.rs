@@ -35,6 +35,7 @@ struct GunToml {
     model: String,
     k_m2_per_s2_per_pa: Option<f64>,
     loss_pressure_pa: Option<f64>,
+    calibration_striker_length_m: Option<f64>,
     reservoir_volume_m3: Option<f64>,
     barrel_length_m: Option<f64>,
     friction_n: Option<f64>,
@@ -231,6 +232,7 @@ impl ApparatusFile for Apparatus {
                 )
             })
         };
+        let striker = bar_geometry(&raw.striker, &v.table("striker"))?;
         let gun = match g.model.as_str() {
             "linear" => Gun::Linear(LinearGun {
                 k_m2_per_s2_per_pa: gv.positive(
@@ -246,9 +248,24 @@ impl ApparatusFile for Apparatus {
                     pmin,
                     "Pa (below min_pressure_pa)",
                 )?,
+                // The striker the line was measured with (same material and bore as [striker]);
+                // without the key, the set-up's own striker (docs/physics.md §6.4).
+                calibration_mass_kg: material.density_kg_m3
+                    * striker.area_m2()
+                    * match g.calibration_striker_length_m {
+                        Some(l) => gv.positive("calibration_striker_length_m", l, 100.0, "m")?,
+                        None => striker.length_m,
+                    },
                 min_pressure_pa: pmin,
                 max_pressure_pa: pmax,
             }),
+            "adiabatic" if g.calibration_striker_length_m.is_some() => {
+                return Err(gv.error(
+                    "calibration_striker_length_m",
+                    "only a calibration line (model = \"linear\") has a calibration striker",
+                    "no calibration_striker_length_m with model = \"adiabatic\"",
+                ));
+            }
             "adiabatic" => Gun::Adiabatic(GasGun {
                 reservoir_volume_m3: gv.positive(
                     "reservoir_volume_m3",
@@ -314,7 +331,7 @@ impl ApparatusFile for Apparatus {
             incident,
             transmission: bar_geometry(&raw.transmission, &v.table("transmission"))?,
             transmission_absorbing,
-            striker: bar_geometry(&raw.striker, &v.table("striker"))?,
+            striker,
             gun,
             gun_calibrated_pa,
             shaper,
@@ -381,6 +398,57 @@ impl ShaperOverride {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn editing_the_striker_length_shares_the_gun_work_with_the_new_striker() {
+        // ½ m v² = W(p) whatever the mass (docs/physics.md §6.4): doubling the striker's length
+        // in the authors' file divides v by √2 and keeps the energy; the calibration striker
+        // still gets the calibrated line (5.81 m/s at 10 psi, bars/authors.toml).
+        let text = crate::builtin::setup("authors").unwrap();
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let p = 10.0 * shpb_core::striker::PSI_PA;
+        let short = Apparatus::from_toml(text, "a.toml", &gauges).unwrap();
+        let long_text = text.replacen("length_m = 0.10\n", "length_m = 0.20\n", 1);
+        assert_ne!(long_text, text);
+        let long = Apparatus::from_toml(&long_text, "a.toml", &gauges).unwrap();
+        assert!((long.striker_mass_kg() / short.striker_mass_kg() - 2.0).abs() < 1e-12);
+        let (v1, v2) = (
+            short.striker_velocity_m_s(p).unwrap(),
+            long.striker_velocity_m_s(p).unwrap(),
+        );
+        assert!((v1 / v2 - 2f64.sqrt()).abs() < 1e-12, "{v1} {v2}");
+        let e = |a: &Apparatus, v: f64| 0.5 * a.striker_mass_kg() * v * v;
+        assert!((e(&long, v2) / e(&short, v1) - 1.0).abs() < 1e-12);
+        // The shipped 20 cm set-up is that same gun.
+        let shipped = Apparatus::resolve("authors-20cm-striker", Path::new(".")).unwrap();
+        assert!((shipped.striker_velocity_m_s(p).unwrap() / v2 - 1.0).abs() < 1e-12);
+        // A file without the key: the line belongs to its own striker (old files keep working).
+        let old = text.replace("calibration_striker_length_m = 0.10", "");
+        let old = Apparatus::from_toml(&old, "a.toml", &gauges).unwrap();
+        assert!((old.striker_velocity_m_s(p).unwrap() / v1 - 1.0).abs() < 1e-12);
+        // The key names itself when it does not apply or is not a length.
+        let bad = text.replace(
+            "calibration_striker_length_m = 0.10",
+            "calibration_striker_length_m = -1",
+        );
+        let e = Apparatus::from_toml(&bad, "a.toml", &gauges).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("a.toml: `gun.calibration_striker_length_m`"),
+            "{e}"
+        );
+        let adiabatic = text.replace(
+            "model = \"linear\"",
+            "model = \"adiabatic\"\nreservoir_volume_m3 = 3.2e-4\nbarrel_length_m = 0.353",
+        );
+        let e = Apparatus::from_toml(&adiabatic, "a.toml", &gauges).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("a.toml: `gun.calibration_striker_length_m`: only a calibration line"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn the_gun_calibration_is_read_and_checked() {

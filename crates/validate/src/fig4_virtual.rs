@@ -1,7 +1,8 @@
 //! Case `fig4-virtual-shpb`: the full virtual SHPB test (calibrated gas gun and copper shaper,
 //! the authors' bars, two spheres with the paper's law, gauges, the lab's reduction of the
 //! simulated records) for the nine scenes of `validation/fig4-virtual-shpb/`, and the SS440c 10
-//! and 12.5 psi tests as the Fig. 4 records were shot (20 cm striker, no shaper), against the eight
+//! and 12.5 psi tests as we infer the Fig. 4 records were shot (20 cm striker, no shaper; README
+//! "How was a test shot?"), against the eight
 //! measured Fig. 4 records: peak force and displacement at peak force.
 
 use crate::figure::{Figure, Legend, Panel, Series, Style};
@@ -17,8 +18,9 @@ use std::fmt::Write as _;
 
 /// (label, scene stem, stem of the Fig. 4 record of the same material and pressure in
 /// `validation/fig4-force-driven/`, if there is one) of the virtual tests: the nine with the
-/// 2013-05-22 set-up (10 cm striker, copper shaper) and the two SS440c tests the Fig. 4 records
-/// show were shot with a 20 cm striker and no shaper (validation/fig4-virtual-shpb/REPORT.md).
+/// 2013-05-22 set-up (10 cm striker, copper shaper) and the two SS440c tests we infer from the
+/// Fig. 4 records' energy and momentum were shot with a 20 cm striker and no shaper (docs/physics.md
+/// §6.4 "Which striker").
 pub(crate) const SCENES: [(&str, &str, &str); 11] = [
     ("SS440c 10 psi", "ss440c-10psi", "ss440c-10psi"),
     ("SS440c 12.5 psi", "ss440c-12p5psi", "ss440c-12p5psi"),
@@ -30,12 +32,12 @@ pub(crate) const SCENES: [(&str, &str, &str); 11] = [
     ("Al2017 12.5 psi", "al2017-12p5psi", "al2017-12p5psi"),
     ("Al2017 15 psi", "al2017-15psi", "al2017-15psi"),
     (
-        "SS440c 10 psi, 20 cm striker (as shot)",
+        "SS440c 10 psi, 20 cm striker (inferred set-up)",
         "ss440c-10psi-20cm-striker",
         "ss440c-10psi",
     ),
     (
-        "SS440c 12.5 psi, 20 cm striker (as shot)",
+        "SS440c 12.5 psi, 20 cm striker (inferred set-up)",
         "ss440c-12p5psi-20cm-striker",
         "ss440c-12p5psi",
     ),
