@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, authors_stress_from_voltage, pulse_metrics};
 use shpb_core::numeric::{bisect, least_squares, moving_average, resample};
-use shpb_core::shaper::PulseShaper;
+use shpb_core::shaper::{PulseShaper, ShaperModel};
 use shpb_core::striker::Gun;
 use shpb_input::Validator;
 use shpb_input::prelude::*;
@@ -569,6 +569,8 @@ fn main() {
                 n: 0.37,
                 m: 4.25,
                 youngs_modulus_pa: 5e9,
+                model: ShaperModel::Frew,
+                calibrated_pressure_pa: None,
             },
         };
         let spec = FitSpec {
@@ -627,6 +629,8 @@ fn main() {
                 n: 0.37,
                 m: 4.25,
                 youngs_modulus_pa: 117e9,
+                model: ShaperModel::Frew,
+                calibrated_pressure_pa: None,
             },
         };
         let spec = FitSpec {
