@@ -532,4 +532,69 @@ mod tests {
             "{e}"
         );
     }
+
+    #[test]
+    fn the_shaper_model_and_its_calibrated_range_are_read_and_checked() {
+        let text = crate::builtin::setup("authors").unwrap();
+        let head = &text[..text.find("\n[shaper]").unwrap() + 1];
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let read =
+            |shaper: &str| Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges);
+        let disc = read(
+            "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\n\
+             youngs_modulus_pa = 117e9\nfriction = 0.1\ncalibrated_pressure_psi = [10.0, 15.0]\n",
+        )
+        .unwrap();
+        let s = disc.shaper.unwrap();
+        let ShaperModel::CrushedDisc(d) = s.model else {
+            panic!("{:?}", s.model)
+        };
+        // Johnson & Cook's OFHC copper unless stated; faces of the set-up's bars, E/(1 − ν²).
+        assert_eq!(d.flow, JohnsonCook::OFHC_COPPER);
+        assert_eq!(d.friction, 0.1);
+        assert_eq!(d.face_compliance_factor, 1.0);
+        assert!((d.face_modulus_pa - 192e9 / (1.0 - 0.31 * 0.31)).abs() < 1.0);
+        let (lo, hi) = s.calibrated_pressure_pa.unwrap();
+        assert!((lo / PSI_PA - 10.0).abs() < 1e-9 && (hi / PSI_PA - 15.0).abs() < 1e-9);
+        // Frew needs its three constants; an unknown model or a reversed range names the key.
+        let e = read("[shaper]\ndiameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\n")
+            .unwrap_err();
+        assert!(e.to_string().contains("`shaper.sigma0_pa`: missing"), "{e}");
+        let e = read(
+            "[shaper]\nmodel = \"rubber\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\n",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("`shaper.model`: unknown shaper model `rubber`"),
+            "{e}"
+        );
+        let e = read(
+            "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\n\
+             youngs_modulus_pa = 117e9\ncalibrated_pressure_psi = [15.0, 10.0]\n",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("`shaper.calibrated_pressure_psi`"),
+            "{e}"
+        );
+        // A scene overriding a constant drops the calibrated range; one that does not keeps it.
+        let v = Validator::new("scene.toml");
+        let kept = ShaperOverride::default()
+            .apply(Some(s), 1e11, &v)
+            .unwrap()
+            .unwrap();
+        assert_eq!(kept.calibrated_pressure_pa, s.calibrated_pressure_pa);
+        let thicker = ShaperOverride {
+            thickness_m: Some(1e-3),
+            ..Default::default()
+        };
+        let t = thicker.apply(Some(s), 1e11, &v).unwrap().unwrap();
+        assert_eq!(t.calibrated_pressure_pa, None);
+        assert_eq!(
+            t.model, s.model,
+            "the override keeps the model and its faces"
+        );
+    }
 }

@@ -370,14 +370,14 @@ fn main() {
     );
     for fam in families {
         let mut folds = Vec::new();
-        for held in 0..3 {
+        for (held, &held_psi) in PRESSURES_PSI.iter().enumerate() {
             let train: Vec<usize> = (0..3).filter(|&i| i != held).collect();
             let f = fit(&a, fam, &records, &train, fam.start_v());
             let sh = fam.shaper(&a, &f.params);
             let sim = simulate(&a, f.velocity_m_s[held], sh);
             let errs = records
                 .iter()
-                .filter(|r| r.psi == PRESSURES_PSI[held])
+                .filter(|r| r.psi == held_psi)
                 .map(|r| {
                     (
                         r.sample,
