@@ -2,7 +2,7 @@
 //! fits each model (gun line through the two training pressures, the shaper's free constants) on
 //! two of 10 / 12.5 / 15 psi, predicts the third, and writes the section "Leave one pressure out"
 //! of `validation/pulse/REPORT.md` (the rest of that file is `calibrate_pulse`'s). Run from the
-//! repository root: `cargo run --release -p shpb-validate --bin shaper_loo` (≈ 3 min);
+//! repository root: `cargo run --release -p shpb-validate --bin shaper_loo` (≈ 19 min on two cores);
 //! `-- --probe d_mm h_mm factor mu v10 v12 v15` runs one crushed disc and prints its errors.
 
 #![warn(missing_docs)]
