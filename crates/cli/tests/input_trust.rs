@@ -384,6 +384,18 @@ fn a_gun_pressure_outside_the_calibration_warns() {
         err.contains("warning: gun pressure 20 psi is outside 10 to 15 psi, the pressures the gun of built-in set-up `authors` was calibrated at"),
         "{err}"
     );
+    assert!(
+        err.contains("warning: gun pressure 20 psi is outside 10 to 15 psi, the pressures the pulse shaper of built-in set-up `authors` was calibrated at"),
+        "{err}"
+    );
+    // Without the shaper, or with its constants overridden, no shaper calibration is claimed.
+    let bare = write(
+        dir.path(),
+        "b.toml",
+        b"kind = \"pulse\"\nbars = \"authors\"\npressure = \"20psi\"\nfidelity = \"fast\"\n[shaper]\nenabled = false\n",
+    );
+    let out = shpb(dir.path(), &["run", bare.to_str().unwrap()]);
+    assert!(!stderr(&out).contains("pulse shaper"), "{}", stderr(&out));
     for p in ["10psi", "12.5psi", "15psi"] {
         let out = shpb(dir.path(), &["run", scene(p).to_str().unwrap()]);
         assert!(!stderr(&out).contains("warning"), "{p}: {}", stderr(&out));

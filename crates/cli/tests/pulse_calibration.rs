@@ -45,7 +45,23 @@ fn authors() -> Apparatus {
 
 #[test]
 fn shipped_gun_and_shaper_match_every_incident_record() {
-    let a = authors();
+    matches_every_incident_record(&authors());
+}
+
+/// The crushed-disc alternative (docs/physics.md §6.5.2) meets the same tolerances.
+#[test]
+fn crushed_disc_gun_and_shaper_match_every_incident_record() {
+    let a = Apparatus::from_file(&root().join("bars/authors-crushed-disc.toml")).unwrap();
+    assert!(matches!(
+        a.shaper.unwrap().model,
+        shpb::shaper::ShaperModel::CrushedDisc(_)
+    ));
+    matches_every_incident_record(&a);
+}
+
+/// Every 2013-05-22 record's incident peak, rise and duration within the tolerances.
+fn matches_every_incident_record(a: &Apparatus) {
+    let a = a.clone();
     let shaper = a.shaper.expect("shipped shaper");
     let sims: Vec<PulseMetrics> = PRESSURES_PSI
         .iter()

@@ -130,7 +130,8 @@ impl Params {
     /// warning, not an error): the sphere approach beyond
     /// [`MODEL_APPROACH_LIMIT_OF_RADIUS`] of the smaller sphere radius (the paper's FEM range);
     /// the global strain rate beyond [`JOHNSON_COOK_RATE_LIMIT_PER_S`] with rate hardening on;
-    /// a gun pressure outside the pressures the set-up's gun was calibrated at.
+    /// a gun pressure outside the pressures the set-up's gun, or its shaper's constants, were
+    /// calibrated at.
     pub fn validity_warnings(&self, out: &RunOutput) -> Vec<String> {
         let mut w = Vec::new();
         let (pair, law) = match &self.params {
@@ -150,6 +151,19 @@ impl Params {
                         crate::error::format_range(lo / psi, hi / psi, "psi"),
                         apparatus.source,
                         format_si(options.striker_velocity_m_s, "m/s"),
+                    ));
+                }
+                if let Some((lo, hi)) = options.shaper.and_then(|s| s.calibrated_pressure_pa)
+                    && (*pressure_pa < lo || *pressure_pa > hi)
+                {
+                    let psi = crate::striker::PSI_PA;
+                    w.push(format!(
+                        "gun pressure {} is outside {}, the pressures the pulse shaper of {} was \
+                         calibrated at (validation/pulse/REPORT.md): the incident pulse is an \
+                         extrapolation of the shaper model",
+                        format_si(pressure_pa / psi, "psi"),
+                        crate::error::format_range(lo / psi, hi / psi, "psi"),
+                        apparatus.source,
                     ));
                 }
                 match &options.specimen {

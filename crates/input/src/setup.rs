@@ -8,7 +8,8 @@ use serde::Deserialize;
 use shpb_core::apparatus::{Apparatus, BarGeometry, Insert, Inserts};
 use shpb_core::bar::BarMaterial;
 use shpb_core::gauge::GaugeSetup;
-use shpb_core::shaper::PulseShaper;
+use shpb_core::shaper::{CrushedDisc, JohnsonCook, PulseShaper, ShaperModel};
+use shpb_core::striker::PSI_PA;
 use shpb_core::striker::{GasGun, Gun, LinearGun};
 use std::path::Path;
 
@@ -46,15 +47,25 @@ struct GunToml {
     calibrated_max_pressure_pa: Option<f64>,
 }
 
-#[derive(Deserialize, Clone, Copy)]
+#[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct ShaperToml {
+    /// "frew" (default) or "crushed-disc".
+    model: Option<String>,
     diameter_m: f64,
     thickness_m: f64,
-    sigma0_pa: f64,
-    n: f64,
-    m: f64,
+    sigma0_pa: Option<f64>,
+    n: Option<f64>,
+    m: Option<f64>,
     youngs_modulus_pa: f64,
+    friction: Option<f64>,
+    face_compliance_factor: Option<f64>,
+    jc_a_pa: Option<f64>,
+    jc_b_pa: Option<f64>,
+    jc_n: Option<f64>,
+    jc_c: Option<f64>,
+    jc_reference_rate_per_s: Option<f64>,
+    calibrated_pressure_psi: Option<[f64; 2]>,
 }
 
 #[derive(Deserialize)]
@@ -102,15 +113,85 @@ fn bar_geometry(b: &BarToml, v: &Validator) -> Result<BarGeometry> {
     })
 }
 
-/// Validates a shaper table (shared by set-up files and scenes).
-fn shaper_from(s: &ShaperToml, v: &Validator) -> Result<PulseShaper> {
+/// Validates a shaper table (shared by set-up files and scenes); `face_modulus_pa` is the
+/// plane-strain modulus E/(1 − ν²) of the bars the disc sits between.
+fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<PulseShaper> {
+    let model_name = s.model.as_deref().unwrap_or("frew");
+    let frew = model_name == "frew";
+    let need = |key: &str, x: Option<f64>| {
+        x.ok_or_else(|| {
+            v.error(
+                key,
+                format!("missing for model = \"{model_name}\""),
+                "a positive number",
+            )
+        })
+    };
+    let model = match model_name {
+        "frew" => ShaperModel::Frew,
+        "crushed-disc" => {
+            let jc = JohnsonCook::OFHC_COPPER;
+            ShaperModel::CrushedDisc(CrushedDisc {
+                flow: JohnsonCook {
+                    a_pa: v.in_range("jc_a_pa", s.jc_a_pa.unwrap_or(jc.a_pa), 0.0, 1e10, "Pa")?,
+                    b_pa: v.in_range("jc_b_pa", s.jc_b_pa.unwrap_or(jc.b_pa), 0.0, 1e10, "Pa")?,
+                    n: v.in_range("jc_n", s.jc_n.unwrap_or(jc.n), 0.01, 1.0, "")?,
+                    c: v.in_range("jc_c", s.jc_c.unwrap_or(jc.c), 0.0, 1.0, "")?,
+                    reference_rate_per_s: v.positive(
+                        "jc_reference_rate_per_s",
+                        s.jc_reference_rate_per_s.unwrap_or(jc.reference_rate_per_s),
+                        1e9,
+                        "1/s",
+                    )?,
+                },
+                friction: v.in_range("friction", s.friction.unwrap_or(0.0), 0.0, 1.0, "")?,
+                face_modulus_pa,
+                face_compliance_factor: v.in_range(
+                    "face_compliance_factor",
+                    s.face_compliance_factor.unwrap_or(1.0),
+                    0.0,
+                    1e3,
+                    "",
+                )?,
+            })
+        }
+        other => {
+            return Err(v.error(
+                "model",
+                format!("unknown shaper model `{other}`"),
+                "frew, crushed-disc",
+            ));
+        }
+    };
+    let calibrated_pressure_pa = match s.calibrated_pressure_psi {
+        None => None,
+        Some([lo, hi]) => {
+            let lo = v.positive("calibrated_pressure_psi", lo, 1e4, "psi")?;
+            let hi = v.in_range("calibrated_pressure_psi", hi, lo, 1e4, "psi")?;
+            Some((lo * PSI_PA, hi * PSI_PA))
+        }
+    };
     Ok(PulseShaper {
         diameter_m: v.positive("diameter_m", s.diameter_m, 0.1, "m")?,
         thickness_m: v.positive("thickness_m", s.thickness_m, 0.05, "m")?,
-        sigma0_pa: v.positive("sigma0_pa", s.sigma0_pa, 1e11, "Pa")?,
-        n: v.in_range("n", s.n, 0.01, 1.0, "")?,
-        m: v.in_range("m", s.m, 0.5, 50.0, "")?,
+        sigma0_pa: if frew {
+            v.positive("sigma0_pa", need("sigma0_pa", s.sigma0_pa)?, 1e11, "Pa")?
+        } else {
+            s.sigma0_pa.unwrap_or(f64::NAN)
+        },
+        n: if frew {
+            v.in_range("n", need("n", s.n)?, 0.01, 1.0, "")?
+        } else {
+            s.n.unwrap_or(f64::NAN)
+        },
+        m: if frew {
+            v.in_range("m", need("m", s.m)?, 0.5, 50.0, "")?
+        } else {
+            s.m.unwrap_or(f64::NAN)
+        },
         youngs_modulus_pa: v.positive("youngs_modulus_pa", s.youngs_modulus_pa, 1e13, "Pa")?,
+        model,
+        calibrated_pressure_pa,
     })
 }
 
@@ -300,7 +381,11 @@ impl ApparatusFile for Apparatus {
             }
         };
         let shaper = match &raw.shaper {
-            Some(s) => Some(shaper_from(s, &v.table("shaper"))?),
+            Some(s) => Some(shaper_from(
+                s,
+                material.youngs_modulus_pa / (1.0 - material.poisson_ratio.powi(2)),
+                &v.table("shaper"),
+            )?),
             None => None,
         };
         let gauges = gauges(&raw.gauges)?;
@@ -341,28 +426,54 @@ impl ApparatusFile for Apparatus {
 }
 
 /// A scene's shaper override table (same keys as the set-up file's `[shaper]`, all optional).
-#[derive(Debug, Clone, Copy, Deserialize, Default)]
+#[derive(Debug, Clone, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ShaperOverride {
     /// Use a shaper at all (default: if the set-up has one).
     pub enabled: Option<bool>,
+    /// Force law: "frew" or "crushed-disc".
+    pub model: Option<String>,
     /// Diameter, m.
     pub diameter_m: Option<f64>,
     /// Thickness, m.
     pub thickness_m: Option<f64>,
-    /// σ0, Pa.
+    /// σ0, Pa (frew).
     pub sigma0_pa: Option<f64>,
-    /// n.
+    /// n (frew).
     pub n: Option<f64>,
-    /// m.
+    /// m (frew).
     pub m: Option<f64>,
     /// Young's modulus, Pa.
     pub youngs_modulus_pa: Option<f64>,
+    /// Coulomb friction coefficient (crushed-disc).
+    pub friction: Option<f64>,
+    /// Multiplier of the Boussinesq face compliance (crushed-disc).
+    pub face_compliance_factor: Option<f64>,
 }
 
 impl ShaperOverride {
-    /// Applies the override to the set-up's shaper; errors name the scene keys.
-    pub fn apply(&self, base: Option<PulseShaper>, v: &Validator) -> Result<Option<PulseShaper>> {
+    /// Whether the override changes any constant of the set-up's shaper.
+    fn changes_constants(&self) -> bool {
+        self.model.is_some()
+            || self.diameter_m.is_some()
+            || self.thickness_m.is_some()
+            || self.sigma0_pa.is_some()
+            || self.n.is_some()
+            || self.m.is_some()
+            || self.youngs_modulus_pa.is_some()
+            || self.friction.is_some()
+            || self.face_compliance_factor.is_some()
+    }
+
+    /// Applies the override to the set-up's shaper (bars of plane-strain modulus
+    /// `face_modulus_pa`); errors name the scene keys. A shaper whose constants are overridden
+    /// carries no calibrated pressure range.
+    pub fn apply(
+        &self,
+        base: Option<PulseShaper>,
+        face_modulus_pa: f64,
+        v: &Validator,
+    ) -> Result<Option<PulseShaper>> {
         if self.enabled == Some(false) {
             return Ok(None);
         }
@@ -379,19 +490,41 @@ impl ShaperOverride {
                     n: 0.37,
                     m: 4.25,
                     youngs_modulus_pa: 117e9,
+                    model: ShaperModel::Frew,
+                    calibrated_pressure_pa: None,
                 }
             }
             None => return Ok(None),
         };
+        if !self.changes_constants() {
+            return Ok(Some(b));
+        }
+        let (base_model, disc) = match b.model {
+            ShaperModel::Frew => ("frew", None),
+            ShaperModel::CrushedDisc(d) => ("crushed-disc", Some(d)),
+        };
+        let opt = |x: f64| x.is_finite().then_some(x);
         let s = ShaperToml {
+            model: Some(self.model.clone().unwrap_or_else(|| base_model.to_string())),
             diameter_m: self.diameter_m.unwrap_or(b.diameter_m),
             thickness_m: self.thickness_m.unwrap_or(b.thickness_m),
-            sigma0_pa: self.sigma0_pa.unwrap_or(b.sigma0_pa),
-            n: self.n.unwrap_or(b.n),
-            m: self.m.unwrap_or(b.m),
+            sigma0_pa: self.sigma0_pa.or(opt(b.sigma0_pa)).or(Some(0.75e9)),
+            n: self.n.or(opt(b.n)).or(Some(0.37)),
+            m: self.m.or(opt(b.m)).or(Some(4.25)),
             youngs_modulus_pa: self.youngs_modulus_pa.unwrap_or(b.youngs_modulus_pa),
+            friction: self.friction.or(disc.map(|d| d.friction)),
+            face_compliance_factor: self
+                .face_compliance_factor
+                .or(disc.map(|d| d.face_compliance_factor)),
+            jc_a_pa: disc.map(|d| d.flow.a_pa),
+            jc_b_pa: disc.map(|d| d.flow.b_pa),
+            jc_n: disc.map(|d| d.flow.n),
+            jc_c: disc.map(|d| d.flow.c),
+            jc_reference_rate_per_s: disc.map(|d| d.flow.reference_rate_per_s),
+            calibrated_pressure_psi: None,
         };
-        shaper_from(&s, v).map(Some)
+        let face = disc.map_or(face_modulus_pa, |d| d.face_modulus_pa);
+        shaper_from(&s, face, v).map(Some)
     }
 }
 
@@ -491,6 +624,71 @@ mod tests {
                 "a.toml: `gun.calibrated_max_pressure_pa`: 300 kPa is out of range; allowed: 69 kPa to 206.8 kPa"
             ),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn the_shaper_model_and_its_calibrated_range_are_read_and_checked() {
+        let text = crate::builtin::setup("authors").unwrap();
+        let head = &text[..text.find("\n[shaper]").unwrap() + 1];
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let read =
+            |shaper: &str| Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges);
+        let disc = read(
+            "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\n\
+             youngs_modulus_pa = 117e9\nfriction = 0.1\ncalibrated_pressure_psi = [10.0, 15.0]\n",
+        )
+        .unwrap();
+        let s = disc.shaper.unwrap();
+        let ShaperModel::CrushedDisc(d) = s.model else {
+            panic!("{:?}", s.model)
+        };
+        // Johnson & Cook's OFHC copper unless stated; faces of the set-up's bars, E/(1 − ν²).
+        assert_eq!(d.flow, JohnsonCook::OFHC_COPPER);
+        assert_eq!(d.friction, 0.1);
+        assert_eq!(d.face_compliance_factor, 1.0);
+        assert!((d.face_modulus_pa - 192e9 / (1.0 - 0.31 * 0.31)).abs() < 1.0);
+        let (lo, hi) = s.calibrated_pressure_pa.unwrap();
+        assert!((lo / PSI_PA - 10.0).abs() < 1e-9 && (hi / PSI_PA - 15.0).abs() < 1e-9);
+        // Frew needs its three constants; an unknown model or a reversed range names the key.
+        let e = read("[shaper]\ndiameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\n")
+            .unwrap_err();
+        assert!(e.to_string().contains("`shaper.sigma0_pa`: missing"), "{e}");
+        let e = read(
+            "[shaper]\nmodel = \"rubber\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\n",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("`shaper.model`: unknown shaper model `rubber`"),
+            "{e}"
+        );
+        let e = read(
+            "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\n\
+             youngs_modulus_pa = 117e9\ncalibrated_pressure_psi = [15.0, 10.0]\n",
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string().contains("`shaper.calibrated_pressure_psi`"),
+            "{e}"
+        );
+        // A scene overriding a constant drops the calibrated range; one that does not keeps it.
+        let v = Validator::new("scene.toml");
+        let kept = ShaperOverride::default()
+            .apply(Some(s), 1e11, &v)
+            .unwrap()
+            .unwrap();
+        assert_eq!(kept.calibrated_pressure_pa, s.calibrated_pressure_pa);
+        let thicker = ShaperOverride {
+            thickness_m: Some(1e-3),
+            ..Default::default()
+        };
+        let t = thicker.apply(Some(s), 1e11, &v).unwrap().unwrap();
+        assert_eq!(t.calibrated_pressure_pa, None);
+        assert_eq!(
+            t.model, s.model,
+            "the override keeps the model and its faces"
         );
     }
 }

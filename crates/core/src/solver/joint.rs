@@ -103,7 +103,7 @@ impl JointState {
             }
             Joint::Shaper(s) => {
                 let shaper = self.shaper;
-                solve_force(|f| s.force_n(&mut shaper.clone(), p.average_closure_m(f, dt_s)))
+                solve_force(|f| s.force_n(&mut shaper.clone(), p.average_closure_m(f, dt_s), dt_s))
             }
             Joint::Spheres { .. } => {
                 let law = self.law.as_ref().expect("sphere joints carry their law");
@@ -119,7 +119,7 @@ impl JointState {
     pub fn commit(&mut self, p: &JointPrediction, f: f64, dt_s: f64) {
         match self.joint {
             Joint::Shaper(s) => {
-                s.force_n(&mut self.shaper, p.average_closure_m(f, dt_s));
+                s.force_n(&mut self.shaper, p.average_closure_m(f, dt_s), dt_s);
             }
             Joint::Spheres { .. } => {
                 let law = self.law.as_mut().expect("sphere joints carry their law");

@@ -62,7 +62,7 @@ pub(super) const SHAPER: Key = Key {
     key: "shaper",
     unit: "",
     default: "the set-up's shaper",
-    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), diameter_m, thickness_m, sigma0_pa, n, m, youngs_modulus_pa",
+    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), model (frew, crushed-disc), diameter_m, thickness_m, sigma0_pa, n, m (frew), youngs_modulus_pa, friction, face_compliance_factor (crushed-disc)",
 };
 
 /// `cell_size_m` (pulse and shpb).
@@ -193,7 +193,11 @@ pub(super) fn parse_bars(
     let velocity = apparatus
         .striker_velocity_m_s(pressure_pa)
         .map_err(v.core("pressure"))?;
-    let shaper = f.shaper.apply(apparatus.shaper, &v.table("shaper"))?;
+    let face_modulus_pa =
+        apparatus.material.youngs_modulus_pa / (1.0 - apparatus.material.poisson_ratio.powi(2));
+    let shaper = f
+        .shaper
+        .apply(apparatus.shaper, face_modulus_pa, &v.table("shaper"))?;
     let end = match f.incident_end.as_str() {
         _ if is_test => IncidentEnd::Specimen,
         "transmission" => IncidentEnd::Transmission,
