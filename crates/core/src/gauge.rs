@@ -406,6 +406,62 @@ pub fn pulse_metrics(
     })
 }
 
+/// Foot of the first pulse of a signal (positive pulse), the arrival feature of the reduction's
+/// windows and of the records' timing (docs/physics.md §7.5; reduce.rs module docs, "Windows").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PulseFoot {
+    /// Last sample before the peak below `fraction` of it (0 if none is).
+    pub index: usize,
+    /// Index of the pulse's peak: the largest sample of the first excursion above half the
+    /// signal's largest value.
+    pub peak_index: usize,
+    /// Where the signal rises through `fraction` of the peak, in (fractional) samples from the
+    /// start, interpolated linearly between `index` and `index + 1`.
+    pub crossing_samples: f64,
+}
+
+impl PulseFoot {
+    /// Time of the crossing on the sample times `time_s` (uniform or not), s.
+    pub fn time_s(&self, time_s: &[f64]) -> f64 {
+        let k = self.index;
+        let w = self.crossing_samples - k as f64;
+        if k + 1 < time_s.len() {
+            time_s[k] + w * (time_s[k + 1] - time_s[k])
+        } else {
+            time_s[k]
+        }
+    }
+}
+
+/// The foot of the first pulse of `y` at `fraction` of its peak (see [`PulseFoot`];
+/// docs/physics.md §7.5); None if `y` has no positive value.
+pub fn pulse_foot(y: &[f64], fraction: f64) -> Option<PulseFoot> {
+    let y_max = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if y_max.is_nan() || y_max <= 0.0 {
+        return None;
+    }
+    let half = 0.5 * y_max;
+    let k_half = y.iter().position(|&v| v >= half)?;
+    let k_end = (k_half..y.len()).find(|&k| y[k] < half).unwrap_or(y.len());
+    let mut k_peak = k_half;
+    for k in k_half..k_end {
+        if y[k] > y[k_peak] {
+            k_peak = k;
+        }
+    }
+    let level = fraction * y[k_peak];
+    let below = (0..=k_peak).rev().find(|&k| y[k] < level);
+    let (index, crossing_samples) = match below {
+        Some(k) => (k, k as f64 + (level - y[k]) / (y[k + 1] - y[k])),
+        None => (0, 0.0),
+    };
+    Some(PulseFoot {
+        index,
+        peak_index: k_peak,
+        crossing_samples,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -450,6 +506,56 @@ mod tests {
         // No tensile pulse in it; a pulse cut off by the record's end has no metrics.
         assert!(pulse_metrics(&t, &y, false).is_none());
         assert!(pulse_metrics(&t[..300], &y[..300], true).is_none());
+    }
+
+    #[test]
+    fn pulse_foot_of_a_ramp_is_its_analytic_crossing_and_skips_a_smaller_earlier_bump() {
+        // A bump of 0.3 at 5–7 µs (below half the largest value, so not "the pulse"), then a ramp
+        // from 0 at 10 µs to 2 at 30 µs (0.1 per µs), flat to 60 µs, on a 0.1 µs grid. Levels
+        // between samples: 2.35 % of the peak (0.047) at 10.47 µs, 1.3 % (0.026) at 10.26 µs.
+        // Exact up to rounding (1e-9 sample).
+        let dt = 0.1e-6;
+        let t: Vec<f64> = (0..800).map(|k| 1e-3 + k as f64 * dt).collect();
+        let y: Vec<f64> = (0..800)
+            .map(|k| {
+                let us = k as f64 * 0.1;
+                if (5.0..7.0).contains(&us) {
+                    0.3
+                } else if (10.0..30.0).contains(&us) {
+                    (us - 10.0) / 10.0
+                } else if (30.0..60.0).contains(&us) {
+                    2.0
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let f = pulse_foot(&y, 0.0235).unwrap();
+        assert_eq!(f.index, 104);
+        assert_eq!(f.peak_index, 300);
+        assert_relative_eq!(f.crossing_samples, 104.7, epsilon = 1e-9);
+        let g = pulse_foot(&y, 0.013).unwrap();
+        assert_eq!(g.index, 102);
+        assert_relative_eq!(g.time_s(&t), 1e-3 + 10.26e-6, epsilon = 1e-15);
+        // The same pulse shifted by 3.7 samples: the foot moves by 0.37 µs.
+        let shift = |s: f64| -> Vec<f64> {
+            (0..800)
+                .map(|k| {
+                    let us = (k as f64 - s) * 0.1;
+                    if (10.0..30.0).contains(&us) {
+                        (us - 10.0) / 10.0
+                    } else if (30.0..60.0).contains(&us) {
+                        2.0
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let (a, b) = (shift(0.0), shift(3.7));
+        let d = pulse_foot(&b, 0.02).unwrap().time_s(&t) - pulse_foot(&a, 0.02).unwrap().time_s(&t);
+        assert_relative_eq!(d, 0.37e-6, epsilon = 1e-15);
+        assert!(pulse_foot(&[0.0, -1.0], 0.02).is_none());
     }
 
     #[test]

@@ -451,24 +451,9 @@ fn debias(v: &[f64], n: usize) -> Vec<f64> {
 }
 
 /// Index of the foot of the first pulse of `y` (positive pulse) and its peak index, by the rule
-/// of the module docs; None if `y` has no positive value.
+/// of the module docs (`gauge::pulse_foot`); None if `y` has no positive value.
 fn pulse_foot(y: &[f64], fraction: f64) -> Option<(usize, usize)> {
-    let y_max = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if y_max.is_nan() || y_max <= 0.0 {
-        return None;
-    }
-    let half = 0.5 * y_max;
-    let k_half = y.iter().position(|&v| v >= half)?;
-    let k_end = (k_half..y.len()).find(|&k| y[k] < half).unwrap_or(y.len());
-    let mut k_peak = k_half;
-    for k in k_half..k_end {
-        if y[k] > y[k_peak] {
-            k_peak = k;
-        }
-    }
-    let level = fraction * y[k_peak];
-    let foot = (0..=k_peak).rev().find(|&k| y[k] < level).unwrap_or(0);
-    Some((foot, k_peak))
+    crate::gauge::pulse_foot(y, fraction).map(|f| (f.index, f.peak_index))
 }
 
 /// How many times the RMS of its baseline a channel's largest |ε| must be for its polarity to be
