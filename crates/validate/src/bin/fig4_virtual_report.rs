@@ -5,8 +5,8 @@
 //! (`validation/gauge-records/data`, reduced by `shpb_core::reduce` and by the authors); writes
 //! `validation/fig4-virtual-shpb/REPORT.md`. Then works out, from each Fig. 4 record's force and
 //! sphere approach, the incident pulse it implies (`shpb_core::reduce::implied_incident`), finds that
-//! the SS440c 10 and 12.5 psi records were shot with a 20 cm striker and no shaper, runs those two
-//! tests as shot (`*-20cm-striker.toml`) and draws `implied-incident.png`. Run from the
+//! the SS440c 10 and 12.5 psi records point to a 20 cm striker and no shaper (an inference: the
+//! paper states a 10 cm striker), runs those two tests with that set-up (`*-20cm-striker.toml`) and draws `implied-incident.png`. Run from the
 //! repository root with `cargo run --release -p shpb-validate --bin fig4_virtual_report`.
 
 #![warn(missing_docs)]
@@ -277,7 +277,8 @@ fn pulse_cells(p: &ImpliedIncident) -> String {
     )
 }
 
-/// The sections on the incident pulse the Fig. 4 records imply and on the SS440c tests as shot.
+/// The sections on the incident pulse the Fig. 4 records imply and on the SS440c tests with the
+/// inferred set-up.
 fn as_shot_sections(
     root: &Path,
     md: &mut String,
@@ -348,7 +349,7 @@ fn as_shot_sections(
         sims.push(row);
     }
     // The as-shot runs (shipped scenes: Love-rod bars) and the same without dispersion.
-    writeln!(md, "\n## SS440c at 10–15 psi as shot\n").unwrap();
+    writeln!(md, "\n## SS440c at 10–15 psi with the inferred set-up\n").unwrap();
     writeln!(md, "10 and 12.5 psi: `shpb run validation/fig4-virtual-shpb/ss440c-<psi>-20cm-striker.toml` (20 cm striker, no shaper, Love-rod bars, the reduction dispersion-corrected), and the same scene with `dispersion = \"none\"`; 15 psi: the shaped test `ss440c-15psi.toml` as shipped (no dispersion) and with Love-rod bars. Dispersion matters for the unshaped pulse, whose end falls within a few µs, and not for the 50 µs ramps of the shaped one. Nothing in these runs is fitted to the Fig. 4 records: the gun is the one calibrated on the 2013-05-22 incident pulses, given the heavier striker, and the striker length is read off the pulse width above.\n").unwrap();
     writeln!(md, "| test | set-up | bars | F peak true (kN) | reduced | Fig. 4 | true / Fig. 4 | δ at peak true (mm) | reduced | Fig. 4 | true / Fig. 4 |").unwrap();
     writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
@@ -395,7 +396,7 @@ fn as_shot_sections(
         }
         as_shot.push((label.to_string(), shipped_t.0, shipped_t.1, fig4, setup));
     }
-    range_table(md, &as_shot, "each test run as it was shot");
+    range_table(md, &as_shot, "each test run with its inferred set-up");
     // Figure: implied incident pulses (top) and force against approach (bottom).
     let mut panels = Vec::new();
     for (i, (label, _, _)) in SS440C.iter().enumerate() {
@@ -533,8 +534,8 @@ const SUMMARY: &str =
     "**In short.** With the set-up calibrated on the 2013-05-22 records (10 cm striker, copper
 shaper: first table) the virtual tests match the Fig. 4 records within 0–10 % in force, except
 SS440c at 10 and 12.5 psi (18 % and 13 % low). The incident pulse those two records imply shows
-why: they were shot with a 20 cm striker and no shaper (third section). Run as shot, with nothing
-fitted to Fig. 4, SS440c at 10, 12.5 and 15 psi gives peak forces 1.00, 1.05 and 1.00 and δ at
+why: they point to a 20 cm striker and no shaper (third section; an inference from the pulse's
+energy and impulse, since the paper states a 10 cm striker). Run so, with nothing fitted to Fig. 4, SS440c at 10, 12.5 and 15 psi gives peak forces 1.00, 1.05 and 1.00 and δ at
 peak 1.03, 1.00 and 1.01 of the records (last tables and figure).
 
 ";
@@ -550,7 +551,7 @@ const ANALYSIS: &str = "
   approximately); Al2017's peak force reads 1–5 % high because its transmitted signal is only
   ≈ 2 mV against the digitiser's 0.16 mV noise: a real property of this set-up with soft
   specimens, not of the model.
-* **The Fig. 4 SS440c tests at 10 and 12.5 psi were shot differently.** With the 2013-05-22
+* **The Fig. 4 SS440c tests at 10 and 12.5 psi were, we infer, shot differently.** With the 2013-05-22
   set-up (10 cm striker, copper shaper) the virtual 10 psi test is 18 % below the Fig. 4 force
   and 12 % below its δ, yet agrees with the other real 10 psi test, 2013-05-22 sample 1. The
   incident pulse the Fig. 4 records imply settles it:
@@ -566,7 +567,8 @@ const ANALYSIS: &str = "
     a 10 cm striker at the calibrated velocity cannot deliver that impulse and energy together:
     giving that impulse it leaves at a speed that takes with it all but 3.20 and 4.28 J (last
     columns of the first table), whatever the shaper does.
-  So the two records are the answer of the spheres to a different, stronger pulse. Run as shot
+  So the two records are, by inference, the answer of the spheres to a different, stronger pulse
+  (`shpb incident` reaches the same verdict from energy over the gun's work). Run so
   (`bars/authors-20cm-striker.toml`: the calibrated gun, a 20 cm striker, no shaper; nothing
   fitted to the Fig. 4 data), the virtual tests give 12.34 kN / 0.235 mm at 10 psi (record 12.28 kN
   / 0.228 mm) and 14.59 kN / 0.271 mm at 12.5 psi (record 13.87 kN / 0.271 mm), and their loading
@@ -574,7 +576,7 @@ const ANALYSIS: &str = "
 * **Dispersion** matters for the unshaped pulse only: its end falls within a few µs, and the
   real bars' dispersion rounds it; without it the peak forces come out 3–4 % higher. For the
   shaped pulse (50 µs ramps) the Love rod changes the peak by 0.1 %.
-* **Against the Fig. 4 range** (last table), run as each test was shot: 10 and 15 psi fall inside
+* **Against the Fig. 4 range** (last table), each test run with its inferred set-up: 10 and 15 psi fall inside
   in force and δ; 12.5 psi has δ at the top of the range and a force 4 % above it (5 % above its
   own record). That 5 % is the accuracy of the paper's law on this record, not of the apparatus:
   the implied incident pulse of the virtual test matches the record's within 0.5 % in plateau and
