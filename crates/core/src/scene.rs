@@ -426,10 +426,11 @@ fn run_pulse(
     let mut spheres_rec = (spheres >= 3).then(|| {
         crate::solver::record::SphereChainRecorder::new(&chain.joints, chain.record_every)
     });
-    let r = match spheres_rec.as_mut() {
-        Some(rec) => crate::solver::simulate_chain_with(&chain, &mut [&mut report, rec])?,
-        None => crate::solver::simulate_chain_with(&chain, &mut [&mut report])?,
-    };
+    let mut recorders: Vec<&mut dyn crate::solver::Recorder> = vec![&mut report];
+    if let Some(rec) = spheres_rec.as_mut() {
+        recorders.push(rec);
+    }
+    let r = crate::solver::simulate_chain_with(&chain, &mut recorders)?;
     let e = apparatus.material.youngs_modulus_pa;
     let mut summary = vec![
         item("pressure", pressure_pa, "Pa"),
@@ -550,7 +551,7 @@ fn run_pulse(
         summary,
         reduction,
         warnings,
-        chain: spheres_rec.map(|rec| rec.series),
+        chain: spheres_rec.map(|rec| rec.into_series()),
     })
 }
 

@@ -201,7 +201,8 @@ pub struct SphereChainRecorder {
     /// Each sphere as (body index, end of that body it sits at: `Some(right)` for a bar's end
     /// node, `None` for a rigid mass).
     pub spheres: Vec<(usize, Option<bool>)>,
-    /// The series (velocities are at the half step, as the bodies keep them).
+    /// The series (velocities are at the half step, as the bodies keep them; the final
+    /// velocities are filled in by [`SphereChainRecorder::into_series`]).
     pub series: ChainSeries,
 }
 
@@ -237,6 +238,19 @@ impl SphereChainRecorder {
     }
 }
 
+impl SphereChainRecorder {
+    /// The recorded series, with each sphere's final velocity (its last sample).
+    pub fn into_series(self) -> ChainSeries {
+        let mut series = self.series;
+        series.final_velocity_m_s = series
+            .velocity_m_s
+            .iter()
+            .map(|v| v.last().copied().unwrap_or(0.0))
+            .collect();
+        series
+    }
+}
+
 impl Recorder for SphereChainRecorder {
     fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]) {
         if !step.is_multiple_of(self.every) {
@@ -251,12 +265,6 @@ impl Recorder for SphereChainRecorder {
             let v = bodies[b].end_half_step_velocity_m_s(end.unwrap_or(true));
             self.series.velocity_m_s[k].push(v);
         }
-        self.series.final_velocity_m_s = self
-            .series
-            .velocity_m_s
-            .iter()
-            .map(|v| v.last().copied().unwrap_or(0.0))
-            .collect();
     }
 }
 
