@@ -17,6 +17,15 @@ pub fn argmax(values: &[f64]) -> usize {
     best
 }
 
+/// Smallest and largest of the values, (min, max); (+∞, −∞) when there are none.
+pub fn min_max(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
+    values
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
 /// Linear interpolation of (t, y) at the times `at` (end values held outside); `t` increasing.
 pub fn resample(t: &[f64], y: &[f64], at: &[f64]) -> Vec<f64> {
     let mut j = 0usize;
@@ -180,6 +189,16 @@ pub fn phase_shift(x: &[f64], dt: f64, delay: impl Fn(f64) -> f64) -> Vec<f64> {
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn min_max_is_the_extent_and_empty_is_inverted() {
+        assert_eq!(min_max([3.0, -1.5, 2.0]), (-1.5, 3.0));
+        assert_eq!(min_max([4.0]), (4.0, 4.0));
+        assert_eq!(
+            min_max(std::iter::empty()),
+            (f64::INFINITY, f64::NEG_INFINITY)
+        );
+    }
 
     #[test]
     fn argmax_takes_the_first_of_ties_and_zero_for_empty() {

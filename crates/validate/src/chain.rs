@@ -105,9 +105,7 @@ fn strike_free(material: &Material, speed_m_s: f64) -> Result<(f64, f64, f64, f6
     let peaks: Vec<f64> = (9..=34)
         .map(|k| r.contact_force_n[k].iter().copied().fold(0.0, f64::max))
         .collect();
-    let (lo, hi) = peaks
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(l, h), &p| (l.min(p), h.max(p)));
+    let (lo, hi) = shpb_core::numeric::min_max(peaks.iter().copied());
     let f_m = peaks[..=20].iter().sum::<f64>() / 21.0;
     let nesterenko = solitary::solitary_wave_speed_m_s(material, DIAMETER_M, f_m);
     Ok((
@@ -130,9 +128,7 @@ fn log_slope(x: &[f64], y: &[f64]) -> f64 {
 
 /// `a … b` of a list of values (two decimals, signed if `signed`), or one value when they agree as shown.
 fn range_text(values: impl Iterator<Item = f64>, signed: bool) -> String {
-    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-        (l.min(v), h.max(v))
-    });
+    let (lo, hi) = shpb_core::numeric::min_max(values);
     let show = |x: f64| {
         if signed {
             format!("{x:+.2}")

@@ -12,7 +12,7 @@ mod common;
 
 use shpb_core::apparatus::{Apparatus, Insert};
 use shpb_core::gauge::{BridgeKind, RawRecord, pulse_foot};
-use shpb_core::numeric::{argmax, least_squares, moving_average};
+use shpb_core::numeric::{argmax, least_squares, min_max, moving_average};
 use shpb_core::reduce::{
     Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
 };
@@ -1192,13 +1192,6 @@ fn within(x: f64) -> bool {
     x.abs() <= ARRIVAL_TOLERANCE_S
 }
 
-/// (min, max) of the values.
-fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
-    v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-        (a.min(x), b.max(x))
-    })
-}
-
 /// The sections *Timing* and *Equilibrium* (docs/physics.md §7.5).
 fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) {
     let c0 = app.material.wave_speed_m_s();
@@ -1226,7 +1219,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
         AUTHORS_INSERT_LENGTH_M * 1e3,
         ARRIVAL_TOLERANCE_S * 1e6
     );
-    let (p_lo, p_hi) = range(rows.iter().map(|r| {
+    let (p_lo, p_hi) = min_max(rows.iter().map(|r| {
         d_i - 0.5 * c0 * (r.timing.shipped.delays.reflected_s - r.timing.record.reflected_s)
     }));
     let _ = writeln!(
@@ -1295,8 +1288,8 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
         (
             rr.iter().filter(|x| within(x.0)).count(),
             rr.iter().filter(|x| within(x.1)).count(),
-            range(rr.iter().map(|x| x.0)),
-            range(rr.iter().map(|x| x.1)),
+            min_max(rr.iter().map(|x| x.0)),
+            min_max(rr.iter().map(|x| x.1)),
         )
     };
     let (a, b, c) = (
@@ -1305,9 +1298,9 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
         count(&eff),
     );
     let n = rows.len();
-    let (rt_lo, rt_hi) = range(rows.iter().map(|r| r.timing.record.transmitted_s));
-    let (rr_lo, rr_hi) = range(rows.iter().map(|r| r.timing.record.reflected_s));
-    let (st_lo, st_hi) = range(rows.iter().map(|r| eff(r).delays.transmitted_s));
+    let (rt_lo, rt_hi) = min_max(rows.iter().map(|r| r.timing.record.transmitted_s));
+    let (rr_lo, rr_hi) = min_max(rows.iter().map(|r| r.timing.record.reflected_s));
+    let (st_lo, st_hi) = min_max(rows.iter().map(|r| eff(r).delays.transmitted_s));
     let both = rows
         .iter()
         .filter(|r| {
@@ -1404,7 +1397,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
     materials.dedup();
     for m in materials {
         let g: Vec<&Row> = rows.iter().filter(|r| r.material == m).collect();
-        let rg = |f: &dyn Fn(&Row) -> f64| range(g.iter().map(|r| f(r)));
+        let rg = |f: &dyn Fn(&Row) -> f64| min_max(g.iter().map(|r| f(r)));
         let stated = rg(&|r| r.ours.equilibrium_ratio_at_peak);
         let feet = rg(&on_feet);
         let sens = rg(&|r| r.timing.sensitivity_per_s * 1e-6);
@@ -1449,12 +1442,13 @@ the simulated ratio is the ideal test's lower bound.\n",
             share.1,
         );
     }
-    let all_share = range(rows.iter().map(|r| {
+    let all_share = min_max(rows.iter().map(|r| {
         r.timing
             .record_on_feet
             .as_ref()
             .map_or(f64::NAN, |x| imbalance_of_incident(x, ea) * 100.0)
     }));
+    let sensitivity = min_max(rows.iter().map(|r| r.timing.sensitivity_per_s * 1e-6));
     let _ = writeln!(
         w,
         "So misalignment explains little of the records' imbalance: re-aligned by their own feet or \
@@ -1470,9 +1464,6 @@ the simulated ratio is the ideal test's lower bound.\n",
          path, the dispersion correction, the incident-bar end and insert interfaces, contact \
          misalignment), not shot-to-shot timing. Which of these it is was not identified here; the \
          simulated ratio is therefore the ideal test's, a lower bound, as `shpb run` says.",
-        range(rows.iter().map(|r| r.timing.sensitivity_per_s * 1e-6)).0,
-        range(rows.iter().map(|r| r.timing.sensitivity_per_s * 1e-6)).1,
-        all_share.0,
-        all_share.1,
+        sensitivity.0, sensitivity.1, all_share.0, all_share.1,
     );
 }

@@ -15,6 +15,7 @@ mod nelder_mead;
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, pulse_metrics};
+use shpb_core::numeric::min_max;
 use shpb_core::shaper::{CrushedDisc, PulseShaper, ShaperModel};
 use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
@@ -428,18 +429,16 @@ fn main() {
             100.0 * worst[3],
             if ok { "yes" } else { "**no**" }
         );
-        let (k, loss) = {
-            let (v0, v2) = (all.velocity_m_s[0], all.velocity_m_s[2]);
+        // The gun line v² = k (p − p_loss) through the 10 and 15 psi velocities of a fit.
+        let gun_line = |v: &[f64]| {
+            let (v0, v2) = (v[0], v[2]);
             let k = (v2 * v2 - v0 * v0) / (5.0 * PSI_PA);
             (k, 10.0 * PSI_PA - v0 * v0 / k)
         };
+        let (k, loss) = gun_line(&all.velocity_m_s);
         for (j, (name, scale, unit)) in names.iter().enumerate() {
             let vals: Vec<f64> = folds.iter().map(|f| f.fit.params[j]).collect();
-            let (lo, hi) = vals
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
+            let (lo, hi) = min_max(vals.iter().copied());
             let _ = writeln!(
                 constants,
                 "| {} | `{name}` | {:.4} {unit} | {:.4} – {:.4} {unit} | ± {:.1} % |",
@@ -452,11 +451,7 @@ fn main() {
         }
         let ks: Vec<(f64, f64)> = folds
             .iter()
-            .map(|f| {
-                let (v0, v2) = (f.fit.velocity_m_s[0], f.fit.velocity_m_s[2]);
-                let k = (v2 * v2 - v0 * v0) / (5.0 * PSI_PA);
-                (k, 10.0 * PSI_PA - v0 * v0 / k)
-            })
+            .map(|f| gun_line(&f.fit.velocity_m_s))
             .collect();
         for (name, x, get) in [
             ("k_m2_per_s2_per_pa", k, 0usize),
@@ -466,11 +461,7 @@ fn main() {
                 .iter()
                 .map(|p| if get == 0 { p.0 } else { p.1 })
                 .collect();
-            let (lo, hi) = vals
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
+            let (lo, hi) = min_max(vals.iter().copied());
             let _ = writeln!(
                 constants,
                 "| {} | `[gun] {name}` | {x:.4e} | {lo:.4e} – {hi:.4e} | ± {:.1} % |",

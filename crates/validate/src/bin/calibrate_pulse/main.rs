@@ -1123,11 +1123,7 @@ fn main() {
                 .collect();
             let simv = if j == 3 { sims[i].energy_j } else { get_m(&sm) };
             let mean = vals.iter().sum::<f64>() / vals.len() as f64;
-            let (lo, hi) = vals
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
+            let (lo, hi) = shpb_core::numeric::min_max(vals.iter().copied());
             let name = match j {
                 0 => "peak (MPa)",
                 1 => "rise 10–90 % (µs)",
