@@ -678,7 +678,9 @@ impl BurgoyneDaraio {
                 }
             }
             Unloading::Authors | Unloading::Dynamic => {
-                let f = h.peak_force_n.max(h.force_max_n);
+                // The largest force reached (never below the force at δmax: both are set
+                // together while loading).
+                let f = h.peak_force_n;
                 let sy = if self.unloading == Unloading::Dynamic {
                     let s = self.state_yield_stress(h.delta_max_m, f);
                     h.yielded = self.curve_at_stress(s).region(h.delta_max_m) != Region::Hertz;
@@ -690,7 +692,7 @@ impl BurgoyneDaraio {
                     let (_, dr) = self.thornton_unloading_at(h.delta_max_m, f, sy);
                     (f, h.delta_max_m - dr)
                 } else if self.unloading == Unloading::Authors {
-                    h.force_max_n = h.force_max_n.max(f);
+                    h.force_max_n = f;
                     h.unloading_radius_m = self.props.radius_m;
                     h.residual_delta_m = 0.0;
                     return;
