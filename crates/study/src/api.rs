@@ -133,18 +133,15 @@ pub fn load_scene(
     // A run file is rerun with its stored inputs and, unless given, its stored fidelity.
     let stored = match scene {
         Scene::File(path) if path.is_file() && shpb_output::reduction::is_hdf5(path)? => {
-            Some(shpb_output::provenance::read_provenance(path)?)
+            Some((path, shpb_output::provenance::read_provenance(path)?))
         }
         _ => None,
     };
     let fidelity = match (fidelity, stored.as_ref()) {
         (Some(f), _) => Some(f),
-        (None, Some(s)) => match s.fidelity_override.as_deref() {
+        (None, Some((path, s))) => match s.fidelity_override.as_deref() {
             Some(name) => Some(Fidelity::parse(name).ok_or_else(|| Error::Input {
-                file: match scene {
-                    Scene::File(path) => path.display().to_string(),
-                    Scene::Text { name, .. } => name.to_string(),
-                },
+                file: path.display().to_string(),
                 key: "/provenance fidelity_override".into(),
                 problem: format!("unknown fidelity `{name}`"),
                 allowed: "fast, standard, reference".into(),
@@ -165,7 +162,7 @@ pub fn load_scene(
         }
     };
     match (scene, stored) {
-        (_, Some(stored)) => {
+        (_, Some((_, stored))) => {
             let params = files::replay(&stored.inputs, || {
                 Params::from_file_overridden(Path::new(&stored.scene_file), &all)
             })?;
