@@ -7,6 +7,9 @@ use crate::{CaseResult, Check, Context, Unit, pct};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, RawRecord, pulse_metrics};
 use shpb_core::reduce::record_strains;
+use shpb_core::run::RunOutput;
+use shpb_core::scene::{Params, SceneParams};
+use shpb_core::shaper::PulseShaper;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
 use std::fmt::Write as _;
@@ -130,10 +133,105 @@ const REFLECTED_DELAY_MAX_S: f64 = 20e-6;
 const TRANSMITTED_DELAY_MAX_S: f64 = 30e-6;
 
 /// The three pulses of a two-channel signal, stress compression-positive.
-struct Pulses {
-    incident: PulseMetrics,
-    reflected: PulseMetrics,
-    transmitted: PulseMetrics,
+#[derive(Debug, Clone, Copy)]
+pub struct Pulses {
+    /// The first compressive pulse of the incident gauge.
+    pub incident: PulseMetrics,
+    /// The tensile pulse of the incident gauge 150–500 µs after the incident one's 10 % foot.
+    pub reflected: PulseMetrics,
+    /// The compressive pulse of the transmission gauge 100–550 µs after it.
+    pub transmitted: PulseMetrics,
+}
+
+/// Bar stresses (compression positive) at the two gauges of a test, on one time axis.
+#[derive(Debug, Clone)]
+pub struct GaugeStresses {
+    /// Time, s (a record's: from its trigger; a simulation's: from the impact).
+    pub time_s: Vec<f64>,
+    /// Incident gauge, Pa.
+    pub incident_pa: Vec<f64>,
+    /// Transmission gauge, Pa.
+    pub transmission_pa: Vec<f64>,
+}
+
+impl GaugeStresses {
+    /// A raw record read as this case reads it: strains through the set-up's channels
+    /// (`record_strains`, baseline = mean of the first [`BASELINE_SAMPLES`]), σ = −E ε, smoothed
+    /// by a centred moving average of `RECORD_SMOOTHING_S` (the records' noise would otherwise
+    /// add ≈ 2σ to each peak).
+    pub fn of_record(apparatus: &Apparatus, path: &Path) -> Result<GaugeStresses> {
+        let e = apparatus.material.youngs_modulus_pa;
+        let rec = RawRecord::read(path)?;
+        let strains = record_strains(&rec, apparatus, BASELINE_SAMPLES)?;
+        let half = (RECORD_SMOOTHING_S / rec.sample_interval_s() / 2.0).round() as usize;
+        let stress =
+            |s: &[f64]| -> Vec<f64> { smooth(&s.iter().map(|x| -e * x).collect::<Vec<_>>(), half) };
+        Ok(GaugeStresses {
+            incident_pa: stress(&strains.incident_strain),
+            transmission_pa: stress(&strains.transmission_strain),
+            time_s: rec.time_s,
+        })
+    }
+
+    /// The noise-free gauge strains of a simulated test (its `incident` and `transmission`
+    /// gauges), σ = −E ε with `e` the bars' modulus; `source` names the run in errors.
+    pub fn of_run(output: &RunOutput, e: f64, source: &str) -> Result<GaugeStresses> {
+        let gauge = |name: &str| -> Result<Vec<f64>> {
+            output
+                .gauges
+                .iter()
+                .find(|g| g.name == name)
+                .map(|g| g.strain.iter().map(|x| -e * x).collect())
+                .ok_or_else(|| Error::Input {
+                    file: source.into(),
+                    key: "gauges".into(),
+                    problem: format!("the run has no `{name}` gauge"),
+                    allowed: "a set-up with incident and transmission gauges".into(),
+                })
+        };
+        Ok(GaugeStresses {
+            time_s: output.time_s.clone().unwrap_or_default(),
+            incident_pa: gauge("incident")?,
+            transmission_pa: gauge("transmission")?,
+        })
+    }
+
+    /// Its incident, reflected and transmitted pulses; `source` names the signal in errors.
+    pub fn pulses(&self, source: &str) -> Result<Pulses> {
+        pulses(&self.time_s, &self.incident_pa, &self.transmission_pa).map_err(|what| {
+            Error::Input {
+                file: source.into(),
+                key: what.into(),
+                problem: "not found (or cut off by the end of the signal)".into(),
+                allowed: "signals with incident, reflected and transmitted pulses".into(),
+            }
+        })
+    }
+}
+
+/// The virtual test of `sample`'s material and pressure, `validation/fig4-virtual-shpb/<scene>.toml`
+/// below `root`, with its striker velocity and pulse shaper replaced when given (e.g. by a
+/// shaper and gun line fitted elsewhere: `shaper_loo`).
+pub fn virtual_test(
+    root: &Path,
+    sample: &Sample,
+    striker_velocity_m_s: Option<f64>,
+    shaper: Option<PulseShaper>,
+) -> Result<RunOutput> {
+    let path = root.join(format!(
+        "validation/fig4-virtual-shpb/{}.toml",
+        sample.scene
+    ));
+    let mut params = Params::from_file(&path)?;
+    if let SceneParams::Pulse { options, .. } = &mut params.params {
+        if let Some(v) = striker_velocity_m_s {
+            options.striker_velocity_m_s = v;
+        }
+        if shaper.is_some() {
+            options.shaper = shaper;
+        }
+    }
+    params.run().map_err(Error::from)
 }
 
 /// Metrics of the largest pulse of `y` (positive) between `t0` and `t1`.
@@ -203,47 +301,15 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
     for sample in SAMPLES {
         let (n, label, stem) = (sample.number, sample.label, sample.scene);
         let path = sample.record_path(&ctx.path(""));
-        let rec = RawRecord::read(&path)?;
-        let strains = record_strains(&rec, &apparatus, BASELINE_SAMPLES)?;
-        let half = (RECORD_SMOOTHING_S / rec.sample_interval_s() / 2.0).round() as usize;
-        let stress = |s: &[f64]| -> Vec<f64> { s.iter().map(|x| -e * x).collect() };
-        let (r_inc, r_tra) = (
-            smooth(&stress(&strains.incident_strain), half),
-            smooth(&stress(&strains.transmission_strain), half),
-        );
+        let rec = GaugeStresses::of_record(&apparatus, &path)?;
         let run = runs
             .iter()
             .find(|r| r.stem == stem)
             .expect("every virtual scene was run");
-        let t_sim = run.output.time_s.as_deref().unwrap_or(&[]);
-        let gauge = |name: &str| -> Result<Vec<f64>> {
-            run.output
-                .gauges
-                .iter()
-                .find(|g| g.name == name)
-                .map(|g| stress(&g.strain))
-                .ok_or_else(|| Error::Input {
-                    file: format!("validation/fig4-virtual-shpb/{stem}.toml"),
-                    key: "gauges".into(),
-                    problem: format!("the run has no `{name}` gauge"),
-                    allowed: "a set-up with incident and transmission gauges".into(),
-                })
-        };
-        let (s_inc, s_tra) = (gauge("incident")?, gauge("transmission")?);
-        let missing = |source: String, what: &str| Error::Input {
-            file: source,
-            key: what.into(),
-            problem: "not found (or cut off by the end of the signal)".into(),
-            allowed: "signals with incident, reflected and transmitted pulses".into(),
-        };
-        let m = pulses(&rec.time_s, &r_inc, &r_tra)
-            .map_err(|w| missing(path.display().to_string(), w))?;
-        let s = pulses(t_sim, &s_inc, &s_tra).map_err(|w| {
-            missing(
-                format!("simulation of validation/fig4-virtual-shpb/{stem}.toml"),
-                w,
-            )
-        })?;
+        let source = format!("validation/fig4-virtual-shpb/{stem}.toml");
+        let sim = GaugeStresses::of_run(&run.output, e, &source)?;
+        let m = rec.pulses(&path.display().to_string())?;
+        let s = sim.pulses(&format!("simulation of {source}"))?;
         let err = |a: &PulseMetrics, b: &PulseMetrics| a.peak / b.peak - 1.0;
         let delay = |p: &Pulses| p.transmitted.start_10_s - p.incident.start_10_s;
         let reflected_delay = |p: &Pulses| p.reflected.start_10_s - p.incident.start_10_s;
@@ -316,10 +382,10 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
             s.transmitted.rise_10_90_s * 1e6,
         ));
         let (t0r, t0s) = (m.incident.start_10_s, s.incident.start_10_s);
-        let (a, b) = window(&rec.time_s, &r_inc, t0r);
-        let (c, d) = window(t_sim, &s_inc, t0s);
-        let (f, g) = window(&rec.time_s, &r_tra, t0r);
-        let (h, k) = window(t_sim, &s_tra, t0s);
+        let (a, b) = window(&rec.time_s, &rec.incident_pa, t0r);
+        let (c, d) = window(&sim.time_s, &sim.incident_pa, t0s);
+        let (f, g) = window(&rec.time_s, &rec.transmission_pa, t0r);
+        let (h, k) = window(&sim.time_s, &sim.transmission_pa, t0s);
         panels.push(Panel {
             title: format!("2013-05-22 sample {n}: {label}"),
             x_label: "time from the incident pulse's 10 % foot (µs)".into(),
