@@ -78,6 +78,53 @@ impl Sample {
     }
 }
 
+/// One raw record of 2013-06-06, a day the calibration never saw (`validation/gauge-records/data`,
+/// CC-BY 4.0): the authors' `hopkinson_tests_6-6/test_data.txt` names each sample's specimen
+/// only; its gun pressure, striker and pulse shaper are stated nowhere in their repository.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DayRecord {
+    /// Sample number of the record.
+    pub number: usize,
+    /// Specimen material as in `specimens/` (the authors' label read as the paper's material).
+    pub material: &'static str,
+    /// The specimen as `test_data.txt` writes it.
+    pub authors_label: &'static str,
+}
+
+/// The eight records of 2013-06-06.
+pub const SAMPLES_2013_06_06: [DayRecord; 8] = [
+    day_record(1, "ss440c", "440"),
+    day_record(2, "ss440c", "440"),
+    day_record(3, "ss440c", "440"),
+    day_record(4, "ss302", "302"),
+    day_record(5, "ss302", "302"),
+    day_record(6, "al2017", "Alum"),
+    day_record(7, "al2017", "Alum"),
+    day_record(8, "ss302", "302"),
+];
+
+const fn day_record(
+    number: usize,
+    material: &'static str,
+    authors_label: &'static str,
+) -> DayRecord {
+    DayRecord {
+        number,
+        material,
+        authors_label,
+    }
+}
+
+impl DayRecord {
+    /// Path of the raw record `2013-06-06_sample<N>_<material>.csv` below the repository root.
+    pub fn record_path(&self, root: &Path) -> PathBuf {
+        root.join(format!(
+            "validation/gauge-records/data/2013-06-06_sample{}_{}.csv",
+            self.number, self.material
+        ))
+    }
+}
+
 /// Window of the incident pulse in a record, s after the trigger.
 pub const INCIDENT_WINDOW_S: (f64, f64) = (-10e-6, 250e-6);
 

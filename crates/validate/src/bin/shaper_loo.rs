@@ -31,7 +31,8 @@ use shpb_core::shaper::{CrushedDisc, PulseShaper, ShaperModel};
 use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
 use shpb_validate::gauge_records::{
-    GaugeStresses, INCIDENT_WINDOW_S, SAMPLES, Sample, incident_pulse, virtual_test,
+    GaugeStresses, INCIDENT_WINDOW_S, SAMPLES, SAMPLES_2013_06_06, Sample, incident_pulse,
+    virtual_test,
 };
 use std::fmt::Write as _;
 
@@ -863,6 +864,7 @@ fn section(
         100.0 * shipped_worst
     );
     sec.push_str(&scatter_section(records, models, &all_folds));
+    sec.push_str(&held_out_day(root, a, records));
     let _ = writeln!(
         sec,
         "### Fitted constants and their spread\n\nThe constants each model needs beyond the published ones, fitted \
@@ -1030,5 +1032,168 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
         );
     }
     s.push('\n');
+    s
+}
+
+/// The 2013-06-06 records against the shipped calibration (`a`, bars/authors.toml): their
+/// pressures are not stated, so each is run at the pressure whose simulated pulse energy equals
+/// the record's (an inference resting on the shipped gun line), and its peak, rise and duration
+/// compared there.
+fn held_out_day(root: &std::path::Path, a: &Apparatus, records: &[Record]) -> String {
+    let shaper = a.shaper.expect("the shipped set-up has a shaper");
+    let (p_lo, p_hi) = a.gun.range_pa();
+    let at = |p_pa: f64| -> Option<(PulseMetrics, f64)> {
+        simulate(a, a.striker_velocity_m_s(p_pa).ok()?, shaper)
+    };
+    let rows: Vec<(String, Option<(f64, f64)>)> = SAMPLES_2013_06_06
+        .par_iter()
+        .map(|d| {
+            let path = d.record_path(root);
+            let (t, y) = incident_pulse(a, &path).expect("2013-06-06 record");
+            let m = pulse_metrics(&t, &y, false).expect("incident pulse");
+            let energy = pulse_energy_j(a, &t, &y);
+            // Bisection on the gauge pressure: the simulated energy grows with it.
+            let (mut lo, mut hi) = (p_lo, p_hi);
+            let energy_at = |p: f64| at(p).map_or(f64::NAN, |s| s.1);
+            let implied = if energy_at(lo) > energy || energy_at(hi) < energy {
+                None
+            } else {
+                while hi - lo > 0.001 * PSI_PA {
+                    let mid = 0.5 * (lo + hi);
+                    if energy_at(mid) < energy {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                Some(0.5 * (lo + hi))
+            };
+            let mut row = format!(
+                "| {} | {} (\"{}\") | {:.1} | {:.1} | {:.1} | {:.2} |",
+                d.number,
+                d.material,
+                d.authors_label,
+                m.peak / 1e6,
+                m.rise_10_90_s * 1e6,
+                m.duration_10_s * 1e6,
+                energy
+            );
+            let mut found = None;
+            match implied.and_then(|p| Some((p, at(p)?))) {
+                Some((p, s)) => {
+                    found = Some((p, s.0.peak / m.peak - 1.0));
+                    let _ = write!(
+                        row,
+                        " {:.2} | {} | {} | {} |",
+                        p / PSI_PA,
+                        pct(s.0.peak / m.peak - 1.0, TOL[0]),
+                        pct(s.0.rise_10_90_s / m.rise_10_90_s - 1.0, TOL[1]),
+                        pct(s.0.duration_10_s / m.duration_10_s - 1.0, TOL[2]),
+                    );
+                }
+                None => row.push_str(" outside the gun's range | | | |"),
+            }
+            (row, found)
+        })
+        .collect();
+    // How far an energy error moves an implied pressure: the shipped model's largest |energy
+    // error| on the 2013-05-22 records, over its energy's slope between 12.5 and 15 psi.
+    let sims: Vec<Option<(PulseMetrics, f64)>> =
+        PRESSURES_PSI.iter().map(|&p| at(p * PSI_PA)).collect();
+    let worst_energy = records
+        .iter()
+        .filter_map(|r| Some((sims[pressure_index(r.psi)].as_ref()?.1 / r.energy_j - 1.0).abs()))
+        .fold(0.0, f64::max);
+    let slope = match (&sims[1], &sims[2]) {
+        (Some(a), Some(b)) => (b.1 - a.1) / 2.5,
+        _ => f64::NAN,
+    };
+    let e15 = sims[2].as_ref().map_or(f64::NAN, |s| s.1);
+    let energies = |psi: f64| {
+        let e: Vec<String> = records
+            .iter()
+            .filter(|r| r.psi == psi)
+            .map(|r| format!("{:.2}", r.energy_j))
+            .collect();
+        e.join(", ")
+    };
+    let mut s = format!(
+        "### The 2013-06-06 records (a held-out day)\n\n\
+         Eight records shot on 2013-06-06 on the same bars (the authors' `hopkinson_tests_6-6/sample<N>.lvm`, \
+         converted to `validation/gauge-records/data/2013-06-06_sample<N>_<material>.csv`, CC-BY 4.0), read \
+         exactly as the 2013-05-22 ones above (incident channel, same window and baseline). The authors' \
+         `test_data.txt` for that day names each sample's specimen (440, 302, Alum) and nothing else: **the gun \
+         pressures, the striker and the pulse shaper of these tests are stated nowhere** in their repository, \
+         the paper (\"pressures varied from 50 kPa to 125 kPa\", 7.3–18.1 psi, over all tests) or the project's \
+         reference notes. So the shipped calibration cannot be checked against them per pressure. What can be \
+         asked is whether the shipped model, run at the pressure whose simulated pulse energy equals the \
+         record's (the *energy-implied pressure*: an inference that rests on the shipped gun line, extrapolated \
+         above 15 psi), gives the record's peak, rise and duration: a test of the shaper's pulse shape at \
+         energies beyond the calibration's, not of the gun. For scale, the 2013-05-22 pulses carry \
+         {} J at 10 psi, {} J at 12.5 psi and {} J at 15 psi. The shipped model's pulse energy errs by up to \
+         {:.1} % on those records; at 15 psi ({:.2} J, {:.2} J per psi) that is {:.1} psi of implied pressure, \
+         the uncertainty of the column below. Errors bold beyond the leave-one-out targets (5 / 10 / 10 %).\n\n\
+         | sample | specimen (test_data.txt) | peak (MPa) | rise 10–90 % (µs) | duration at 10 % (µs) | energy (J) | energy-implied pressure, shipped gun line (psi) | peak error there | rise error | duration error |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+        energies(10.0),
+        energies(12.5),
+        energies(15.0),
+        100.0 * worst_energy,
+        e15,
+        slope,
+        worst_energy * e15 / slope
+    );
+    for (r, _) in &rows {
+        let _ = writeln!(s, "{r}");
+    }
+    let (cal_lo, cal_hi) = a
+        .gun_calibrated_pa
+        .map_or((10.0, 15.0), |(l, h)| (l / PSI_PA, h / PSI_PA));
+    let group = |inside: bool| -> String {
+        let mut v: Vec<(usize, f64, f64)> = rows
+            .iter()
+            .zip(&SAMPLES_2013_06_06)
+            .filter_map(|((_, f), d)| {
+                let (p, e) = (*f)?;
+                let psi = p / PSI_PA;
+                ((psi <= cal_hi + 1e-9) == inside).then_some((d.number, psi, e))
+            })
+            .collect();
+        v.sort_by(|x, y| x.1.total_cmp(&y.1));
+        if v.is_empty() {
+            return "no record".into();
+        }
+        let items: Vec<String> = v
+            .iter()
+            .map(|(n, psi, e)| format!("sample {n} {psi:.1} psi {:+.1} %", 100.0 * e))
+            .collect();
+        items.join(", ")
+    };
+    let range = |inside: bool| -> String {
+        let e: Vec<f64> = rows
+            .iter()
+            .filter_map(|(_, f)| {
+                let (p, e) = (*f)?;
+                ((p / PSI_PA <= cal_hi + 1e-9) == inside).then_some(e)
+            })
+            .collect();
+        if e.is_empty() {
+            return "—".into();
+        }
+        let (lo, hi) = min_max(e.iter().copied());
+        format!("{:+.1} to {:+.1} %", 100.0 * lo, 100.0 * hi)
+    };
+    let _ = writeln!(
+        s,
+        "\n**Reading (inference).** Peak error at the energy-implied pressure, ordered by that pressure: within \
+         the calibrated {cal_lo:.0}–{cal_hi:.0} psi {}; above it {}. So, matched to these pulses' energy, the shipped \
+         model's peak errs by {} where the implied pressure lies within the calibrated range and by {} above it \
+         (rise and duration: the table): the direction of its held-out 15 psi peak error above, and what issue 18 \
+         reported for this day. Knowing the pressure each test was shot at would turn this inference into a test.\n",
+        group(true),
+        group(false),
+        range(true),
+        range(false),
+    );
     s
 }
