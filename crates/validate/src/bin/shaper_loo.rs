@@ -901,8 +901,9 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
     let mut s = String::from(
         "### The records' own scatter\n\nThe records at one pressure differ among themselves (one record per \
          specimen material, shot the same day with the same gun and shaper). Per pressure: the records' values, \
-         their mean and their spread (max − min)/mean; and each model's held-out prediction against that mean \
-         (bold: outside the target). The transmitted peak has no such column: at one pressure each record has \
+         their mean and their spread (max − min)/mean (two records at 10 psi, three at 12.5 and 15 psi: a spread \
+         of so few records is a lower bound of the day's scatter); and each model's held-out prediction against \
+         that mean (bold: outside the target). The transmitted peak has no such column: at one pressure each record has \
          another specimen material, so its records do not repeat one test.\n\n",
     );
     let mut head = String::from("| psi | samples | metric | records | mean | spread |");
