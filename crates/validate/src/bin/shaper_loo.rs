@@ -400,6 +400,11 @@ fn read_cache(path: &std::path::Path) -> Result<(Vec<ModelFits>, u64), String> {
             .ok_or(format!("unknown model `{key}`"))?;
         let train = floats(entry.get("trained_on_psi"), "trained_on_psi")?;
         let v = floats(entry.get("velocity_m_s"), "velocity_m_s")?;
+        if !train.iter().all(|p| PRESSURES_PSI.contains(p)) {
+            return Err(format!(
+                "`trained_on_psi` = {train:?}: not among 10, 12.5, 15 psi"
+            ));
+        }
         let index = match train.len() {
             3 => 3,
             2 => (0..3)
@@ -1197,4 +1202,78 @@ fn held_out_day(root: &std::path::Path, a: &Apparatus, records: &[Record]) -> St
         range(false),
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit(x: f64) -> Fit {
+        Fit {
+            velocity_m_s: [x, 2.0 * x, 3.0 * x],
+            params: vec![x * 1e-3, x * 1e-20, x * 1e9],
+            objective: x / 7.0,
+        }
+    }
+
+    #[test]
+    fn the_fit_cache_reads_back_every_constant_exactly() {
+        // The cache must hand the evaluation the very numbers the fits found (the report's
+        // numbers are reproduced from it), so the round trip is exact, not within a tolerance.
+        let models: Vec<ModelFits> = FAMILIES
+            .iter()
+            .enumerate()
+            .map(|(i, &fam)| ModelFits {
+                fam,
+                folds: (0..3)
+                    .map(|k| fit(1.0 / (3.0 + (3 * i + k) as f64)))
+                    .collect(),
+                all: fit(std::f64::consts::PI + i as f64),
+            })
+            .collect();
+        let path =
+            std::env::temp_dir().join(format!("shaper_loo_cache_test_{}.toml", std::process::id()));
+        std::fs::write(&path, cache_text(&models, 1234)).unwrap();
+        let (back, seconds) = read_cache(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(seconds, 1234);
+        assert_eq!(back.len(), models.len());
+        for (a, b) in models.iter().zip(&back) {
+            assert!(a.fam == b.fam);
+            for (x, y) in a
+                .folds
+                .iter()
+                .chain([&a.all])
+                .zip(b.folds.iter().chain([&b.all]))
+            {
+                assert_eq!(x.velocity_m_s, y.velocity_m_s);
+                assert_eq!(x.params, y.params);
+                assert_eq!(x.objective, y.objective);
+            }
+        }
+    }
+
+    #[test]
+    fn a_cache_without_a_model_or_with_a_foreign_pressure_is_refused_or_incomplete() {
+        let path =
+            std::env::temp_dir().join(format!("shaper_loo_cache_bad_{}.toml", std::process::id()));
+        let text = "fit_seconds = 1\n[[fit]]\nmodel = \"frew\"\ntrained_on_psi = [10.0, 17.5]\n\
+                    velocity_m_s = [1.0, 2.0, 3.0]\nparams = [1.0, 2.0, 3.0]\nobjective = 1.0\n";
+        std::fs::write(&path, text).unwrap();
+        let r = read_cache(&path);
+        std::fs::remove_file(&path).unwrap();
+        assert!(
+            r.is_err(),
+            "a pressure outside 10 / 12.5 / 15 psi must be refused"
+        );
+        let text = "fit_seconds = 1\n[[fit]]\nmodel = \"frew\"\ntrained_on_psi = [10.0, 15.0]\n\
+                    velocity_m_s = [1.0, 2.0, 3.0]\nparams = [1.0, 2.0, 3.0]\nobjective = 1.0\n";
+        std::fs::write(&path, text).unwrap();
+        let (models, _) = read_cache(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert!(
+            models.is_empty(),
+            "a model with one of its four fits is not usable"
+        );
+    }
 }
