@@ -9,7 +9,7 @@ use shpb::gauge::{
     authors_stress_from_voltage, pulse_metrics, remove_baseline,
 };
 use shpb::prelude::*;
-use shpb::validate::gauge_records::SAMPLES;
+use shpb::validate::gauge_records::{SAMPLES, SAMPLES_2013_06_06};
 use std::path::{Path, PathBuf};
 
 /// The authors' bar constants (shared/reference/README.md).
@@ -662,4 +662,39 @@ fn record_with_non_monotonic_time_is_an_error_naming_file_and_line() {
     let rec = RawRecord::read(Path::new(&records()[0].1)).unwrap();
     assert_eq!(rec.incident_v.len(), rec.time_s.len());
     assert!((rec.sample_interval_s() - 1e-7).abs() < 1e-12);
+}
+
+#[test]
+fn the_2013_06_06_records_read_like_the_2013_05_22_ones() {
+    // The held-out day's fixtures (validation/gauge-records/data/README.md): converted from the
+    // authors' LabVIEW files with their credit line, the same sampling and length as the
+    // calibration records, and, like them, a compressive incident pulse (negative incident
+    // voltage) before anything else on the channel.
+    let reference = RawRecord::read(&SAMPLES[0].record_path(&root())).unwrap();
+    for d in SAMPLES_2013_06_06 {
+        let path = d.record_path(&root());
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.lines()
+                .take_while(|l| l.starts_with('#'))
+                .any(|l| l.starts_with("# source: Daraio-lab/Burgoyne_PRE_2014 (CC-BY 4.0)")),
+            "{}: no credit line",
+            path.display()
+        );
+        let r = RawRecord::read(&path).unwrap();
+        assert_eq!(r.time_s.len(), reference.time_s.len(), "{}", path.display());
+        assert!(
+            (r.sample_interval_s() / reference.sample_interval_s() - 1.0).abs() < 1e-6,
+            "{}",
+            path.display()
+        );
+        let v = remove_baseline(&r.incident_v, 900);
+        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let first = v.iter().find(|x| x.abs() > 0.3 * largest).unwrap();
+        assert!(
+            *first < 0.0,
+            "{}: first pulse not compressive",
+            path.display()
+        );
+    }
 }
