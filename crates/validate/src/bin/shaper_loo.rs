@@ -10,8 +10,8 @@
 //! Run from the repository root: `cargo run --release -p shpb-validate --bin shaper_loo`.
 //! The fits are cached: a fitting run writes every fitted constant at full precision to
 //! `validation/pulse/shaper_loo_fits.toml`, and a run without `--refit` reads them from there and
-//! only evaluates (seconds instead of the fits' minutes; it fits when the cache is missing or
-//! lacks a model). `-- --refit` fits again (≈ 5–20 min on two cores, depending on the load) and
+//! only evaluates (≈ 1 min on two cores instead of the fits' 20–30; it fits when the cache is
+//! missing or lacks a model). `-- --refit` fits again (≈ 5–20 min on two cores, depending on the load) and
 //! rewrites the cache; `-- --frew` / `-- --disc` restrict the run to one model (a refit of one
 //! model keeps the others' cached fits). `-- --probe d_mm h_mm factor mu v10 v12 v15` runs one
 //! crushed disc and prints its errors.
@@ -870,6 +870,7 @@ fn section(
     );
     sec.push_str(&scatter_section(records, models, &all_folds));
     sec.push_str(&held_out_day(root, a, records));
+    sec.push_str(&held_out_day_models(root, a, models));
     let _ = writeln!(
         sec,
         "### Fitted constants and their spread\n\nThe constants each model needs beyond the published ones, fitted \
@@ -1041,6 +1042,127 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
     s
 }
 
+/// The gauge pressure in `lo`–`hi` (Pa) at which the pulse `at` gives carries `energy` (J), by
+/// bisection (the simulated energy grows with the pressure), with that pulse; None: outside.
+fn energy_implied(
+    at: &(dyn Fn(f64) -> Option<(PulseMetrics, f64)> + Sync),
+    energy: f64,
+    lo: f64,
+    hi: f64,
+) -> Option<(f64, (PulseMetrics, f64))> {
+    let energy_at = |p: f64| at(p).map_or(f64::NAN, |s| s.1);
+    if !(energy_at(lo) <= energy && energy_at(hi) >= energy) {
+        return None;
+    }
+    let (mut lo, mut hi) = (lo, hi);
+    while hi - lo > 0.001 * PSI_PA {
+        let mid = 0.5 * (lo + hi);
+        if energy_at(mid) < energy {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let p = 0.5 * (lo + hi);
+    Some((p, at(p)?))
+}
+
+/// An energy-implied pressure (psi) and the peak, rise and duration errors there.
+type Implied = (f64, [f64; 3]);
+
+/// The 2013-06-06 records against each model fitted on all three pressures, each at its own
+/// energy-implied pressure (its gun line through its fitted 10 and 15 psi velocities).
+fn held_out_day_models(root: &std::path::Path, a: &Apparatus, models: &[ModelFits]) -> String {
+    let (p_min, p_max) = a.gun.range_pa();
+    let measured: Vec<(PulseMetrics, f64)> = SAMPLES_2013_06_06
+        .iter()
+        .map(|d| {
+            let (t, y) = incident_pulse(a, &d.record_path(root)).expect("2013-06-06 record");
+            (
+                pulse_metrics(&t, &y, false).expect("incident pulse"),
+                pulse_energy_j(a, &t, &y),
+            )
+        })
+        .collect();
+    let mut s = String::from(
+        "The same question for each model fitted on all three pressures (the constants above), each at the \
+         pressure at which its own gun line and shaper give the record's pulse energy: implied pressure (psi), \
+         then peak / rise / duration error there.\n\n| sample |",
+    );
+    let mut rule = String::from("|---|");
+    for m in models {
+        let _ = write!(s, " {} |", m.fam.name());
+        rule.push_str("---|");
+    }
+    let _ = writeln!(s, "\n{rule}");
+    let mut above: Vec<Vec<f64>> = vec![Vec::new(); models.len()];
+    let cells: Vec<Vec<Option<Implied>>> = models
+        .par_iter()
+        .map(|m| {
+            let v = m.all.velocity_m_s;
+            let k = (v[2] * v[2] - v[0] * v[0]) / (5.0 * PSI_PA);
+            let loss = 10.0 * PSI_PA - v[0] * v[0] / k;
+            let shaper = m.fam.shaper(a, &m.all.params);
+            let at = move |p: f64| -> Option<(PulseMetrics, f64)> {
+                let v2 = k * (p - loss);
+                (v2 > 0.0).then(|| simulate(a, v2.sqrt(), shaper)).flatten()
+            };
+            measured
+                .iter()
+                .map(|(mm, e)| {
+                    let (p, sim) = energy_implied(&at, *e, p_min.max(loss + 0.1 * PSI_PA), p_max)?;
+                    Some((
+                        p / PSI_PA,
+                        [
+                            sim.0.peak / mm.peak - 1.0,
+                            sim.0.rise_10_90_s / mm.rise_10_90_s - 1.0,
+                            sim.0.duration_10_s / mm.duration_10_s - 1.0,
+                        ],
+                    ))
+                })
+                .collect()
+        })
+        .collect();
+    for (k, d) in SAMPLES_2013_06_06.iter().enumerate() {
+        let mut row = format!("| {} |", d.number);
+        for (mi, c) in cells.iter().enumerate() {
+            match c[k] {
+                Some((psi, e)) => {
+                    if psi > 15.0 {
+                        above[mi].push(e[0]);
+                    }
+                    let _ = write!(
+                        row,
+                        " {psi:.1}: {} / {} / {} |",
+                        pct(e[0], TOL[0]),
+                        pct(e[1], TOL[1]),
+                        pct(e[2], TOL[2])
+                    );
+                }
+                None => row.push_str(" outside the gun's range |"),
+            }
+        }
+        let _ = writeln!(s, "{row}");
+    }
+    s.push('\n');
+    for (mi, m) in models.iter().enumerate() {
+        if above[mi].is_empty() {
+            continue;
+        }
+        let (lo, hi) = min_max(above[mi].iter().copied());
+        let _ = writeln!(
+            s,
+            "- **{}**: peak error {:+.1} to {:+.1} % on the {} records implied above 15 psi.",
+            m.fam.name(),
+            100.0 * lo,
+            100.0 * hi,
+            above[mi].len()
+        );
+    }
+    s.push('\n');
+    s
+}
+
 /// The 2013-06-06 records against the shipped calibration (`a`, bars/authors.toml): their
 /// pressures are not stated, so each is run at the pressure whose simulated pulse energy equals
 /// the record's (an inference resting on the shipped gun line), and its peak, rise and duration
@@ -1058,22 +1180,7 @@ fn held_out_day(root: &std::path::Path, a: &Apparatus, records: &[Record]) -> St
             let (t, y) = incident_pulse(a, &path).expect("2013-06-06 record");
             let m = pulse_metrics(&t, &y, false).expect("incident pulse");
             let energy = pulse_energy_j(a, &t, &y);
-            // Bisection on the gauge pressure: the simulated energy grows with it.
-            let (mut lo, mut hi) = (p_lo, p_hi);
-            let energy_at = |p: f64| at(p).map_or(f64::NAN, |s| s.1);
-            let implied = if energy_at(lo) > energy || energy_at(hi) < energy {
-                None
-            } else {
-                while hi - lo > 0.001 * PSI_PA {
-                    let mid = 0.5 * (lo + hi);
-                    if energy_at(mid) < energy {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                Some(0.5 * (lo + hi))
-            };
+            let implied = energy_implied(&at, energy, p_lo, p_hi).map(|x| x.0);
             let mut row = format!(
                 "| {} | {} (\"{}\") | {:.1} | {:.1} | {:.1} | {:.2} |",
                 d.number,
