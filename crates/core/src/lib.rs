@@ -12,6 +12,7 @@
 pub mod apparatus;
 pub mod bar;
 pub mod contact;
+pub mod dispersion;
 pub mod error;
 pub mod estimate;
 pub mod fidelity;
