@@ -296,12 +296,27 @@ def curve(
     return _shpb.curve(pair, float(rate), float(to), int(points), law)
 
 
-def reduce(record: PathLike, bars: Optional[PathLike] = None, dispersion: bool = True) -> Run:
+def reduce(
+    record: PathLike,
+    bars: Optional[PathLike] = None,
+    dispersion: Union[str, bool] = "bancroft",
+    tyas_pope: bool = False,
+) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
-    ``bars``: the set-up (default: the run file's own, else ``"authors"``)."""
+    ``bars``: the set-up (default: the run file's own, else ``"authors"``). ``dispersion``:
+    ``"none"``, ``"bancroft"`` or ``"pochhammer-chree"`` (``--dispersion``; ``True``/``False``,
+    the old form, mean ``"bancroft"``/``"none"``); ``tyas_pope``: the Tyas–Pope amplitude
+    factors (``--tyas-pope``)."""
+    if isinstance(dispersion, bool):
+        dispersion = "bancroft" if dispersion else "none"
     return Run(
-        _shpb.reduce(os.fspath(record), None if bars is None else os.fspath(bars), dispersion)
+        _shpb.reduce(
+            os.fspath(record),
+            None if bars is None else os.fspath(bars),
+            dispersion,
+            bool(tyas_pope),
+        )
     )
 
 

@@ -6,6 +6,7 @@ use crate::cmd;
 use clap::{Parser, Subcommand, ValueEnum};
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
+use shpb_core::reduce::DispersionCorrection;
 use shpb_input::Result;
 use std::path::PathBuf;
 
@@ -69,6 +70,27 @@ pub enum LawArg {
     RateIndependent,
     /// Elastic Hertz.
     Hertz,
+}
+
+/// The dispersion corrections of `shpb reduce --dispersion`.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum DispersionArg {
+    /// No correction.
+    None,
+    /// The authors' six-parameter Bancroft fit for ν = 0.31.
+    Bancroft,
+    /// The exact Pochhammer–Chree first mode for the bars' Poisson's ratio.
+    PochhammerChree,
+}
+
+impl From<DispersionArg> for DispersionCorrection {
+    fn from(d: DispersionArg) -> DispersionCorrection {
+        match d {
+            DispersionArg::None => DispersionCorrection::None,
+            DispersionArg::Bancroft => DispersionCorrection::Bancroft,
+            DispersionArg::PochhammerChree => DispersionCorrection::PochhammerChree,
+        }
+    }
 }
 
 /// The fidelity presets selectable on the command line (`--fidelity`).
@@ -290,9 +312,17 @@ pub enum Command {
         /// CSV output.
         #[arg(long)]
         csv: Option<PathBuf>,
-        /// Skip the Bancroft dispersion correction.
-        #[arg(long)]
+        /// Dispersion correction between gauges and faces: the Bancroft fit for ν = 0.31 (the
+        /// authors'), the exact Pochhammer–Chree first mode for the bars' ν, or none.
+        #[arg(long, value_enum, default_value_t = DispersionArg::Bancroft)]
+        dispersion: DispersionArg,
+        /// Deprecated: the same as `--dispersion none`.
+        #[arg(long, conflicts_with = "dispersion")]
         no_dispersion: bool,
+        /// Also apply the Tyas–Pope amplitude factors M1·M2 (exact first mode; needs a
+        /// dispersion correction).
+        #[arg(long)]
+        tyas_pope: bool,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -425,7 +455,9 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             bars,
             output,
             csv,
+            dispersion,
             no_dispersion,
+            tyas_pope,
             force,
         } => cmd::reduce::reduce_command(
             &record,
@@ -433,7 +465,12 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             output.as_deref(),
             csv.as_deref(),
             force,
-            no_dispersion,
+            if no_dispersion {
+                DispersionCorrection::None
+            } else {
+                dispersion.into()
+            },
+            tyas_pope,
         ),
         Command::Strain {
             record,

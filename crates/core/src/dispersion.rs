@@ -4,8 +4,8 @@
 //!
 //! # The frequency equation
 //!
-//! For axisymmetric waves `exp(i(kz − ωt))` in a free cylinder of radius a (J. F. Doyle's and
-//! K. F. Graff's form, *Wave Motion in Elastic Solids* (1975) §8.2.2), with
+//! For axisymmetric waves `exp(i(kz − ωt))` in a free cylinder of radius a (in the form of
+//! K. F. Graff, *Wave Motion in Elastic Solids* (1975), §8.2), with
 //! `α² = ω²/cL² − k²` and `β² = ω²/cT² − k²`:
 //!
 //! ```text
@@ -31,7 +31,7 @@
 //!
 //! At a fixed wavenumber (or a fixed frequency) the first mode is the slowest root c > 0: the
 //! first branch lies below every other. The solver scans c/c0 upwards from 0.9 cR/c0 in steps of
-//! 0.005 (the next root, on the second branch, is never closer than cT − cR ≥ 0.04 c0 for
+//! 0.005 (the next root, on the second branch, is never closer than cT − cR ≥ 0.025 c0 for
 //! 0 < ν < 0.5) and bisects the first sign change to 1e-14.
 
 use std::cell::RefCell;
@@ -183,7 +183,7 @@ fn speed_ratios_squared(poisson_ratio: f64) -> (f64, f64) {
 }
 
 /// The Pochhammer frequency function F of the module docs, divided by K⁴, at normalised
-/// wavenumber `ka` and velocity ratio `x = c/c0` (Graff 1975, §8.2.2).
+/// wavenumber `ka` and velocity ratio `x = c/c0` (Graff 1975, §8.2).
 pub fn frequency_function(poisson_ratio: f64, ka: f64, velocity_ratio: f64) -> f64 {
     let (l2, t2) = speed_ratios_squared(poisson_ratio);
     let x2 = velocity_ratio * velocity_ratio;
@@ -198,7 +198,8 @@ pub fn frequency_function(poisson_ratio: f64, ka: f64, velocity_ratio: f64) -> f
 }
 
 /// Rayleigh surface-wave speed over c0, the first mode's limit at high frequency: the root
-/// ξ = c/cT in (0.5, 1) of `(2 − ξ²)² = 4 √(1 − ξ² cT²/cL²) √(1 − ξ²)` (Graff 1975, §6.3).
+/// ξ = c/cT in (0.5, 1) of `(2 − ξ²)² = 4 √(1 − ξ² cT²/cL²) √(1 − ξ²)` (Lord Rayleigh,
+/// *Proc. Lond. Math. Soc.* 17, 4 (1885)).
 pub fn rayleigh_velocity_ratio(poisson_ratio: f64) -> f64 {
     let (l2, t2) = speed_ratios_squared(poisson_ratio);
     let r = l2 / t2; // cT²/cL²
@@ -253,7 +254,8 @@ fn first_root(lo: f64, g: impl Fn(f64) -> f64) -> f64 {
 }
 
 /// Below this a/Λ (or f a/c0) the solver uses Rayleigh's long-wave limit
-/// `c/c0 = 1 − ν²π²(a/Λ)²` (Rayleigh, *Theory of Sound* §157), whose error is O((a/Λ)⁴) < 1e-16.
+/// `c/c0 = 1 − ν²π²(a/Λ)²` (the Rayleigh–Love rod, docs/physics.md §6.3), whose error is
+/// O((a/Λ)⁴) < 1e-16.
 const LONG_WAVE_LIMIT: f64 = 1e-4;
 
 /// First-mode phase velocity over c0 at radius over wavelength `a/Λ` (exact Pochhammer–Chree

@@ -77,11 +77,20 @@
 //! bars with another Poisson's ratio. As f → 0 the fit gives c → (A + B) c0 = 1.0013 c0, so the
 //! longest waves are shifted by −0.13 % of the transit (−0.18 µs over 0.64 m), as in the
 //! authors' code.
+//!
+//! `DispersionCorrection::PochhammerChree` takes `c(f)` instead from the exact first mode for
+//! the bar's own Poisson's ratio (`crate::dispersion`, docs/physics.md §7.6), solved once per FFT
+//! bin. With `tyas_pope` each component is also multiplied by the Tyas–Pope factor M1·M2 (mean
+//! axial stress over E times the surface strain the gauge reads), up to the cut-off
+//! `f a/c0 = TYAS_POPE_CUTOFF_FA_OVER_C0`; components above it are removed. The three strain
+//! series of such a reduction are then σ̄/E at the faces (forces exact for the first mode); the
+//! face velocities keep the 1-D relation v = ∓c0 ε with them.
 
 use crate::apparatus::Apparatus;
+use crate::dispersion::PochhammerChree;
 use crate::error::{Error, Result};
 use crate::gauge::{GaugeChannel, RawRecord};
-use crate::numeric::{bisect, cumulative_trapezoid, moving_average, phase_shift};
+use crate::numeric::{bisect, cumulative_trapezoid, moving_average, spectral_filter};
 
 /// Bancroft first-mode fit for ν = 0.31 (docs/physics.md §7): A, B, C, D, E, F of
 /// `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`.
@@ -206,6 +215,47 @@ pub struct ReductionInput {
     pub transmission_strain: Vec<f64>,
 }
 
+/// How the reduction corrects each wave for geometric dispersion between its gauge and the
+/// specimen face (module docs, "Dispersion correction"; docs/physics.md §7.2, §7.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DispersionCorrection {
+    /// No correction: every component travels at c0.
+    None,
+    /// The six-parameter Bancroft fit for ν = 0.31 of the authors' `disp_corr.m` (§7.2).
+    #[default]
+    Bancroft,
+    /// The exact Pochhammer–Chree first mode for the bar's own Poisson's ratio (§7.6).
+    PochhammerChree,
+}
+
+impl DispersionCorrection {
+    /// Every correction, in the order the command line lists them.
+    pub const ALL: [DispersionCorrection; 3] = [
+        DispersionCorrection::None,
+        DispersionCorrection::Bancroft,
+        DispersionCorrection::PochhammerChree,
+    ];
+
+    /// The correction called `name` (`none`, `bancroft`, `pochhammer-chree`), if any.
+    pub fn from_name(name: &str) -> Option<DispersionCorrection> {
+        Self::ALL.into_iter().find(|d| d.name() == name)
+    }
+
+    /// The name the command line and the outputs use: `none`, `bancroft`, `pochhammer-chree`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DispersionCorrection::None => "none",
+            DispersionCorrection::Bancroft => "bancroft",
+            DispersionCorrection::PochhammerChree => "pochhammer-chree",
+        }
+    }
+}
+
+/// Highest normalised frequency f a/c0 the Tyas–Pope factors are applied to; components above
+/// it are removed (docs/physics.md §7.6: M1 has a pole near f a/c0 ≈ 0.3 for ν = 0.29–0.31, at
+/// 0.2 M1·M2 ≈ 1.09).
+pub const TYAS_POPE_CUTOFF_FA_OVER_C0: f64 = 0.2;
+
 /// Manual window settings; each `None` keeps the automatic rule (module docs, "Windows").
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct WindowOverride {
@@ -225,8 +275,11 @@ pub struct ReductionOptions {
     /// Samples at the start of each record whose mean is the baseline (default 900: 90 µs at
     /// 10 MHz, the pre-trigger part of the authors' records).
     pub baseline_samples: usize,
-    /// Correct the waves for Bancroft dispersion between gauges and faces (default true).
-    pub dispersion_correction: bool,
+    /// Dispersion correction of the waves between gauges and faces (default Bancroft).
+    pub dispersion: DispersionCorrection,
+    /// Apply the Tyas–Pope amplitude factors M1·M2 (exact first mode; needs a dispersion
+    /// correction; default false).
+    pub tyas_pope: bool,
     /// Manual windows (default None: the automatic rule).
     pub window: Option<WindowOverride>,
     /// Fraction of the incident peak that marks its foot (default 0.02).
@@ -245,7 +298,8 @@ impl Default for ReductionOptions {
     fn default() -> Self {
         ReductionOptions {
             baseline_samples: 900,
-            dispersion_correction: true,
+            dispersion: DispersionCorrection::Bancroft,
+            tyas_pope: false,
             window: None,
             start_fraction: 0.02,
             specimen_transit_s: 0.0,
@@ -323,8 +377,12 @@ pub struct Reduction {
     /// incident, on its largest tensile excursion), minus the incident start, s; None if no
     /// tensile pulse of at least 10 % of the incident peak is found.
     pub measured_reflected_delay_s: Option<f64>,
-    /// Whether the dispersion correction was applied.
+    /// Whether a dispersion correction was applied.
     pub dispersion_corrected: bool,
+    /// Which dispersion correction was applied.
+    pub dispersion: DispersionCorrection,
+    /// Whether the Tyas–Pope amplitude factors were applied.
+    pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
 }
@@ -514,14 +572,62 @@ fn check_polarity(
     }
 }
 
+/// The correction of one wave between its gauge and the face: Bancroft fit (`exact` None) or
+/// the exact first mode, and optionally the Tyas–Pope amplitude factors.
+struct WaveCorrection<'a> {
+    /// Distance the wave is moved, m (negative: back against its propagation).
+    distance_m: f64,
+    /// Bar radius, m.
+    radius_m: f64,
+    /// Bar-wave speed c0, m/s.
+    c0_m_s: f64,
+    /// The exact first mode, if it gives the phase (else the Bancroft fit).
+    exact: Option<&'a PochhammerChree>,
+    /// The exact first mode, if the Tyas–Pope factors apply.
+    tyas_pope: Option<&'a PochhammerChree>,
+}
+
+/// The correction of a wave moved by `distance_m` along bar `b` under `options` (None: no
+/// dispersion correction).
+fn wave_correction<'a>(
+    options: &ReductionOptions,
+    distance_m: f64,
+    b: &BarProperties,
+    pc: Option<&'a PochhammerChree>,
+) -> Option<WaveCorrection<'a>> {
+    (options.dispersion != DispersionCorrection::None).then_some(WaveCorrection {
+        distance_m,
+        radius_m: b.radius_m,
+        c0_m_s: b.wave_speed_m_s,
+        exact: if options.dispersion == DispersionCorrection::PochhammerChree {
+            pc
+        } else {
+            None
+        },
+        tyas_pope: if options.tyas_pope { pc } else { None },
+    })
+}
+
+impl WaveCorrection<'_> {
+    /// Smallest phase velocity over c0 any component can have (margin of [`cut`]).
+    fn slowest_ratio(&self) -> f64 {
+        match self.exact {
+            // The first mode dips below cR before rising back to it (docs/physics.md §7.6);
+            // 0.95 cR bounds the dip for every 0 < ν < 0.5.
+            Some(pc) => 0.95 * pc.rayleigh_ratio(),
+            None => BANCROFT_FIT[0],
+        }
+    }
+}
+
 /// Cuts `n` samples starting at fractional index `start` out of `x` (uniform step `dt`), after
-/// delaying every Fourier component by `dispersion_delay_s(f, distance)` when `dispersion` is
-/// given as (distance, radius, c0). Exact copy when the start is on a sample and there is no
-/// dispersion; otherwise a Fourier phase shift (see `phase_shift`) of the window extended by
-/// margins on both sides that cover the largest dispersion delay, so that what the shift moves
-/// into the window comes from the record, not from the wrap-around. Samples outside the record
-/// read as 0 (the caller keeps the window itself inside the record).
-fn cut(x: &[f64], dt: f64, start: f64, n: usize, dispersion: Option<(f64, f64, f64)>) -> Vec<f64> {
+/// delaying every Fourier component by its dispersion delay `Δx (1/c(f) − 1/c0)` (and scaling it
+/// by the Tyas–Pope factor) when a correction is given. Exact copy when the start is on a sample
+/// and there is no correction; otherwise a Fourier filter (see `spectral_filter`) of the window
+/// extended by margins on both sides that cover the largest dispersion delay, so that what the
+/// shift moves into the window comes from the record, not from the wrap-around. Samples outside
+/// the record read as 0 (the caller keeps the window itself inside the record).
+fn cut(x: &[f64], dt: f64, start: f64, n: usize, correction: Option<&WaveCorrection>) -> Vec<f64> {
     let i = start.floor();
     let mut frac = start - i;
     let mut i = i as isize;
@@ -531,7 +637,7 @@ fn cut(x: &[f64], dt: f64, start: f64, n: usize, dispersion: Option<(f64, f64, f
     } else if frac < 1e-9 {
         frac = 0.0;
     }
-    if frac == 0.0 && dispersion.is_none() {
+    if frac == 0.0 && correction.is_none() {
         return (0..n)
             .map(|k| {
                 let j = i + k as isize;
@@ -543,20 +649,34 @@ fn cut(x: &[f64], dt: f64, start: f64, n: usize, dispersion: Option<(f64, f64, f
             })
             .collect();
     }
-    // Margin: the largest dispersion delay (slowest components travel at A·c0) plus slack.
-    let max_delay = dispersion
-        .map(|(d, _, c0)| d.abs() / c0 * (1.0 / BANCROFT_FIT[0] - 1.0))
+    // Margin: the largest dispersion delay (the slowest components) plus slack.
+    let max_delay = correction
+        .map(|w| w.distance_m.abs() / w.c0_m_s * (1.0 / w.slowest_ratio() - 1.0))
         .unwrap_or(0.0);
     let margin = (max_delay / dt).ceil() as isize + 64;
     let lo = (i - margin).max(0);
     let hi = (i + n as isize + margin).min(x.len() as isize);
     let seg = &x[lo as usize..hi as usize];
-    let shifted = phase_shift(seg, dt, |f| {
+    let shifted = spectral_filter(seg, dt, |bin| {
         // Advance by `frac` samples (y(t) = x(t + frac·dt)), then the dispersion delay.
-        let disp = dispersion
-            .map(|(d, a, c0)| dispersion_delay_s(f, d, a, c0))
-            .unwrap_or(0.0);
-        disp - frac * dt
+        let Some(w) = correction else {
+            return (-frac * dt, 1.0);
+        };
+        let disp = match w.exact {
+            Some(pc) => pc.delay_for_bin_s(bin.index, bin.length, dt, w.distance_m),
+            None => dispersion_delay_s(bin.frequency_hz, w.distance_m, w.radius_m, w.c0_m_s),
+        };
+        let gain = match w.tyas_pope {
+            Some(pc) => {
+                if bin.frequency_hz * w.radius_m / w.c0_m_s <= TYAS_POPE_CUTOFF_FA_OVER_C0 {
+                    pc.tyas_pope_factor_for_bin(bin.index, bin.length, dt)
+                } else {
+                    0.0
+                }
+            }
+            None => 1.0,
+        };
+        (disp - frac * dt, gain)
     });
     let off = i - lo;
     (0..n)
@@ -587,8 +707,39 @@ pub fn dispersion_shift(
         dt_s,
         0.0,
         signal.len(),
-        Some((distance_m, bar.radius_m, bar.wave_speed_m_s)),
+        Some(&WaveCorrection {
+            distance_m,
+            radius_m: bar.radius_m,
+            c0_m_s: bar.wave_speed_m_s,
+            exact: None,
+            tyas_pope: None,
+        }),
     )
+}
+
+/// [`dispersion_shift`] along the exact Pochhammer–Chree first mode of `bar` (its own Poisson's
+/// ratio; docs/physics.md §7.6) instead of the Bancroft fit. Errors name the bar property out of
+/// range.
+pub fn dispersion_shift_exact(
+    signal: &[f64],
+    dt_s: f64,
+    distance_m: f64,
+    bar: &BarProperties,
+) -> Result<Vec<f64>> {
+    let pc = PochhammerChree::new(bar.poisson_ratio, bar.radius_m, bar.wave_speed_m_s)?;
+    Ok(cut(
+        signal,
+        dt_s,
+        0.0,
+        signal.len(),
+        Some(&WaveCorrection {
+            distance_m,
+            radius_m: bar.radius_m,
+            c0_m_s: bar.wave_speed_m_s,
+            exact: Some(&pc),
+            tyas_pope: None,
+        }),
+    ))
 }
 
 /// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
@@ -659,6 +810,14 @@ fn check_input(input: &ReductionInput, file: &str) -> Result<f64> {
 
 fn check_options(o: &ReductionOptions) -> Result<()> {
     let file = "reduction options";
+    if o.tyas_pope && o.dispersion == DispersionCorrection::None {
+        return Err(input_err(
+            file,
+            "tyas_pope",
+            "the Tyas–Pope amplitude factors were asked for without a dispersion correction",
+            "tyas_pope with dispersion bancroft or pochhammer-chree",
+        ));
+    }
     if !(o.start_fraction > 0.0 && o.start_fraction < 0.5) {
         return Err(input_err(
             file,
@@ -874,7 +1033,7 @@ pub fn reduce_named(
             nominal_r * 1e6
         ));
     }
-    if options.dispersion_correction {
+    if options.dispersion == DispersionCorrection::Bancroft {
         for (name, b) in [("incident", bi), ("transmission", bt)] {
             if (b.poisson_ratio - BANCROFT_FIT_POISSON_RATIO).abs() > 0.02 {
                 warnings.push(format!(
@@ -885,15 +1044,37 @@ pub fn reduce_named(
         }
     }
 
-    // Waves at the faces.
-    let disp = |d: f64, b: &BarProperties| {
-        options
-            .dispersion_correction
-            .then_some((d, b.radius_m, b.wave_speed_m_s))
+    // Waves at the faces (one exact first mode per bar, its roots shared by its windows).
+    let exact = |b: &BarProperties| -> Result<Option<PochhammerChree>> {
+        if options.dispersion == DispersionCorrection::PochhammerChree || options.tyas_pope {
+            PochhammerChree::new(b.poisson_ratio, b.radius_m, b.wave_speed_m_s).map(Some)
+        } else {
+            Ok(None)
+        }
     };
-    let e_in = cut(&eps_i, dt, s_i, samples, disp(d_i, bi));
-    let e_re = cut(&eps_i, dt, s_r, samples, disp(-d_i, bi));
-    let e_tr = cut(&eps_t, dt, s_t, samples, disp(-d_t, bt));
+    let (pc_i, pc_t) = (exact(bi)?, exact(bt)?);
+    let disp = |d: f64, b: &BarProperties, pc| wave_correction(options, d, b, pc);
+    let e_in = cut(
+        &eps_i,
+        dt,
+        s_i,
+        samples,
+        disp(d_i, bi, pc_i.as_ref()).as_ref(),
+    );
+    let e_re = cut(
+        &eps_i,
+        dt,
+        s_r,
+        samples,
+        disp(-d_i, bi, pc_i.as_ref()).as_ref(),
+    );
+    let e_tr = cut(
+        &eps_t,
+        dt,
+        s_t,
+        samples,
+        disp(-d_t, bt, pc_t.as_ref()).as_ref(),
+    );
 
     // Quantities.
     let (ea_i, ea_t) = (
@@ -952,7 +1133,9 @@ pub fn reduce_named(
             baseline_samples: nb,
         },
         measured_reflected_delay_s,
-        dispersion_corrected: options.dispersion_correction,
+        dispersion_corrected: options.dispersion != DispersionCorrection::None,
+        dispersion: options.dispersion,
+        tyas_pope: options.tyas_pope,
         warnings,
         time_s,
         incident_strain: e_in,
@@ -1045,7 +1228,7 @@ mod tests {
 
     fn options() -> ReductionOptions {
         ReductionOptions {
-            dispersion_correction: false,
+            dispersion: DispersionCorrection::None,
             ..ReductionOptions::default()
         }
     }
@@ -1093,6 +1276,55 @@ mod tests {
         assert!(
             msg.starts_with("rec.csv: `transmission_strain`: the first pulse on the transmission gauge is tensile"),
             "{msg}"
+        );
+    }
+
+    /// The exact correction undoes its own propagation, and on a smooth pulse it differs from
+    /// the Bancroft fit by no more than the fit's long-wave offset explains: c → (A + B) c0 moves
+    /// every long component by τ0 = d/c0 (1 − 1/(A + B)), so |Δε| ≲ τ0 max|ε̇| (10 % allowance
+    /// for the fit's residual higher up, ±0.3 % of c). In the pulse's band the residual is of
+    /// the other sign (−0.1 % at 20 kHz) and takes back part of the offset, so the difference
+    /// is smaller; it is not zero (at least a fifth of τ0 max|ε̇|).
+    #[test]
+    fn exact_dispersion_inverts_itself_and_differs_from_the_fit_by_its_offset() {
+        let (_, setup) = record();
+        let bar = setup.incident_bar;
+        let dt = 1e-7;
+        let t_rise = 60e-6;
+        let pulse: Vec<f64> = (0..6000)
+            .map(|k| {
+                let x = (k as f64 * dt - 150e-6) / (2.0 * t_rise);
+                if (0.0..=1.0).contains(&x) {
+                    -1e-3 * (std::f64::consts::PI * x).sin().powi(2)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let d = 0.644525;
+        let there = dispersion_shift_exact(&pulse, dt, d, &bar).unwrap();
+        let back = dispersion_shift_exact(&there, dt, -d, &bar).unwrap();
+        let err = pulse
+            .iter()
+            .zip(&back)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(err < 1e-9, "round trip error {err}");
+        let fit = dispersion_shift(&pulse, dt, d, &bar);
+        let diff = fit
+            .iter()
+            .zip(&there)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let tau0 = d / bar.wave_speed_m_s * (1.0 - 1.0 / (BANCROFT_FIT[0] + BANCROFT_FIT[1]));
+        let max_rate = 1e-3 * std::f64::consts::PI / (2.0 * t_rise);
+        assert!(
+            diff > 0.2 * tau0 * max_rate,
+            "{diff} vs {}",
+            tau0 * max_rate
+        );
+        assert!(
+            diff < 1.1 * tau0 * max_rate,
+            "{diff} vs {}",
+            tau0 * max_rate
         );
     }
 

@@ -674,7 +674,11 @@ fn reduce_simulated_records(
         transmission_strain: strain("transmission")?,
     };
     let reduction_options = crate::reduce::ReductionOptions {
-        dispersion_correction: options.dispersion != Dispersion::None,
+        dispersion: if options.dispersion == Dispersion::None {
+            crate::reduce::DispersionCorrection::None
+        } else {
+            crate::reduce::DispersionCorrection::Bancroft
+        },
         specimen_radii_m: Some(specimen_radii_m(&spec.spheres)),
         smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
         ..Default::default()

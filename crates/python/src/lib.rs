@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
-use shpb_core::reduce::Reduction;
+use shpb_core::reduce::{DispersionCorrection, Reduction};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::Params;
 use shpb_input::Error;
@@ -471,25 +471,41 @@ fn curve<'py>(
     ))
 }
 
-/// The lab's reduction of a raw record or run file (`shpb reduce`).
+/// The lab's reduction of a raw record or run file (`shpb reduce`); `dispersion` is `none`,
+/// `bancroft` or `pochhammer-chree` (`--dispersion`), `tyas_pope` adds the Tyas–Pope factors.
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = true))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false))]
 fn reduce(
     py: Python<'_>,
     record: PathBuf,
     bars: Option<PathBuf>,
-    dispersion: bool,
+    dispersion: String,
+    tyas_pope: bool,
 ) -> PyResult<RunData> {
+    let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
+        return Err(input_error(
+            "dispersion",
+            format!("unknown dispersion correction `{dispersion}`"),
+            DispersionCorrection::ALL
+                .iter()
+                .map(|d| d.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ));
+    };
     let (reduced, scene) = detached(py, || {
-        let r = api::reduce_record(&record, bars.as_deref(), !dispersion)?;
+        let r = api::reduce_record(&record, bars.as_deref(), correction, tyas_pope)?;
         let mut scene = format!(
             "shpb reduce {} --bars {}",
             record.display(),
             bars.as_deref()
                 .map_or(r.apparatus.source.clone(), |b| b.display().to_string())
         );
-        if !dispersion {
-            scene.push_str(" --no-dispersion");
+        if correction != DispersionCorrection::Bancroft {
+            scene.push_str(&format!(" --dispersion {}", correction.name()));
+        }
+        if tyas_pope {
+            scene.push_str(" --tyas-pope");
         }
         Ok((r, scene))
     })?;

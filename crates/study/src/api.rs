@@ -248,7 +248,8 @@ pub struct Reduced {
 pub fn reduce_record(
     record: &Path,
     bars_flag: Option<&Path>,
-    no_dispersion: bool,
+    dispersion: shpb_core::reduce::DispersionCorrection,
+    tyas_pope: bool,
 ) -> Result<Reduced> {
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
@@ -287,7 +288,8 @@ pub fn reduce_record(
         None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
     };
     let options = ReductionOptions {
-        dispersion_correction: !no_dispersion,
+        dispersion,
+        tyas_pope,
         specimen_radii_m: Some(radii),
         ..ReductionOptions::default()
     };

@@ -1,12 +1,14 @@
 //! `shpb reduce`: the lab's reduction of a raw record or of a run file.
 
 use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, warn, wrote};
+use shpb_core::reduce::{DispersionCorrection, Reduction};
 use shpb_input::Result;
 use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::reduction::{write_reduction_csv, write_reduction_hdf5};
 use std::path::Path;
 
-/// `shpb reduce RECORD --bars SET-UP [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
+/// `shpb reduce RECORD --bars SET-UP [-o OUT.h5] [--csv OUT.csv] [--dispersion none|bancroft|
+/// pochhammer-chree] [--tyas-pope] [--force]`:
 /// reduces a raw record (the authors' CSV) or an HDF5 file of `shpb run` (recognised by its
 /// signature) with the set-up's bars and gauges (`bars`: a built-in set-up name or a set-up
 /// file), writes `/reduction/*` (HDF5) and/or CSV, and prints a summary. The strain rate uses
@@ -17,7 +19,8 @@ pub fn reduce_command(
     output: Option<&Path>,
     csv: Option<&Path>,
     force: bool,
-    no_dispersion: bool,
+    dispersion: DispersionCorrection,
+    tyas_pope: bool,
 ) -> Result<()> {
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
@@ -36,7 +39,7 @@ pub fn reduce_command(
         reduction: r,
         apparatus,
         hdf5_input,
-    } = shpb_study::api::reduce_record(record, bars_flag, no_dispersion)?;
+    } = shpb_study::api::reduce_record(record, bars_flag, dispersion, tyas_pope)?;
     let mut scene = format!(
         "shpb reduce {} --bars {}",
         record.display(),
@@ -48,8 +51,11 @@ pub fn reduce_command(
     if let Some(c) = csv {
         scene.push_str(&format!(" --csv {}", c.display()));
     }
-    if no_dispersion {
-        scene.push_str(" --no-dispersion");
+    if dispersion != DispersionCorrection::Bancroft {
+        scene.push_str(&format!(" --dispersion {}", dispersion.name()));
+    }
+    if tyas_pope {
+        scene.push_str(" --tyas-pope");
     }
     if force {
         scene.push_str(" --force");
@@ -95,7 +101,7 @@ pub fn reduce_command(
         r.windows.reflected_delay_s * 1e6,
         r.windows.transmitted_delay_s * 1e6,
         r.windows.duration_s * 1e6,
-        if r.dispersion_corrected { "on" } else { "off" },
+        dispersion_summary(&r),
         r.peak_back_force_n,
         r.peak_back_force_time_s * 1e6,
         r.displacement_at_peak_force_m * 1e6,
@@ -113,6 +119,8 @@ pub fn reduce_command(
                 "duration": finite(r.windows.duration_s),
             },
             "dispersion_corrected": r.dispersion_corrected,
+            "dispersion": r.dispersion.name(),
+            "tyas_pope": r.tyas_pope,
             "peak_back_force_N": finite(r.peak_back_force_n),
             "peak_back_force_time_s": finite(r.peak_back_force_time_s),
             "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),
@@ -120,4 +128,14 @@ pub fn reduce_command(
             "warnings": r.warnings,
         })
     })
+}
+
+/// The summary's word for the correction used: `off`, `bancroft`, `pochhammer-chree`, with
+/// `+ tyas-pope` when the amplitude factors were applied.
+fn dispersion_summary(r: &Reduction) -> String {
+    match (r.dispersion, r.tyas_pope) {
+        (DispersionCorrection::None, _) => "off".to_string(),
+        (d, false) => d.name().to_string(),
+        (d, true) => format!("{} + tyas-pope", d.name()),
+    }
 }

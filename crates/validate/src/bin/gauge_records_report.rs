@@ -413,7 +413,7 @@ fn main() -> Result<()> {
             &rec_path,
             &app,
             &ReductionOptions {
-                dispersion_correction: false,
+                dispersion: shpb_core::reduce::DispersionCorrection::None,
                 ..default
             },
         )?;
