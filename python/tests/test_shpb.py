@@ -204,6 +204,22 @@ def test_reduce_equals_shpb_reduce(cli, tmp_path):
     assert_runs_equal(shpb.load(tmp_path / "py.h5"), r)
 
 
+def test_reduce_dispersion_keyword_equals_the_flags(cli, tmp_path):
+    # dispersion= takes the names of `shpb reduce --dispersion`; True/False are the old form.
+    cli(
+        "reduce", RECORD, "--bars", "authors", "-o", tmp_path / "pc.h5",
+        "--dispersion", "pochhammer-chree", "--tyas-pope",
+    )
+    r = shpb.reduce(RECORD, bars="authors", dispersion="pochhammer-chree", tyas_pope=True)
+    for k, (data, units) in h5_datasets(tmp_path / "pc.h5").items():
+        assert same(r[k], data), k
+    off = shpb.reduce(RECORD, bars="authors", dispersion="none")
+    old = shpb.reduce(RECORD, bars="authors", dispersion=False)
+    assert same(off["reduction/force_back"], old["reduction/force_back"])
+    with pytest.raises(shpb.InputError):
+        shpb.reduce(RECORD, dispersion="love")
+
+
 def test_sweep_in_parallel_equals_serial():
     kw = dict(set={"pressure": ["8psi", "10psi", "12psi"]})
     scene = "scenes/shpb-ss440c-10psi.toml"

@@ -1328,6 +1328,57 @@ mod tests {
         );
     }
 
+    /// The Poisson's-ratio warning belongs to the Bancroft fit (made for ν = 0.31); the exact
+    /// mode takes the bar's own ν. The Tyas–Pope factors need a phase correction.
+    #[test]
+    fn exact_correction_takes_the_bars_poisson_ratio_and_tyas_pope_needs_a_correction() {
+        let (input, mut setup) = record();
+        setup.incident_bar.poisson_ratio = 0.29;
+        setup.transmission_bar.poisson_ratio = 0.29;
+        let with = |dispersion, tyas_pope| ReductionOptions {
+            dispersion,
+            tyas_pope,
+            ..ReductionOptions::default()
+        };
+        let fit = reduce(&input, &setup, &with(DispersionCorrection::Bancroft, false)).unwrap();
+        assert_eq!(fit.dispersion, DispersionCorrection::Bancroft);
+        assert!(
+            fit.warnings.iter().any(|w| w.contains("0.29")),
+            "{:?}",
+            fit.warnings
+        );
+        let exact = reduce(
+            &input,
+            &setup,
+            &with(DispersionCorrection::PochhammerChree, false),
+        )
+        .unwrap();
+        assert_eq!(exact.dispersion, DispersionCorrection::PochhammerChree);
+        assert!(exact.dispersion_corrected && !exact.tyas_pope);
+        assert!(
+            !exact.warnings.iter().any(|w| w.contains("Poisson")),
+            "{:?}",
+            exact.warnings
+        );
+        let e = reduce(&input, &setup, &with(DispersionCorrection::None, true)).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("tyas_pope") && msg.contains("pochhammer-chree"),
+            "{msg}"
+        );
+        // On a 120 µs sin² pulse (nearly all its energy below 20 kHz, where M1·M2 − 1 < 0.2 %)
+        // the amplitude factors change the peak back force by less than 0.5 %, but do change it.
+        let tp = reduce(
+            &input,
+            &setup,
+            &with(DispersionCorrection::PochhammerChree, true),
+        )
+        .unwrap();
+        assert!(tp.tyas_pope);
+        let rel = tp.peak_back_force_n / exact.peak_back_force_n - 1.0;
+        assert!(rel.abs() < 5e-3 && rel != 0.0, "{rel}");
+    }
+
     #[test]
     fn polarity_is_not_judged_on_noise() {
         // A channel that is all noise has no first pulse to judge.
