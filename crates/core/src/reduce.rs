@@ -253,7 +253,7 @@ impl DispersionCorrection {
 
 /// Highest normalised frequency f a/c0 the Tyas–Pope factors are applied to; components above
 /// it are removed (docs/physics.md §7.6: M1 has a pole near f a/c0 ≈ 0.3 for ν = 0.29–0.31, at
-/// 0.2 M1·M2 ≈ 1.09).
+/// 0.2 M1·M2 ≈ 1.1 for ν = 0.31).
 pub const TYAS_POPE_CUTOFF_FA_OVER_C0: f64 = 0.2;
 
 /// Manual window settings; each `None` keeps the automatic rule (module docs, "Windows").

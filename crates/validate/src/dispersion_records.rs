@@ -24,6 +24,8 @@ pub struct RecordComparison {
     pub bancroft: Reduction,
     /// Reduction with the exact first mode.
     pub exact: Reduction,
+    /// Reduction with the exact first mode and the Tyas–Pope amplitude factors.
+    pub exact_tyas_pope: Reduction,
     /// RMS of the transmission gauge's pre-trigger strain (baseline removed) times E A, N: the
     /// noise of one sample of the back force.
     pub back_noise_n: f64,
@@ -162,6 +164,15 @@ pub fn compare_records(root: &Path) -> Result<Vec<RecordComparison>> {
         let input = record_strains(&rec, &app, bancroft.baseline_samples)?;
         let b = reduce_named(&input, &setup, &bancroft, &name)?;
         let e = reduce_named(&input, &setup, &exact, &name)?;
+        let tp = reduce_named(
+            &input,
+            &setup,
+            &ReductionOptions {
+                tyas_pope: true,
+                ..exact
+            },
+            &name,
+        )?;
         let nb = b.windows.baseline_samples;
         let dt_s = rec.sample_interval_s();
         let (bi, bt) = (&setup.incident_bar, &setup.transmission_bar);
@@ -186,6 +197,7 @@ pub fn compare_records(root: &Path) -> Result<Vec<RecordComparison>> {
             sample,
             bancroft: b,
             exact: e,
+            exact_tyas_pope: tp,
             back_noise_n: ea_t * rms_head(tra, nb),
             front_noise_n: ea_i * rms_head(inc, nb) * std::f64::consts::SQRT_2,
             back_noise_band_n: ea_t * rms_head(&low_pass(tra, dt_s), nb),

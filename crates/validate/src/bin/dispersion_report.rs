@@ -226,6 +226,61 @@ fn main() -> Result<()> {
             front_over.join(", ")
         }
     );
+    let _ = writeln!(
+        w,
+        "## 3. With the Tyas–Pope amplitude factors\n\n\
+         The same records reduced with `--dispersion pochhammer-chree --tyas-pope` (PC+TP): each \
+         component multiplied by M1·M2 up to f a/c0 = 0.2 ({:.0} kHz here), the components \
+         above removed (docs/physics.md §7.6). Removing the noise above that edge lowers the \
+         raw peaks, which are partly noise; the in-band peak (≤ 50 kHz, as in §2) shows what \
+         the factors change in the pulse.\n",
+        0.2 * c0 / a / 1e3
+    );
+    let _ = writeln!(
+        w,
+        "| record | peak F_back PC / PC+TP (N) | in-band peak F_back PC / PC+TP (N) | peak F_front PC / PC+TP (N) | δ at peak PC / PC+TP (µm) |\n\
+         |---|---:|---:|---:|---:|"
+    );
+    for r in &rows {
+        let (e, t) = (&r.exact, &r.exact_tyas_pope);
+        let band_peak = |v: &[f64]| {
+            shpb_validate::dispersion_records::low_pass(v, r.dt_s)
+                .into_iter()
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let _ = writeln!(
+            w,
+            "| {} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.3} / {:.3} |",
+            r.sample.label,
+            e.peak_back_force_n,
+            t.peak_back_force_n,
+            band_peak(&e.force_back_n),
+            band_peak(&t.force_back_n),
+            e.peak_front_force_n,
+            t.peak_front_force_n,
+            e.displacement_at_peak_force_m * 1e6,
+            t.displacement_at_peak_force_m * 1e6
+        );
+    }
+    let worst_tp = rows
+        .iter()
+        .map(|r| {
+            let band_peak = |v: &[f64]| {
+                shpb_validate::dispersion_records::low_pass(v, r.dt_s)
+                    .into_iter()
+                    .fold(f64::NEG_INFINITY, f64::max)
+            };
+            (band_peak(&r.exact_tyas_pope.force_back_n) / band_peak(&r.exact.force_back_n) - 1.0)
+                .abs()
+        })
+        .fold(0.0f64, f64::max);
+    let _ = writeln!(
+        w,
+        "\nIn band the factors change the peak back force by at most {:.3} %: the pulses of \
+         these tests lie below f a/c0 ≈ 0.05, where M1·M2 − 1 ≲ 0.3 %. The raw peaks fall by \
+         3–15 % because the cut-off removes the noise that rode on them.\n",
+        worst_tp * 100.0
+    );
     let dir = root.join("validation/dispersion");
     if !dir.is_dir() {
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
