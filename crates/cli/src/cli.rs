@@ -293,6 +293,13 @@ pub enum Command {
         /// Skip the Bancroft dispersion correction.
         #[arg(long)]
         no_dispersion: bool,
+        /// Length of a cylindrical specimen, m (with --specimen-diameter): also its 1/2/3-wave
+        /// stress, strain, strain rate and true stress/strain (/reduction/cylinder).
+        #[arg(long, value_name = "L")]
+        specimen_length: Option<f64>,
+        /// Diameter of a cylindrical specimen, m (with --specimen-length).
+        #[arg(long, value_name = "D")]
+        specimen_diameter: Option<f64>,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -426,6 +433,8 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             output,
             csv,
             no_dispersion,
+            specimen_length,
+            specimen_diameter,
             force,
         } => cmd::reduce::reduce_command(
             &record,
@@ -434,6 +443,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             csv.as_deref(),
             force,
             no_dispersion,
+            (specimen_length, specimen_diameter),
         ),
         Command::Strain {
             record,

@@ -831,7 +831,16 @@ fn reduce_command_writes_hdf5_and_csv_from_a_raw_record() {
     let h5 = dir.path().join("red.h5");
     let csv = dir.path().join("red.csv");
     let bars = root().join("bars/authors.toml");
-    reduce_command(rec, Some(&bars), Some(&h5), Some(&csv), false, false).unwrap();
+    reduce_command(
+        rec,
+        Some(&bars),
+        Some(&h5),
+        Some(&csv),
+        false,
+        false,
+        (None, None),
+    )
+    .unwrap();
     let n = check_reduction_hdf5(&h5);
     let t = CsvTable::read(&csv).unwrap();
     assert_eq!(
@@ -849,9 +858,10 @@ fn reduce_command_writes_hdf5_and_csv_from_a_raw_record() {
     );
     assert_eq!(t.columns[0].len(), n);
     // An existing output is kept without --force, replaced with it.
-    let err = reduce_command(rec, Some(&bars), Some(&h5), None, false, true).unwrap_err();
+    let err =
+        reduce_command(rec, Some(&bars), Some(&h5), None, false, true, (None, None)).unwrap_err();
     assert!(matches!(err, Error::OutputExists(_)), "{err}");
-    reduce_command(rec, Some(&bars), Some(&h5), None, true, true).unwrap();
+    reduce_command(rec, Some(&bars), Some(&h5), None, true, true, (None, None)).unwrap();
     let f = hdf5::File::open(&h5).unwrap();
     assert!(read_attr_string(&f, "scene").contains("--no-dispersion"));
     // No temporary files are left.
@@ -908,6 +918,7 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
         None,
         false,
         true,
+        (None, None),
     )
     .unwrap();
     check_reduction_hdf5(&red);
@@ -937,7 +948,8 @@ fn bad_inputs_name_file_and_key() {
     }
     let short = dir.path().join("short.csv");
     std::fs::write(&short, text).unwrap();
-    let err = reduce_command(&short, Some(&bars), None, None, false, false).unwrap_err();
+    let err =
+        reduce_command(&short, Some(&bars), None, None, false, false, (None, None)).unwrap_err();
     let msg = err.to_string();
     assert_eq!(err.exit_code(), 2, "{msg}");
     assert!(msg.contains("short.csv") && msg.contains("time_s"), "{msg}");
@@ -949,6 +961,7 @@ fn bad_inputs_name_file_and_key() {
         None,
         false,
         false,
+        (None, None),
     )
     .unwrap_err();
     assert!(err.to_string().contains("RECORD"), "{err}");
@@ -959,13 +972,14 @@ fn bad_inputs_name_file_and_key() {
         None,
         false,
         false,
+        (None, None),
     )
     .unwrap_err();
     assert!(err.to_string().contains("--bars"), "{err}");
     // An HDF5 file without gauges names the dataset.
     let h5 = dir.path().join("empty.h5");
     hdf5::File::create(&h5).unwrap();
-    let err = reduce_command(&h5, Some(&bars), None, None, false, false).unwrap_err();
+    let err = reduce_command(&h5, Some(&bars), None, None, false, false, (None, None)).unwrap_err();
     assert!(err.to_string().contains("time"), "{err}");
     // Options out of range.
     let s = setup(5000.0, 0.65, 0.35);

@@ -481,7 +481,7 @@ fn reduce(
     dispersion: bool,
 ) -> PyResult<RunData> {
     let (reduced, scene) = detached(py, || {
-        let r = api::reduce_record(&record, bars.as_deref(), !dispersion)?;
+        let r = api::reduce_record(&record, bars.as_deref(), !dispersion, None)?;
         let mut scene = format!(
             "shpb reduce {} --bars {}",
             record.display(),

@@ -239,16 +239,62 @@ pub struct Reduced {
     pub apparatus: Apparatus,
     /// Whether the record was a run file's gauge strains (else raw gauge voltages).
     pub hdf5_input: bool,
+    /// A cylindrical specimen's 1/2/3-wave stress and strain, when its geometry was given
+    /// (docs/physics.md §7.6).
+    pub cylinder: Option<shpb_core::reduce_cylinder::CylinderReduction>,
+}
+
+/// The cylinder of `shpb reduce --specimen-length L --specimen-diameter D` (both or neither;
+/// `keys` name the two options in messages): each greater than 0, at most 1 m.
+pub fn cylinder_geometry(
+    length_m: Option<f64>,
+    diameter_m: Option<f64>,
+    keys: (&str, &str),
+) -> Result<Option<shpb_core::reduce_cylinder::CylinderGeometry>> {
+    let (length_m, diameter_m) = match (length_m, diameter_m) {
+        (None, None) => return Ok(None),
+        (Some(l), Some(d)) => (l, d),
+        (l, _) => {
+            let (given, missing) = if l.is_some() {
+                (keys.0, keys.1)
+            } else {
+                (keys.1, keys.0)
+            };
+            return Err(input_err(
+                missing,
+                format!("missing: {given} is given"),
+                format!(
+                    "both {} and {} (a cylinder's length and diameter, m), or neither",
+                    keys.0, keys.1
+                ),
+            ));
+        }
+    };
+    for (key, v) in [(keys.0, length_m), (keys.1, diameter_m)] {
+        if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+            return Err(input_err(
+                key,
+                format!("{v} m is out of range"),
+                "greater than 0, at most 1 (m)",
+            ));
+        }
+    }
+    Ok(Some(shpb_core::reduce_cylinder::CylinderGeometry {
+        length_m,
+        diameter_m,
+    }))
 }
 
 /// `shpb reduce`: reduces a raw record (the authors' CSV) or a run file of `shpb run`
 /// (recognised by its signature, reduced with its own set-up and spheres) with the set-up
 /// `bars_flag` (default [`DEFAULT_BARS`]; for a run file, a set-up that differs from the run's
-/// is refused).
+/// is refused); with `cylinder`, also that specimen's 1/2/3-wave stress and strain
+/// (`shpb_core::reduce_cylinder`).
 pub fn reduce_record(
     record: &Path,
     bars_flag: Option<&Path>,
     no_dispersion: bool,
+    cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
 ) -> Result<Reduced> {
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
@@ -288,7 +334,8 @@ pub fn reduce_record(
     };
     let options = ReductionOptions {
         dispersion_correction: !no_dispersion,
-        specimen_radii_m: Some(radii),
+        // A cylinder's rate is its own (reduce_cylinder); the spheres' δ̇/(r1 + r2) is not.
+        specimen_radii_m: cylinder.is_none().then_some(radii),
         ..ReductionOptions::default()
     };
     let reduction = if hdf5_input {
@@ -302,10 +349,19 @@ pub fn reduce_record(
     } else {
         shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
     };
+    let cylinder = match cylinder {
+        Some(g) => Some(shpb_core::reduce_cylinder::reduce_cylinder(
+            &reduction,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &g,
+        )?),
+        None => None,
+    };
     Ok(Reduced {
         reduction,
         apparatus,
         hdf5_input,
+        cylinder,
     })
 }
 

@@ -3,14 +3,15 @@
 use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, warn, wrote};
 use shpb_input::Result;
 use shpb_output::atomic::{check_not_input, check_output_path};
-use shpb_output::reduction::{write_reduction_csv, write_reduction_hdf5};
+use shpb_output::reduction::{write_reduction_csv_with, write_reduction_hdf5_with};
 use std::path::Path;
 
 /// `shpb reduce RECORD --bars SET-UP [-o OUT.h5] [--csv OUT.csv] [--no-dispersion] [--force]`:
 /// reduces a raw record (the authors' CSV) or an HDF5 file of `shpb run` (recognised by its
 /// signature) with the set-up's bars and gauges (`bars`: a built-in set-up name or a set-up
 /// file), writes `/reduction/*` (HDF5) and/or CSV, and prints a summary. The strain rate uses
-/// the paper's spheres (r1 + r2 = 6.35 mm).
+/// the paper's spheres (r1 + r2 = 6.35 mm). With `specimen` = (length, diameter) of a cylinder
+/// (both or neither), also its 1/2/3-wave stress and strain (docs/physics.md §7.6).
 pub fn reduce_command(
     record: &Path,
     bars_flag: Option<&Path>,
@@ -18,9 +19,15 @@ pub fn reduce_command(
     csv: Option<&Path>,
     force: bool,
     no_dispersion: bool,
+    specimen: (Option<f64>, Option<f64>),
 ) -> Result<()> {
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
+    let geometry = shpb_study::api::cylinder_geometry(
+        specimen.0,
+        specimen.1,
+        ("--specimen-length", "--specimen-diameter"),
+    )?;
     let outputs = [
         (output, "--output", &["h5", "hdf5"][..]),
         (csv, "--csv", &["csv"][..]),
@@ -36,7 +43,8 @@ pub fn reduce_command(
         reduction: r,
         apparatus,
         hdf5_input,
-    } = shpb_study::api::reduce_record(record, bars_flag, no_dispersion)?;
+        cylinder,
+    } = shpb_study::api::reduce_record(record, bars_flag, no_dispersion, geometry)?;
     let mut scene = format!(
         "shpb reduce {} --bars {}",
         record.display(),
@@ -51,15 +59,21 @@ pub fn reduce_command(
     if no_dispersion {
         scene.push_str(" --no-dispersion");
     }
+    if let Some(g) = &geometry {
+        scene.push_str(&format!(
+            " --specimen-length {} --specimen-diameter {}",
+            g.length_m, g.diameter_m
+        ));
+    }
     if force {
         scene.push_str(" --force");
     }
     if let Some(o) = output {
-        write_reduction_hdf5(o, force, &scene, &r)?;
+        write_reduction_hdf5_with(o, force, &scene, &r, cylinder.as_ref())?;
         wrote(o);
     }
     if let Some(c) = csv {
-        write_reduction_csv(c, force, &r)?;
+        write_reduction_csv_with(c, force, &r, cylinder.as_ref())?;
         wrote(c);
     }
     for w in &r.warnings {
@@ -80,7 +94,7 @@ pub fn reduce_command(
             )
         })
         .collect();
-    let text = format!(
+    let mut text = format!(
         "record: {} ({}); bridges: {}\n\
          windows: incident from {:.2} µs, reflected +{:.2} µs, transmitted +{:.2} µs, {:.1} µs long; dispersion correction {}\n\
          peak back force {:.1} N at t = {:.2} µs; displacement at peak force {:.2} µm; equilibrium ratio at peak {:.3}\n",
@@ -101,8 +115,19 @@ pub fn reduce_command(
         r.displacement_at_peak_force_m * 1e6,
         r.equilibrium_ratio_at_peak
     );
+    if let Some(c) = &cylinder {
+        text.push_str(&format!(
+            "cylinder {:.3} mm × {:.3} mm (1-wave, compression positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
+            c.geometry.length_m * 1e3,
+            c.geometry.diameter_m * 1e3,
+            c.peak_stress_pa * 1e-6,
+            c.peak_time_s * 1e6,
+            c.strain_at_peak,
+            c.mean_strain_rate_per_s
+        ));
+    }
     report(&text, || {
-        serde_json::json!({
+        let mut json = serde_json::json!({
             "record": record.display().to_string(),
             "set_up": apparatus.source,
             "input": if hdf5_input { "hdf5 gauge strains" } else { "raw gauge voltages" },
@@ -118,6 +143,17 @@ pub fn reduce_command(
             "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),
             "equilibrium_ratio_at_peak": finite(r.equilibrium_ratio_at_peak),
             "warnings": r.warnings,
-        })
+        });
+        if let Some(c) = &cylinder {
+            json["cylinder"] = serde_json::json!({
+                "length_m": finite(c.geometry.length_m),
+                "diameter_m": finite(c.geometry.diameter_m),
+                "peak_stress_Pa": finite(c.peak_stress_pa),
+                "peak_stress_time_s": finite(c.peak_time_s),
+                "strain_at_peak_stress": finite(c.strain_at_peak),
+                "mean_strain_rate_per_s": finite(c.mean_strain_rate_per_s),
+            });
+        }
+        json
     })
 }

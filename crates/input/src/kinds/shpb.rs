@@ -2,7 +2,7 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
-use super::{CHAIN_SPECIMEN, LAW, Parsed, REGION2, SceneKind, UNLOADING};
+use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
 use shpb_core::fidelity::Fidelity;
 use std::path::Path;
@@ -10,9 +10,9 @@ use std::path::Path;
 /// The registry entry.
 pub(super) const KIND: SceneKind = SceneKind {
     name: "shpb",
-    help: "the whole virtual test: gun, striker, shaper, bars, two (or more) spheres, gauges and the lab's reduction",
+    help: "the whole virtual test: gun, striker, shaper, bars, spheres or a cylinder, gauges and the lab's reduction",
     keys: &[
-        CHAIN_SPECIMEN,
+        SPECIMEN,
         LAW,
         REGION2,
         UNLOADING,
@@ -27,6 +27,14 @@ pub(super) const KIND: SceneKind = SceneKind {
     example: "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nspecimen = { pair = \"ss440c\" }\n",
     example_dir: None,
     parse,
+};
+
+/// `[specimen]` of a full test: spheres (as a chain scene's) or a cylinder (docs/physics.md §6.9).
+const SPECIMEN: Key = Key {
+    key: "specimen",
+    unit: "",
+    default: "required",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio)",
 };
 
 fn parse(
