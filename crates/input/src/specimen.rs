@@ -227,7 +227,7 @@ impl SpecimenSpec {
             other => {
                 return Err(v.error(
                     "material",
-                    format!("a {} is not a material", other.type_str()),
+                    format!("a value of type {} is not a material", other.type_str()),
                     CYLINDER_FORM,
                 ));
             }
