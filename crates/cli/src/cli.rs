@@ -294,7 +294,8 @@ pub enum Command {
         #[arg(long)]
         no_dispersion: bool,
         /// Length of a cylindrical specimen, m (with --specimen-diameter): also its 1/2/3-wave
-        /// stress, strain, strain rate and true stress/strain (/reduction/cylinder).
+        /// stress, strain, strain rate and true stress/strain (/reduction/cylinder) [default: a
+        /// run file's own cylinder, if it has one].
         #[arg(long, value_name = "L")]
         specimen_length: Option<f64>,
         /// Diameter of a cylindrical specimen, m (with --specimen-length).

@@ -262,6 +262,11 @@ fn shpb_run_and_shpb_reduce_recover_the_cylinder_modulus() {
         "{json_peak} vs {peak}"
     );
     assert!(v["cylinder"]["mean_strain_rate_per_s"].as_f64().unwrap() > 0.0);
+    // Without the flags, a cylinder's run file is reduced as its own cylinder.
+    let o = shpb(d, &["reduce", "run.h5", "--no-dispersion", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let own: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(own["cylinder"], v["cylinder"]);
 }
 
 /// `--specimen-length` without `--specimen-diameter` (or the reverse) is refused, naming the

@@ -289,7 +289,7 @@ pub fn cylinder_geometry(
 /// (recognised by its signature, reduced with its own set-up and spheres) with the set-up
 /// `bars_flag` (default [`DEFAULT_BARS`]; for a run file, a set-up that differs from the run's
 /// is refused); with `cylinder`, also that specimen's 1/2/3-wave stress and strain
-/// (`shpb_core::reduce_cylinder`).
+/// (`shpb_core::reduce_cylinder`) — for a run file of a cylinder, its own cylinder by default.
 pub fn reduce_record(
     record: &Path,
     bars_flag: Option<&Path>,
@@ -307,8 +307,8 @@ pub fn reduce_record(
     }
     let hdf5_input = shpb_output::reduction::is_hdf5(record)?;
     let run = if hdf5_input { run_setup(record)? } else { None };
-    let (apparatus, radii) = match run {
-        Some((run_apparatus, radii)) => {
+    let (apparatus, radii, run_cylinder) = match run {
+        Some((run_apparatus, radii, run_cylinder)) => {
             if let Some(flag) = bars_flag {
                 let given = load_apparatus(flag)?;
                 if ReductionSetup::from_apparatus(&given)?
@@ -328,10 +328,12 @@ pub fn reduce_record(
                     ));
                 }
             }
-            (run_apparatus, radii)
+            (run_apparatus, radii, run_cylinder)
         }
-        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
+        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M, None),
     };
+    // A cylinder run file is reduced as its own specimen unless the geometry is given.
+    let cylinder = cylinder.or(run_cylinder);
     let options = ReductionOptions {
         dispersion_correction: !no_dispersion,
         // A cylinder's rate is its own (reduce_cylinder); the spheres' δ̇/(r1 + r2) is not.
@@ -365,9 +367,19 @@ pub fn reduce_record(
     })
 }
 
-/// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored
-/// in its `/provenance` (None for a file without a stored bar scene, e.g. `shpb strain`'s).
-fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
+/// The set-up, sphere radii and cylinder (if any) a run file was simulated with, from the scene
+/// and inputs stored in its `/provenance` (None for a file without a stored bar scene, e.g.
+/// `shpb strain`'s).
+#[allow(clippy::type_complexity)]
+fn run_setup(
+    record: &Path,
+) -> Result<
+    Option<(
+        Apparatus,
+        (f64, f64),
+        Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+    )>,
+> {
     let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
         return Ok(None);
     };
@@ -385,7 +397,13 @@ fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
                 Some(sp) => shpb_core::scene::specimen_radii_m(&sp.spheres),
                 None => (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
             };
-            Some((*apparatus, radii))
+            let cylinder = options
+                .cylinder
+                .map(|c| shpb_core::reduce_cylinder::CylinderGeometry {
+                    length_m: c.length_m,
+                    diameter_m: c.diameter_m,
+                });
+            Some((*apparatus, radii, cylinder))
         }
         _ => None,
     })
