@@ -80,6 +80,53 @@ mod tests {
         );
     }
 
+    /// A cylinder of a named material takes its E, ν, ρ; one given as a table takes the table's;
+    /// the fast fidelity's 4 mm cell is refined so the specimen has CYLINDER_MIN_CELLS cells
+    /// (docs/physics.md §6.9), an explicit cell is kept when fine enough.
+    #[test]
+    fn a_cylinder_specimen_is_read_and_resolved() {
+        use shpb_core::apparatus::CYLINDER_MIN_CELLS;
+        use shpb_core::material::Material;
+        let v = Validator::new("c.toml");
+        let head = "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n";
+        let named = format!(
+            "{head}[specimen]\nshape = \"cylinder\"\nmaterial = \"al2017\"\nlength_m = 6e-3\ndiameter_m = 12e-3\n"
+        );
+        let (_, _, _, p) = parse(&named, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let SceneParams::Pulse {
+            options, apparatus, ..
+        } = p
+        else {
+            panic!("not a bar scene")
+        };
+        let c = options.cylinder.expect("a cylinder");
+        let al = <Material as crate::material::MaterialFile>::builtin("al2017").unwrap();
+        assert_eq!(
+            (
+                c.material.youngs_modulus_pa,
+                c.material.poisson_ratio,
+                c.material.density_kg_m3
+            ),
+            (al.youngs_modulus_pa, al.poisson_ratio, al.density_kg_m3)
+        );
+        assert_eq!((c.length_m, c.diameter_m), (6e-3, 12e-3));
+        assert!(options.specimen.is_none());
+        assert_eq!(options.end, IncidentEnd::Specimen);
+        let c0 = apparatus.material.wave_speed_m_s();
+        assert!(options.cell_size_m < Fidelity::Fast.bar_knobs().cell_size_m);
+        assert_eq!(c.cells_at(options.cell_size_m / c0), CYLINDER_MIN_CELLS);
+        let table = format!(
+            "{head}cell_size_m = 5e-4\n[specimen]\nshape = \"cylinder\"\nlength_m = 5e-3\ndiameter_m = 5e-3\nmaterial = {{ density_kg_m3 = 7850.0, youngs_modulus_pa = 200e9, poisson_ratio = 0.3 }}\n"
+        );
+        let (_, _, _, p) = parse(&table, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let SceneParams::Pulse { options, .. } = p else {
+            panic!("not a bar scene")
+        };
+        let c = options.cylinder.unwrap();
+        assert_eq!(c.material.youngs_modulus_pa, 200e9);
+        assert_eq!(options.cell_size_m, 5e-4);
+    }
+
     #[test]
     fn a_specimen_is_required() {
         let v = Validator::new("s.toml");
