@@ -7,8 +7,34 @@
 //! (e) `reduce_command` on a raw record and on a `shpb run` HDF5 file, its outputs and errors.
 
 use shpb::Error;
+
+/// `shpb reduce RECORD --bars BARS [-o H5] [--csv CSV] [--force] [--no-dispersion]` with the
+/// other choices at their defaults.
+fn reduce_command(
+    record: &Path,
+    bars: Option<&Path>,
+    output: Option<&Path>,
+    csv: Option<&Path>,
+    force: bool,
+    no_dispersion: bool,
+) -> shpb::Result<()> {
+    shpb::cmd::reduce::reduce_command(
+        &[record.to_path_buf()],
+        bars,
+        shpb::cmd::reduce::Outputs {
+            output,
+            csv,
+            summary: None,
+            report: None,
+            force,
+        },
+        &shpb::api::RecordOptions {
+            no_dispersion,
+            ..Default::default()
+        },
+    )
+}
 use shpb::apparatus::Apparatus;
-use shpb::cmd::reduce::reduce_command;
 use shpb::csv::CsvTable;
 use shpb::gauges::reduce_record_file;
 use shpb::io::write_hdf5;

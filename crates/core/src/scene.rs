@@ -642,11 +642,6 @@ fn run_free_chain(
     Ok(out)
 }
 
-/// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
-/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
-/// < 0.02 % of its peak.
-pub const SIMULATED_RECORD_SMOOTHING_S: f64 = 2e-6;
-
 /// The lab's reduction of a simulated test: the digitised voltages read back through each
 /// channel's bridge (as the lab gets them), dispersion correction only when the bars disperse.
 fn reduce_simulated_records(
@@ -676,7 +671,7 @@ fn reduce_simulated_records(
     let reduction_options = crate::reduce::ReductionOptions {
         dispersion_correction: options.dispersion != Dispersion::None,
         specimen_radii_m: Some(specimen_radii_m(&spec.spheres)),
-        smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
+        smoothing_window_s: crate::reduce::DEFAULT_SMOOTHING_S,
         ..Default::default()
     };
     crate::reduce::reduce(
