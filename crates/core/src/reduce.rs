@@ -252,7 +252,7 @@ pub struct ReductionOptions {
     /// Sphere radii (r1, r2), m, for the global strain rate δ̇/(r1 + r2) (default None).
     pub specimen_radii_m: Option<(f64, f64)>,
     /// Width of a centred moving average applied to both strain records before the reduction,
-    /// s (default 0: off). A box of width w attenuates noise by √(w/Δt) and changes a pulse of
+    /// s (default [`DEFAULT_SMOOTHING_S`]; 0: off). A box of width w attenuates noise by √(w/Δt) and changes a pulse of
     /// rise time τ by about w²/(24 τ²) of its peak.
     pub smoothing_window_s: f64,
     /// How the reflected and transmitted windows are placed (default geometric); a window
@@ -271,7 +271,7 @@ impl Default for ReductionOptions {
             start_fraction: 0.02,
             specimen_transit_s: 0.0,
             specimen_radii_m: None,
-            smoothing_window_s: 0.0,
+            smoothing_window_s: DEFAULT_SMOOTHING_S,
             alignment: Alignment::Geometric,
             balance_bound_s: DEFAULT_BALANCE_BOUND_S,
         }
@@ -1279,9 +1279,11 @@ mod tests {
         )
     }
 
+    /// No dispersion and no smoothing: the record's own samples.
     fn options() -> ReductionOptions {
         ReductionOptions {
             dispersion_correction: false,
+            smoothing_window_s: 0.0,
             ..ReductionOptions::default()
         }
     }

@@ -125,13 +125,7 @@ pub(crate) struct BalanceProblem<'a> {
 /// sample reaching 10 % of its peak to the peak, as sample indices (docs/physics.md §7.6).
 pub(crate) fn loading_span(incident: &[f64]) -> (usize, usize) {
     let y: Vec<f64> = incident.iter().map(|e| -e).collect();
-    let k_peak = y
-        .iter()
-        .enumerate()
-        .fold((0, f64::NEG_INFINITY), |best, (k, &v)| {
-            if v > best.1 { (k, v) } else { best }
-        })
-        .0;
+    let k_peak = crate::numeric::argmax(&y);
     let level = 0.1 * y[k_peak];
     let k_start = (0..=k_peak).find(|&k| y[k] >= level).unwrap_or(k_peak);
     (k_start, k_peak)
