@@ -309,7 +309,7 @@ def reduce(
     ``specimen_length_m`` and ``specimen_diameter_m`` (both or neither): a cylindrical
     specimen's 1/2/3-wave curves, ``reduction/cylinder/{one_wave,two_wave,three_wave}/
     {stress,strain,strain_rate,true_stress,true_strain}``, compression positive
-    (docs/physics.md §7.6), and ``peak_stress``, ``strain_at_peak_stress``,
+    (docs/physics.md §7.8), and ``peak_stress``, ``strain_at_peak_stress``,
     ``mean_strain_rate`` in the summary."""
     return Run(
         _shpb.reduce(

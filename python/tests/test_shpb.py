@@ -205,7 +205,7 @@ def test_reduce_equals_shpb_reduce(cli, tmp_path):
 
 
 def test_reduce_of_a_cylinder_equals_shpb_reduce_and_recovers_its_modulus(cli, tmp_path):
-    """A cylinder's run file reduced with its geometry (docs/physics.md §7.6): the same curves as
+    """A cylinder's run file reduced with its geometry (docs/physics.md §7.8): the same curves as
     `shpb reduce --specimen-length --specimen-diameter`, and the 3-wave modulus fitted on 30-90 %
     of the loading part within 1 % of the scene's material (crates/cli/tests/cylinder.rs)."""
     import tomllib

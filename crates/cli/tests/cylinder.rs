@@ -1,4 +1,4 @@
-//! Cylindrical specimens (issue 19; docs/physics.md §6.9, §7.6): a full test of an elastic
+//! Cylindrical specimens (issue 19; docs/physics.md §6.9, §7.8): a full test of an elastic
 //! cylinder is simulated, its run file reduced back, and the modulus fitted on the loading part
 //! of its stress–strain curve must be the input modulus within 1 %, through the library
 //! (`shpb_study::api::reduce_record`) and through the binary (`shpb run` + `shpb reduce`).
@@ -55,6 +55,7 @@ fn library_round_trip(
     shpb_core::reduce_cylinder::ModulusFit,
     shpb_core::reduce_cylinder::ModulusFit,
 ) {
+    let _one_at_a_time = hdf5_in_this_process();
     let params = Params::from_file(scene).unwrap();
     let cyl = cylinder_of(&params);
     let out = params.run().unwrap();
@@ -75,6 +76,14 @@ fn library_round_trip(
     let one = loading_modulus(&c.one_wave, eq, lo, hi).unwrap();
     let three = loading_modulus(&c.three_wave, eq, lo, hi).unwrap();
     (cyl, one, three)
+}
+
+/// One test at a time touches HDF5 files in this process: two test threads writing and
+/// reopening HDF5 files were seen to fail with "unable to lock file" (errno 11) from the HDF5 C
+/// library, whose open-file table is process-wide.
+fn hdf5_in_this_process() -> std::sync::MutexGuard<'static, ()> {
+    static HDF5: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    HDF5.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -160,6 +169,7 @@ fn units(f: &hdf5::File, name: &str) -> String {
 /// the CSV carries the same columns, the JSON summary the same peak.
 #[test]
 fn shpb_run_and_shpb_reduce_recover_the_cylinder_modulus() {
+    let _one_at_a_time = hdf5_in_this_process();
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = root().join(SCENE);

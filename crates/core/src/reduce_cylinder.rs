@@ -1,5 +1,5 @@
 //! Stress, strain and strain rate of a cylindrical specimen from a bar reduction
-//! (docs/physics.md §7.6): the 1-, 2- and 3-wave analyses of the Kolsky bar (G. T. Gray III,
+//! (docs/physics.md §7.8): the 1-, 2- and 3-wave analyses of the Kolsky bar (G. T. Gray III,
 //! "Classic Split-Hopkinson Pressure Bar Testing", ASM Handbook Vol. 8, ASM International
 //! (2000), pp. 462–476; W. Chen & B. Song, *Split Hopkinson (Kolsky) Bar*, Springer (2011),
 //! §1.3), and the true stress and strain at constant volume.
@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 use crate::numeric::{argmax, cumulative_trapezoid, least_squares};
 use crate::reduce::{Reduction, ReductionSetup};
 
-/// The geometry of a cylindrical specimen as the reduction needs it (docs/physics.md §7.6).
+/// The geometry of a cylindrical specimen as the reduction needs it (docs/physics.md §7.8).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CylinderGeometry {
     /// Initial length L_s, m.
@@ -57,7 +57,7 @@ impl CylinderGeometry {
     }
 }
 
-/// One analysis (1-, 2- or 3-wave) of the specimen, on the reduction's time axis (docs/physics.md §7.6).
+/// One analysis (1-, 2- or 3-wave) of the specimen, on the reduction's time axis (docs/physics.md §7.8).
 #[derive(Debug, Clone, PartialEq)]
 pub struct WaveAnalysis {
     /// Engineering stress σ, Pa (compression positive).
@@ -74,7 +74,7 @@ pub struct WaveAnalysis {
 
 impl WaveAnalysis {
     /// Builds the analysis from stress and strain rate (ε by the trapezoidal rule, or the given
-    /// strain) and adds the true quantities σ(1 − ε), −ln(1 − ε) (docs/physics.md §7.6).
+    /// strain) and adds the true quantities σ(1 − ε), −ln(1 − ε) (docs/physics.md §7.8).
     fn new(stress_pa: Vec<f64>, strain_rate_per_s: Vec<f64>, strain: Vec<f64>) -> Result<Self> {
         if let Some(&e) = strain.iter().find(|e| !(e.is_finite() && **e < 1.0)) {
             return Err(Error::invalid(
@@ -99,7 +99,7 @@ impl WaveAnalysis {
     }
 }
 
-/// A cylindrical specimen reduced by the 1-, 2- and 3-wave analyses (docs/physics.md §7.6).
+/// A cylindrical specimen reduced by the 1-, 2- and 3-wave analyses (docs/physics.md §7.8).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CylinderReduction {
     /// The specimen's geometry.
@@ -122,7 +122,7 @@ pub struct CylinderReduction {
 }
 
 /// The 1-, 2- and 3-wave stress, strain and strain rate of a cylinder of geometry `g` from the
-/// face waves of `r` and the bars of `setup` (docs/physics.md §7.6; Gray 2000, Chen & Song 2011).
+/// face waves of `r` and the bars of `setup` (docs/physics.md §7.8; Gray 2000, Chen & Song 2011).
 pub fn reduce_cylinder(
     r: &Reduction,
     setup: &ReductionSetup,
@@ -181,11 +181,11 @@ pub fn reduce_cylinder(
 /// The loading window of [`loading_modulus`] as fractions of the peak stress: (0.3, 0.9) — above
 /// the foot, where ring-up and the wave's toe leave the specimen out of equilibrium, and below
 /// the rounded top, where the rate falls to zero and the strain's small errors weigh most
-/// (docs/physics.md §7.6, "Modulus").
+/// (docs/physics.md §7.8, "Modulus").
 pub const MODULUS_WINDOW: (f64, f64) = (0.3, 0.9);
 
 /// A straight line σ = E ε + b fitted to the loading part of a stress–strain curve
-/// (docs/physics.md §7.6, "Modulus").
+/// (docs/physics.md §7.8, "Modulus").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModulusFit {
     /// Slope E, Pa.
@@ -202,7 +202,7 @@ pub struct ModulusFit {
 
 /// Least-squares slope dσ/dε of `a` over its loading part: from the first sample at which σ
 /// reaches `low` × peak to the last sample before the peak below `high` × peak, with the
-/// reduction's `equilibrium_ratio` reported over that window (docs/physics.md §7.6).
+/// reduction's `equilibrium_ratio` reported over that window (docs/physics.md §7.8).
 pub fn loading_modulus(
     a: &WaveAnalysis,
     equilibrium_ratio: &[f64],
@@ -314,6 +314,26 @@ mod tests {
                 baseline_samples: 0,
             },
             measured_reflected_delay_s: None,
+            alignment: crate::reduce::AlignmentReport {
+                strategy: crate::reduce::Alignment::Geometric,
+                geometric_reflected_delay_s: 0.0,
+                geometric_transmitted_delay_s: 0.0,
+                measured_reflected_delay_s: None,
+                measured_transmitted_delay_s: None,
+                balance_shift_s: None,
+                balance_bound_s: crate::reduce::DEFAULT_BALANCE_BOUND_S,
+                at_bound: false,
+            },
+            quality: crate::reduce::Quality {
+                loading_span_s: (0.0, 0.0),
+                equilibrium_mean: 0.0,
+                equilibrium_max: 0.0,
+                verdict: crate::reduce::EquilibriumVerdict::Equilibrium,
+                incident_duration_s: 0.0,
+                pulse_overlap_s: 0.0,
+                noise_strain: (0.0, 0.0),
+                signal_to_noise: (f64::INFINITY, f64::INFINITY),
+            },
             dispersion_corrected: false,
             warnings: vec![],
         }

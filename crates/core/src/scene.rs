@@ -528,7 +528,7 @@ fn run_pulse(
     }
     energy.push(("total".into(), total));
     let mut warnings = Vec::new();
-    // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.6).
+    // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.8).
     let radii = options
         .specimen
         .as_ref()
@@ -656,11 +656,6 @@ fn run_free_chain(
     Ok(out)
 }
 
-/// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
-/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
-/// < 0.02 % of its peak.
-pub const SIMULATED_RECORD_SMOOTHING_S: f64 = 2e-6;
-
 /// The lab's reduction of a simulated test: the digitised voltages read back through each
 /// channel's bridge (as the lab gets them), dispersion correction only when the bars disperse.
 fn reduce_simulated_records(
@@ -690,7 +685,7 @@ fn reduce_simulated_records(
     let reduction_options = crate::reduce::ReductionOptions {
         dispersion_correction: options.dispersion != Dispersion::None,
         specimen_radii_m: specimen_radii,
-        smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
+        smoothing_window_s: crate::reduce::DEFAULT_SMOOTHING_S,
         ..Default::default()
     };
     crate::reduce::reduce(
@@ -708,7 +703,7 @@ pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
     (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
 }
 
-/// Summary items of a simulated cylinder's reduction (docs/physics.md §7.6): 1-wave peak
+/// Summary items of a simulated cylinder's reduction (docs/physics.md §7.8): 1-wave peak
 /// stress, strain at peak, mean strain rate, and the modulus fitted to the 3-wave curve on
 /// 30–90 % of its peak (`reduce_cylinder::MODULUS_WINDOW`).
 fn reduced_cylinder_summary(

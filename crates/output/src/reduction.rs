@@ -112,6 +112,37 @@ pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
     if let Some(m) = r.measured_reflected_delay_s {
         v.push(("measured_reflected_delay", m, "s"));
     }
+    let a = &r.alignment;
+    v.push((
+        "geometric_reflected_delay",
+        a.geometric_reflected_delay_s,
+        "s",
+    ));
+    v.push((
+        "geometric_transmitted_delay",
+        a.geometric_transmitted_delay_s,
+        "s",
+    ));
+    if let Some(m) = a.measured_transmitted_delay_s {
+        v.push(("measured_transmitted_delay", m, "s"));
+    }
+    if let Some((sr, st)) = a.balance_shift_s {
+        v.push(("balance_shift_reflected", sr, "s"));
+        v.push(("balance_shift_transmitted", st, "s"));
+    }
+    let q = &r.quality;
+    v.extend([
+        ("equilibrium_mean_loading", q.equilibrium_mean, "1"),
+        ("equilibrium_max_loading", q.equilibrium_max, "1"),
+        ("loading_start", q.loading_span_s.0, "s"),
+        ("loading_end", q.loading_span_s.1, "s"),
+        ("incident_duration", q.incident_duration_s, "s"),
+        ("pulse_overlap", q.pulse_overlap_s, "s"),
+        ("noise_incident_strain", q.noise_strain.0, "1"),
+        ("noise_transmission_strain", q.noise_strain.1, "1"),
+        ("signal_to_noise_incident", q.signal_to_noise.0, "1"),
+        ("signal_to_noise_transmission", q.signal_to_noise.1, "1"),
+    ]);
     v
 }
 
@@ -131,7 +162,7 @@ pub fn cylinder_analyses(c: &CylinderReduction) -> [(&'static str, &WaveAnalysis
     ]
 }
 
-/// The series of one analysis: (name, data, units, CSV column suffix) (docs/physics.md §7.6).
+/// The series of one analysis: (name, data, units, CSV column suffix) (docs/physics.md §7.8).
 pub fn analysis_columns(
     a: &WaveAnalysis,
 ) -> [(&'static str, &[f64], &'static str, &'static str); 5] {
@@ -195,7 +226,7 @@ pub fn write_reduction_hdf5_with(
             string_attr(
                 &cg,
                 "sign",
-                "compression positive (stress, strain, strain rate); docs/physics.md §7.6",
+                "compression positive (stress, strain, strain rate); docs/physics.md §7.8",
                 path,
             )?;
             for (group, a) in cylinder_analyses(c) {
@@ -221,6 +252,8 @@ pub fn write_reduction_hdf5_with(
             .join(", ");
         string_attr(&s, "units", &units, path)?;
         string_attr(&s, "warnings", &r.warnings.join("\n"), path)?;
+        string_attr(&s, "alignment", r.alignment.strategy.name(), path)?;
+        string_attr(&s, "equilibrium_verdict", r.quality.verdict.name(), path)?;
         f.close().map_err(h5err(path))
     })
 }

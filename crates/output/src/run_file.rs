@@ -101,7 +101,7 @@ pub fn reduction_datasets(r: &Reduction) -> Vec<Dataset<'_>> {
 }
 
 /// The `/reduction/cylinder/<analysis>/<series>` datasets of a cylinder's reduction (as
-/// `shpb reduce --specimen-length --specimen-diameter -o` writes them; docs/physics.md §7.6).
+/// `shpb reduce --specimen-length --specimen-diameter -o` writes them; docs/physics.md §7.8).
 pub fn cylinder_datasets(c: &shpb_core::reduce_cylinder::CylinderReduction) -> Vec<Dataset<'_>> {
     crate::reduction::cylinder_analyses(c)
         .into_iter()

@@ -499,7 +499,7 @@ fn curve<'py>(
 }
 
 /// The lab's reduction of a raw record or run file (`shpb reduce`); with a cylinder's length and
-/// diameter (m, both or neither) also its 1/2/3-wave curves (docs/physics.md §7.6).
+/// diameter (m, both or neither) also its 1/2/3-wave curves (docs/physics.md §7.8).
 #[pyfunction]
 #[pyo3(signature = (record, bars = None, dispersion = true, specimen_length_m = None, specimen_diameter_m = None))]
 fn reduce(

@@ -240,7 +240,7 @@ pub struct Reduced {
     /// Whether the record was a run file's gauge strains (else raw gauge voltages).
     pub hdf5_input: bool,
     /// A cylindrical specimen's 1/2/3-wave stress and strain, when its geometry was given
-    /// (docs/physics.md §7.6).
+    /// (docs/physics.md §7.8).
     pub cylinder: Option<shpb_core::reduce_cylinder::CylinderReduction>,
 }
 
@@ -296,6 +296,86 @@ pub fn reduce_record(
     no_dispersion: bool,
     cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
 ) -> Result<Reduced> {
+    reduce_record_with(
+        record,
+        bars_flag,
+        &RecordOptions {
+            no_dispersion,
+            cylinder,
+            ..RecordOptions::default()
+        },
+    )
+}
+
+/// The choices of `shpb reduce` beyond the record and set-up (its flags; docs/physics.md §7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordOptions {
+    /// Skip the dispersion correction (`--no-dispersion`).
+    pub no_dispersion: bool,
+    /// Window alignment (`--align`, default geometric).
+    pub alignment: shpb_core::reduce::Alignment,
+    /// Moving-average width applied to both channels, s (`--smooth`, default
+    /// [`shpb_core::reduce::DEFAULT_SMOOTHING_S`], as `shpb run` smooths simulated records).
+    pub smoothing_s: f64,
+    /// Manual windows (`--incident-start`, `--reflected-delay`, `--transmitted-delay`,
+    /// `--duration`).
+    pub window: Option<shpb_core::reduce::WindowOverride>,
+    /// A cylindrical specimen's geometry (`--specimen-length`, `--specimen-diameter`; default: a
+    /// run file's own cylinder, if it has one).
+    pub cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+}
+
+impl Default for RecordOptions {
+    fn default() -> Self {
+        RecordOptions {
+            no_dispersion: false,
+            alignment: shpb_core::reduce::Alignment::Geometric,
+            smoothing_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+            window: None,
+            cylinder: None,
+        }
+    }
+}
+
+/// [`reduce_record`] with every choice of `shpb reduce` ([`RecordOptions`]).
+pub fn reduce_record_with(
+    record: &Path,
+    bars_flag: Option<&Path>,
+    choices: &RecordOptions,
+) -> Result<Reduced> {
+    if !(choices.smoothing_s.is_finite() && choices.smoothing_s >= 0.0) {
+        return Err(input_err(
+            "--smooth",
+            format!("{} s is out of range", choices.smoothing_s),
+            "0 (off) or a positive width in seconds, e.g. 2e-6",
+        ));
+    }
+    if let Some(w) = choices.window {
+        for (flag, v) in [
+            ("--reflected-delay", w.reflected_delay_s),
+            ("--transmitted-delay", w.transmitted_delay_s),
+            ("--duration", w.duration_s),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(input_err(
+                    flag,
+                    format!("{v} s is out of range"),
+                    "a positive number of seconds",
+                ));
+            }
+        }
+        if let Some(v) = w.incident_start_s
+            && !v.is_finite()
+        {
+            return Err(input_err(
+                "--incident-start",
+                format!("{v} s"),
+                "a finite time on the record clock, s",
+            ));
+        }
+    }
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
     if !record.is_file() {
@@ -333,11 +413,14 @@ pub fn reduce_record(
         None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M, None),
     };
     // A cylinder run file is reduced as its own specimen unless the geometry is given.
-    let cylinder = cylinder.or(run_cylinder);
+    let cylinder = choices.cylinder.or(run_cylinder);
     let options = ReductionOptions {
-        dispersion_correction: !no_dispersion,
+        dispersion_correction: !choices.no_dispersion,
         // A cylinder's rate is its own (reduce_cylinder); the spheres' δ̇/(r1 + r2) is not.
         specimen_radii_m: cylinder.is_none().then_some(radii),
+        alignment: choices.alignment,
+        smoothing_window_s: choices.smoothing_s,
+        window: choices.window,
         ..ReductionOptions::default()
     };
     let reduction = if hdf5_input {
