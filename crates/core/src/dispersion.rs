@@ -1,5 +1,5 @@
 //! The exact first longitudinal mode of a solid elastic cylinder (Pochhammer 1876, Chree 1889;
-//! docs/physics.md §7.6): its phase velocity c(f) for any Poisson's ratio 0 < ν < 0.5, the
+//! docs/physics.md §7.9): its phase velocity c(f) for any Poisson's ratio 0 < ν < 0.5, the
 //! Tyas–Pope amplitude factors M1 and M2, and a per-FFT-bin cache for the reduction.
 //!
 //! # The frequency equation
@@ -310,7 +310,7 @@ pub fn tyas_pope_m2(velocity_ratio: f64) -> f64 {
 }
 
 /// The first Pochhammer–Chree mode of one bar, with its phase velocity memoised per FFT bin
-/// (the reduction evaluates the same bins for every window; docs/physics.md §7.6).
+/// (the reduction evaluates the same bins for every window; docs/physics.md §7.9).
 #[derive(Debug, Clone)]
 pub struct PochhammerChree {
     poisson_ratio: f64,
@@ -524,7 +524,7 @@ mod tests {
             assert!((tyas_pope_m2(x) - 1.0).abs() < 1e-5);
             for y in [0.05, 0.1, 0.2, 0.3] {
                 // The axial strain of the mode across the section, up to a constant
-                // (docs/physics.md §7.6): (K² − Y) C1(Y) C0(X r²/a²) + 2X C1(X) C0(Y r²/a²);
+                // (docs/physics.md §7.9): (K² − Y) C1(Y) C0(X r²/a²) + 2X C1(X) C0(Y r²/a²);
                 // its area mean by Simpson's rule over r/a in [0, 1], over its surface value.
                 let x = velocity_ratio_at_radius_over_wavelength(nu, y);
                 let (l2, t2) = speed_ratios_squared(nu);

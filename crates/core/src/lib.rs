@@ -22,6 +22,7 @@ pub mod gauge;
 pub mod material;
 pub mod numeric;
 pub mod reduce;
+pub mod reduce_cylinder;
 pub mod run;
 pub mod scene;
 pub mod shaper;

@@ -163,7 +163,7 @@ pub struct FftBin {
 }
 
 /// [`phase_shift`] with a real gain as well: the component of bin b is multiplied by
-/// `gain · exp(−2πi f delay)` where `(delay, gain) = factor(b)` (docs/physics.md §7.6, the
+/// `gain · exp(−2πi f delay)` where `(delay, gain) = factor(b)` (docs/physics.md §7.9, the
 /// Tyas–Pope amplitude factors). With gain 1 it is exactly [`phase_shift`].
 pub fn spectral_filter(
     x: &[f64],

@@ -1,5 +1,5 @@
 //! The authors' eight records (2013-05-22) reduced twice, with the Bancroft fit and with the
-//! exact Pochhammer–Chree first mode (docs/physics.md §7.6), and the difference set against each
+//! exact Pochhammer–Chree first mode (docs/physics.md §7.9), and the difference set against each
 //! record's noise: the report `validation/dispersion/REPORT.md` (`src/bin/dispersion_report.rs`)
 //! and the test `tests/dispersion_records.rs` read the same numbers from [`compare_records`].
 

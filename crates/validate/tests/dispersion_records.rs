@@ -1,5 +1,5 @@
 //! The exact Pochhammer–Chree correction against the Bancroft fit on the authors' eight records
-//! (docs/physics.md §7.6, `validation/dispersion/REPORT.md`): for the authors' bars (ν = 0.31,
+//! (docs/physics.md §7.9, `validation/dispersion/REPORT.md`): for the authors' bars (ν = 0.31,
 //! the fit's own ratio) the two must agree to within what the records can resolve, their noise.
 
 use shpb_core::reduce::DispersionCorrection;
