@@ -147,11 +147,15 @@ fn rms_head(v: &[f64], n: usize) -> f64 {
 
 /// Reduces each of the eight records (`validation/gauge-records/data` below `root`) with the
 /// authors' set-up (`bars/authors.toml`), once with the Bancroft fit and once with the exact
-/// first mode, all other options at their defaults.
+/// first mode, on the raw samples (no smoothing: the comparison is with the records' own noise),
+/// all other options at their defaults.
 pub fn compare_records(root: &Path) -> Result<Vec<RecordComparison>> {
     let app = Apparatus::from_file(&root.join("bars/authors.toml"))?;
     let setup = ReductionSetup::from_apparatus(&app)?;
-    let bancroft = ReductionOptions::default();
+    let bancroft = ReductionOptions {
+        smoothing_window_s: 0.0,
+        ..ReductionOptions::default()
+    };
     let exact = ReductionOptions {
         dispersion: DispersionCorrection::PochhammerChree,
         ..bancroft
