@@ -296,12 +296,42 @@ def curve(
     return _shpb.curve(pair, float(rate), float(to), int(points), law)
 
 
-def reduce(record: PathLike, bars: Optional[PathLike] = None, dispersion: bool = True) -> Run:
+def reduce(
+    record: PathLike,
+    bars: Optional[PathLike] = None,
+    dispersion: Union[str, bool] = "bancroft",
+    tyas_pope: bool = False,
+    align: str = "geometric",
+    smooth: float = 2e-6,
+    specimen_length_m: Optional[float] = None,
+    specimen_diameter_m: Optional[float] = None,
+) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
-    ``bars``: the set-up (default: the run file's own, else ``"authors"``)."""
+    ``bars``: the set-up (default: the run file's own, else ``"authors"``). ``dispersion``:
+    ``"none"``, ``"bancroft"`` or ``"pochhammer-chree"`` (``--dispersion``; ``True``/``False``,
+    the old form, mean ``"bancroft"``/``"none"``); ``tyas_pope``: the Tyas–Pope amplitude
+    factors (``--tyas-pope``). ``align``: ``"geometric"``, ``"foot"`` or ``"balance"``
+    (``--align``); ``smooth``: moving-average width, s (``--smooth``, 0 is off; the default is
+    what ``shpb run`` applies to simulated records). ``specimen_length_m`` and
+    ``specimen_diameter_m`` (both or neither): a cylindrical specimen's 1/2/3-wave curves,
+    ``reduction/cylinder/{one_wave,two_wave,three_wave}/
+    {stress,strain,strain_rate,true_stress,true_strain}``, compression positive
+    (docs/physics.md §7.8), and ``peak_stress``, ``strain_at_peak_stress``,
+    ``mean_strain_rate`` in the summary."""
+    if isinstance(dispersion, bool):
+        dispersion = "bancroft" if dispersion else "none"
     return Run(
-        _shpb.reduce(os.fspath(record), None if bars is None else os.fspath(bars), dispersion)
+        _shpb.reduce(
+            os.fspath(record),
+            None if bars is None else os.fspath(bars),
+            dispersion,
+            bool(tyas_pope),
+            align,
+            float(smooth),
+            specimen_length_m,
+            specimen_diameter_m,
+        )
     )
 
 

@@ -41,7 +41,16 @@ def curve(
     points: int = 101,
     law: str = "burgoyne-daraio",
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
-def reduce(record: str, bars: Optional[str] = None, dispersion: bool = True) -> RunData: ...
+def reduce(
+    record: str,
+    bars: Optional[str] = None,
+    dispersion: str = "bancroft",
+    tyas_pope: bool = False,
+    align: str = "geometric",
+    smooth: float = 2e-6,
+    specimen_length_m: Optional[float] = None,
+    specimen_diameter_m: Optional[float] = None,
+) -> RunData: ...
 def sweep(
     scene: str, set: Sequence[str], jobs: int = 1
 ) -> Tuple[

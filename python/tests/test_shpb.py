@@ -204,6 +204,72 @@ def test_reduce_equals_shpb_reduce(cli, tmp_path):
     assert_runs_equal(shpb.load(tmp_path / "py.h5"), r)
 
 
+def test_reduce_dispersion_keyword_equals_the_flags(cli, tmp_path):
+    # dispersion= takes the names of `shpb reduce --dispersion`; True/False are the old form.
+    cli(
+        "reduce", RECORD, "--bars", "authors", "-o", tmp_path / "pc.h5",
+        "--dispersion", "pochhammer-chree", "--tyas-pope",
+    )
+    r = shpb.reduce(RECORD, bars="authors", dispersion="pochhammer-chree", tyas_pope=True)
+    for k, (data, units) in h5_datasets(tmp_path / "pc.h5").items():
+        assert same(r[k], data), k
+    off = shpb.reduce(RECORD, bars="authors", dispersion="none")
+    old = shpb.reduce(RECORD, bars="authors", dispersion=False)
+    assert same(off["reduction/force_back"], old["reduction/force_back"])
+    with pytest.raises(shpb.InputError):
+        shpb.reduce(RECORD, dispersion="love")
+
+
+def test_reduce_of_a_cylinder_equals_shpb_reduce_and_recovers_its_modulus(cli, tmp_path):
+    """A cylinder's run file reduced with its geometry (docs/physics.md §7.8): the same curves as
+    `shpb reduce --specimen-length --specimen-diameter`, and the 3-wave modulus fitted on 30-90 %
+    of the loading part within 1 % of the scene's material (crates/cli/tests/cylinder.rs)."""
+    import tomllib
+
+    scene = "scenes/shpb-cylinder-al.toml"
+    spec = tomllib.loads((ROOT / scene).read_text())["specimen"]
+    material = tomllib.loads((ROOT / "specimens" / f"{spec['material']}.toml").read_text())
+    length, diameter = spec["length_m"], spec["diameter_m"]
+    run = tmp_path / "run.h5"
+    cli("run", scene, "-o", run)
+    geometry = ["--specimen-length", repr(length), "--specimen-diameter", repr(diameter)]
+    cli("reduce", run, "--no-dispersion", *geometry, "-o", tmp_path / "red.h5")
+    r = shpb.reduce(run, dispersion=False, specimen_length_m=length, specimen_diameter_m=diameter)
+    file = h5_datasets(tmp_path / "red.h5")
+    assert r.keys() == sorted(file)
+    for k, (data, units) in file.items():
+        assert same(r[k], data) and r.units[k] == units, k
+    assert r.summary == h5_summary(tmp_path / "red.h5")
+    assert r.units["reduction/cylinder/one_wave/stress"] == "Pa"
+    stress = r["reduction/cylinder/three_wave/stress"]
+    strain = r["reduction/cylinder/three_wave/strain"]
+    k = int(np.argmax(stress))
+    peak = stress[k]
+    first = int(np.argmax(stress[: k + 1] >= 0.3 * peak))
+    last = int(np.nonzero(stress[: k + 1] <= 0.9 * peak)[0][-1])
+    slope = np.polyfit(strain[first : last + 1], stress[first : last + 1], 1)[0]
+    assert abs(slope / material["youngs_modulus_pa"] - 1) < 0.01
+    # Both keywords or neither, as the flags.
+    code, message = cli_message(cli, "reduce", run, "--specimen-length", "6e-3")
+    with pytest.raises(shpb.InputError) as e:
+        shpb.reduce(run, specimen_length_m=6e-3)
+    assert "`specimen_diameter_m`: missing" in str(e.value)
+    assert "missing" in message and code == 2
+
+
+def test_reduce_alignment_and_smoothing_keywords_equal_the_flags(cli, tmp_path):
+    # align= and smooth= take the values of `shpb reduce --align/--smooth`: the same datasets.
+    cli(
+        "reduce", RECORD, "--bars", "authors", "-o", tmp_path / "foot.h5",
+        "--align", "foot", "--smooth", "0",
+    )
+    r = shpb.reduce(RECORD, bars="authors", align="foot", smooth=0.0)
+    for k, (data, units) in h5_datasets(tmp_path / "foot.h5").items():
+        assert same(r[k], data), k
+    with pytest.raises(shpb.InputError):
+        shpb.reduce(RECORD, align="auto")
+
+
 def test_sweep_in_parallel_equals_serial():
     kw = dict(set={"pressure": ["8psi", "10psi", "12psi"]})
     scene = "scenes/shpb-ss440c-10psi.toml"

@@ -6,6 +6,7 @@ use crate::cmd;
 use clap::{Parser, Subcommand, ValueEnum};
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
+use shpb_core::reduce::DispersionCorrection;
 use shpb_input::Result;
 use std::path::PathBuf;
 
@@ -69,6 +70,49 @@ pub enum LawArg {
     RateIndependent,
     /// Elastic Hertz.
     Hertz,
+}
+
+/// The dispersion corrections of `shpb reduce --dispersion`.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum DispersionArg {
+    /// No correction.
+    None,
+    /// The authors' six-parameter Bancroft fit for ν = 0.31.
+    Bancroft,
+    /// The exact Pochhammer–Chree first mode for the bars' Poisson's ratio.
+    PochhammerChree,
+}
+
+impl From<DispersionArg> for DispersionCorrection {
+    fn from(d: DispersionArg) -> DispersionCorrection {
+        match d {
+            DispersionArg::None => DispersionCorrection::None,
+            DispersionArg::Bancroft => DispersionCorrection::Bancroft,
+            DispersionArg::PochhammerChree => DispersionCorrection::PochhammerChree,
+        }
+    }
+}
+
+/// The window alignments of `shpb reduce` (`--align`; docs/physics.md §7.6).
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum AlignArg {
+    /// Delays from the gauge distances and c0 (the lab's rule).
+    Geometric,
+    /// Delays from the feet of the reflected and transmitted pulses in the record.
+    Foot,
+    /// Geometric delays shifted (within ±20 µs) to balance front and back forces over the loading.
+    Balance,
+}
+
+impl From<AlignArg> for shpb_core::reduce::Alignment {
+    fn from(a: AlignArg) -> Self {
+        use shpb_core::reduce::Alignment;
+        match a {
+            AlignArg::Geometric => Alignment::Geometric,
+            AlignArg::Foot => Alignment::Foot,
+            AlignArg::Balance => Alignment::Balance,
+        }
+    }
 }
 
 /// The fidelity presets selectable on the command line (`--fidelity`).
@@ -277,8 +321,9 @@ pub enum Command {
     /// displacement, force_front, force_back, force_3wave, strain_rate, equilibrium_ratio,
     /// approach_velocity}.
     Reduce {
-        /// The record (.csv or .h5).
-        record: PathBuf,
+        /// The records (.csv or .h5); several reduce as a batch (see --summary, --report).
+        #[arg(required = true, num_args = 1..)]
+        record: Vec<PathBuf>,
         /// Bar set-up (bars, gauge distances, bridge, gain, polarity): a built-in set-up
         /// (`shpb list`) or a set-up file [default: a run file's own set-up, else `authors`].
         /// For a run file, a set-up that differs from the one it was simulated with is refused.
@@ -290,9 +335,58 @@ pub enum Command {
         /// CSV output.
         #[arg(long)]
         csv: Option<PathBuf>,
-        /// Skip the Bancroft dispersion correction.
-        #[arg(long)]
+        /// Dispersion correction between gauges and faces: the Bancroft fit for ν = 0.31 (the
+        /// authors'), the exact Pochhammer–Chree first mode for the bars' ν, or none.
+        #[arg(long, value_enum, default_value_t = DispersionArg::Bancroft)]
+        dispersion: DispersionArg,
+        /// Deprecated: the same as `--dispersion none`.
+        #[arg(long, conflicts_with = "dispersion")]
         no_dispersion: bool,
+        /// Also apply the Tyas–Pope amplitude factors M1·M2 (exact first mode; needs a
+        /// dispersion correction).
+        #[arg(long)]
+        tyas_pope: bool,
+        /// Length of a cylindrical specimen, m (with --specimen-diameter): also its 1/2/3-wave
+        /// stress, strain, strain rate and true stress/strain (/reduction/cylinder) [default: a
+        /// run file's own cylinder, if it has one].
+        #[arg(long, value_name = "L")]
+        specimen_length: Option<f64>,
+        /// Diameter of a cylindrical specimen, m (with --specimen-length).
+        #[arg(long, value_name = "D")]
+        specimen_diameter: Option<f64>,
+        /// How the reflected and transmitted windows are placed: from the gauge distances, the
+        /// record's pulse feet, or a bounded force-balance search (docs/physics.md §7.6).
+        #[arg(long, value_enum, default_value = "geometric")]
+        align: AlignArg,
+        /// Width of the moving average applied to both records before the reduction, s (0: off);
+        /// the default is what `shpb run` applies to simulated records.
+        #[arg(
+            long,
+            value_name = "SECONDS",
+            default_value = "2e-6",
+            allow_hyphen_values = true
+        )]
+        smooth: f64,
+        /// Incident window start on the record clock, s (overrides the detected foot).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        incident_start: Option<f64>,
+        /// Reflected window start after the incident start, s (overrides --align for it).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        reflected_delay: Option<f64>,
+        /// Transmitted window start after the incident start, s (overrides --align for it).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        transmitted_delay: Option<f64>,
+        /// Window length, s (default: the longest clean window the record holds).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        duration: Option<f64>,
+        /// Batch summary: one CSV row per record (forces, δ at peak, strain rate, equilibrium
+        /// verdict, windows, pulse metrics, warnings).
+        #[arg(long, value_name = "FILE.csv")]
+        summary: Option<PathBuf>,
+        /// Batch report: Markdown with a table of the records and one figure per record
+        /// (FILE-<record>.png beside it).
+        #[arg(long, value_name = "FILE.md")]
+        report: Option<PathBuf>,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -425,16 +519,55 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             bars,
             output,
             csv,
+            dispersion,
             no_dispersion,
+            tyas_pope,
+            align,
+            smooth,
+            incident_start,
+            reflected_delay,
+            transmitted_delay,
+            duration,
+            summary,
+            report,
+            specimen_length,
+            specimen_diameter,
             force,
-        } => cmd::reduce::reduce_command(
-            &record,
-            bars.as_deref(),
-            output.as_deref(),
-            csv.as_deref(),
-            force,
-            no_dispersion,
-        ),
+        } => {
+            let window = shpb_core::reduce::WindowOverride {
+                incident_start_s: incident_start,
+                reflected_delay_s: reflected_delay,
+                transmitted_delay_s: transmitted_delay,
+                duration_s: duration,
+            };
+            cmd::reduce::reduce_command(
+                &record,
+                bars.as_deref(),
+                cmd::reduce::Outputs {
+                    output: output.as_deref(),
+                    csv: csv.as_deref(),
+                    summary: summary.as_deref(),
+                    report: report.as_deref(),
+                    force,
+                },
+                &shpb_study::api::RecordOptions {
+                    dispersion: if no_dispersion {
+                        DispersionCorrection::None
+                    } else {
+                        dispersion.into()
+                    },
+                    tyas_pope,
+                    alignment: align.into(),
+                    smoothing_s: smooth,
+                    window: (window != Default::default()).then_some(window),
+                    cylinder: shpb_study::api::cylinder_geometry(
+                        specimen_length,
+                        specimen_diameter,
+                        ("--specimen-length", "--specimen-diameter"),
+                    )?,
+                },
+            )
+        }
         Command::Strain {
             record,
             bars,

@@ -21,8 +21,10 @@ pub use shpb_core::{
 pub use shpb_input::{
     Error, Result, Validator, csv, error, gauges, kinds, provenance, resources, units,
 };
-pub use shpb_output::{io, plot, study as study_table, writer};
-pub use shpb_study::{bench, convergence, file as study_file, identity as study_identity, sweep};
+pub use shpb_output::{batch, io, plot, study as study_table, writer};
+pub use shpb_study::{
+    api, bench, convergence, file as study_file, identity as study_identity, sweep,
+};
 pub use shpb_validate as validate;
 
 /// The scenes: the validated [`scene::Params`] of the core and the scene-file reader of the input

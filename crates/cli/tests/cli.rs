@@ -998,3 +998,71 @@ fn unknown_bars_is_refused_naming_the_option_and_the_builtin_setups() {
         }
     }
 }
+
+#[test]
+fn reduce_names_the_dispersion_correction_it_used() {
+    let tmp = TempDir::new().unwrap();
+    let raw = format!(
+        "{}/validation/gauge-records/data/2013-05-22_sample1_ss440c.csv",
+        repo()
+    );
+    let json = |args: &[&str]| -> serde_json::Value {
+        let mut all = vec!["--json", "reduce", raw.as_str()];
+        all.extend_from_slice(args);
+        serde_json::from_str(&succeeds(tmp.path(), &all)).unwrap()
+    };
+    let default = json(&[]);
+    assert_eq!(default["dispersion"], "bancroft");
+    assert_eq!(default["tyas_pope"], false);
+    let exact = json(&["--dispersion", "pochhammer-chree", "--tyas-pope"]);
+    assert_eq!(exact["dispersion"], "pochhammer-chree");
+    assert_eq!(exact["tyas_pope"], true);
+    assert_eq!(exact["dispersion_corrected"], true);
+    // The deprecated flag is `--dispersion none`.
+    let off = json(&["--no-dispersion"]);
+    assert_eq!(off["dispersion"], "none");
+    assert_eq!(off, json(&["--dispersion", "none"]));
+    let summary = succeeds(
+        tmp.path(),
+        &["reduce", &raw, "--dispersion", "pochhammer-chree"],
+    );
+    assert!(
+        summary.contains("dispersion correction pochhammer-chree"),
+        "{summary}"
+    );
+    // The two spellings conflict; an unknown name lists the allowed ones; the amplitude factors
+    // need a phase correction.
+    let out = shpb(
+        tmp.path(),
+        &[
+            "reduce",
+            &raw,
+            "--no-dispersion",
+            "--dispersion",
+            "bancroft",
+        ],
+    );
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("--no-dispersion"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = shpb(tmp.path(), &["reduce", &raw, "--dispersion", "love"]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("none") && err.contains("bancroft") && err.contains("pochhammer-chree"),
+        "{err}"
+    );
+    let out = shpb(
+        tmp.path(),
+        &["reduce", &raw, "--dispersion", "none", "--tyas-pope"],
+    );
+    assert_eq!(out.status.code(), Some(BAD_INPUT), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("tyas_pope"),
+        "{}",
+        text(&out.stderr)
+    );
+}

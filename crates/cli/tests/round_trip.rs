@@ -19,7 +19,7 @@ fn reduction_of_simulated_records_recovers_the_true_contact() {
         let out = params.run().unwrap();
         let input = ReductionInput::from_noise_free_gauges(&out).unwrap();
         let options = ReductionOptions {
-            dispersion_correction: false,
+            dispersion: shpb::reduce::DispersionCorrection::None,
             specimen_radii_m: Some((params.pair.sphere1.radius_m, params.pair.sphere2.radius_m)),
             ..Default::default()
         };

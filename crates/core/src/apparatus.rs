@@ -154,7 +154,7 @@ pub enum IncidentEnd {
     Free,
     /// A non-reflecting end.
     Absorbing,
-    /// The two-sphere specimen, then the transmission bar (a full SHPB test).
+    /// The specimen (spheres or a cylinder), then the transmission bar (a full SHPB test).
     Specimen,
 }
 
@@ -172,11 +172,72 @@ pub struct SpecimenSetup {
     pub unloading: crate::contact::Unloading,
 }
 
+/// Fewest cells the chain gives a cylindrical specimen (docs/physics.md §6.9): its lowest
+/// longitudinal mode (half a wavelength over L_s) on ≥ 4 cells, and its Courant number
+/// n c_s Δt/L_s ≥ 0.8, so its ring-up (a few transits L_s/c_s) is resolved in time and space.
+pub const CYLINDER_MIN_CELLS: usize = 4;
+
+/// An elastic cylindrical specimen between the bars (docs/physics.md §6.9): a bar segment of its
+/// own material and diameter, pressed on both bars (or inserts) by compression-only butt joints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CylinderSpecimen {
+    /// Material (E, ν, ρ), as for bars and inserts.
+    pub material: BarMaterial,
+    /// Diameter d_s, m.
+    pub diameter_m: f64,
+    /// Length L_s along the bar axis, m.
+    pub length_m: f64,
+}
+
+impl CylinderSpecimen {
+    /// The specimen as one uniform bar segment.
+    pub fn segment(&self) -> Segment {
+        Segment {
+            length_m: self.length_m,
+            diameter_m: self.diameter_m,
+            material: self.material,
+        }
+    }
+
+    /// Cross-section A_s = π d_s²/4, m².
+    pub fn area_m2(&self) -> f64 {
+        self.segment().area_m2()
+    }
+
+    /// One-way wave transit L_s/c_s, s (c_s = √(E_s/ρ_s), docs/physics.md §6.9).
+    pub fn transit_s(&self) -> f64 {
+        self.length_m / self.material.wave_speed_m_s()
+    }
+
+    /// Cells the chain gives the specimen at time step `dt_s`: ⌊L_s/(c_s Δt)⌋ (Courant ≤ 1, as
+    /// every bar segment, docs/physics.md §6.2).
+    pub fn cells_at(&self, dt_s: f64) -> usize {
+        let s = self.segment();
+        crate::bar::BarSpec {
+            name: "specimen".into(),
+            segments: vec![s],
+            left_end: EndCondition::Free,
+            right_end: EndCondition::Free,
+            dispersion: Dispersion::None,
+        }
+        .cells_for_time_step(dt_s)[0]
+    }
+
+    /// Largest bar cell (Δx = c0 Δt, Courant 1 in bars of speed `bar_wave_speed_m_s`) that gives
+    /// the specimen at least `cells` cells: c0 L_s/(c_s · cells), m.
+    pub fn largest_bar_cell_m(&self, bar_wave_speed_m_s: f64, cells: usize) -> f64 {
+        bar_wave_speed_m_s * self.transit_s() / cells as f64
+    }
+}
+
 /// Options of a bar run (what a `pulse` or `shpb` scene sets).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PulseOptions {
-    /// The specimen, when `end` is `IncidentEnd::Specimen`.
+    /// The sphere specimen, when `end` is `IncidentEnd::Specimen` (None with a cylinder).
     pub specimen: Option<SpecimenSetup>,
+    /// A cylindrical specimen instead of spheres, when `end` is `IncidentEnd::Specimen`
+    /// (docs/physics.md §6.9).
+    pub cylinder: Option<CylinderSpecimen>,
     /// Striker impact velocity, m/s.
     pub striker_velocity_m_s: f64,
     /// Pulse shaper (None: striker on bar).
@@ -301,7 +362,22 @@ impl Apparatus {
                     sphere_masses.push((front, true, sp.spheres.spheres[0].mass_kg));
                     sphere_masses.push((back, false, sp.spheres.spheres[n - 1].mass_kg));
                 }
-                _ => joints.push(Joint::Butt),
+                _ => match &o.cylinder {
+                    // A cylinder is a bar segment of its own between two butt joints, as an
+                    // insert (docs/physics.md §6.9).
+                    Some(c) if end == IncidentEnd::Specimen => {
+                        bodies.push(crate::solver::BodySpec::Bar(BarSpec {
+                            name: "specimen".to_string(),
+                            segments: vec![c.segment()],
+                            left_end: EndCondition::Free,
+                            right_end: EndCondition::Free,
+                            dispersion: Dispersion::None,
+                        }));
+                        joints.push(Joint::Butt);
+                        joints.push(Joint::Butt);
+                    }
+                    _ => joints.push(Joint::Butt),
+                },
             }
             bodies.extend(tail);
             // A sphere on a rigid insert adds to its mass; on a bar, to its end node.
@@ -381,6 +457,7 @@ impl Apparatus {
         })?;
         let setup = self.pulse_chain(&PulseOptions {
             specimen: None,
+            cylinder: None,
             striker_velocity_m_s,
             shaper,
             end: IncidentEnd::Transmission,

@@ -190,7 +190,7 @@ pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
         .fold(0.0, f64::max);
     let digitised = (options.end_time_s * rate).floor();
     let post = digitised * F64 * (DIGITISED_SERIES + 3.0 * gauges);
-    let reduction = if options.specimen.is_some() {
+    let reduction = if options.specimen.is_some() || options.cylinder.is_some() {
         // /reduction: 15 series at most of the window's length (shorter than the record).
         15.0 * digitised
     } else {

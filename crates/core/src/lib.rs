@@ -12,6 +12,7 @@
 pub mod apparatus;
 pub mod bar;
 pub mod contact;
+pub mod dispersion;
 pub mod error;
 pub mod estimate;
 pub mod fidelity;
@@ -21,6 +22,7 @@ pub mod gauge;
 pub mod material;
 pub mod numeric;
 pub mod reduce;
+pub mod reduce_cylinder;
 pub mod run;
 pub mod scene;
 pub mod shaper;

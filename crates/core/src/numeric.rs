@@ -148,6 +148,28 @@ pub fn least_squares(columns: &[&[f64]], y: &[f64]) -> Option<Vec<f64>> {
 /// by a raised-cosine bridge from its last value back to its first over a padding at least as
 /// long as the segment (power-of-two FFT length), so no jump is created at the wrap.
 pub fn phase_shift(x: &[f64], dt: f64, delay: impl Fn(f64) -> f64) -> Vec<f64> {
+    spectral_filter(x, dt, |bin| (delay(bin.frequency_hz), 1.0))
+}
+
+/// One bin of the FFT [`spectral_filter`] applies its factor to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FftBin {
+    /// |k|, from 0 to m/2 (negative frequencies share their positive twin's bin).
+    pub index: usize,
+    /// FFT length m.
+    pub length: usize,
+    /// |f| = |k|/(m dt), Hz.
+    pub frequency_hz: f64,
+}
+
+/// [`phase_shift`] with a real gain as well: the component of bin b is multiplied by
+/// `gain · exp(−2πi f delay)` where `(delay, gain) = factor(b)` (docs/physics.md §7.9, the
+/// Tyas–Pope amplitude factors). With gain 1 it is exactly [`phase_shift`].
+pub fn spectral_filter(
+    x: &[f64],
+    dt: f64,
+    mut factor: impl FnMut(FftBin) -> (f64, f64),
+) -> Vec<f64> {
     let n = x.len();
     if n == 0 {
         return Vec::new();
@@ -172,12 +194,17 @@ pub fn phase_shift(x: &[f64], dt: f64, delay: impl Fn(f64) -> f64) -> Vec<f64> {
             k as f64 - m as f64
         };
         let f = kk * df;
-        let phase = -2.0 * std::f64::consts::PI * f * delay(f.abs());
+        let (delay, gain) = factor(FftBin {
+            index: kk.abs() as usize,
+            length: m,
+            frequency_hz: f.abs(),
+        });
+        let phase = -2.0 * std::f64::consts::PI * f * delay;
         let factor = if 2 * k == m {
             // Nyquist bin: keep the signal real.
-            Complex::new(phase.cos(), 0.0)
+            Complex::new(gain * phase.cos(), 0.0)
         } else {
-            Complex::from_polar(1.0, phase)
+            Complex::from_polar(gain, phase)
         };
         *z *= factor;
     }

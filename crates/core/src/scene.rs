@@ -528,19 +528,33 @@ fn run_pulse(
     }
     energy.push(("total".into(), total));
     let mut warnings = Vec::new();
-    let reduction = match &options.specimen {
-        Some(spec) => match reduce_simulated_records(apparatus, options, spec, &t, &gauges) {
-            Ok(red) => {
-                summary.extend(reduced_summary(&red));
-                warnings.extend(red.warnings.iter().map(|w| format!("reduction: {w}")));
-                Some(red)
+    // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.8).
+    let radii = options
+        .specimen
+        .as_ref()
+        .map(|spec| specimen_radii_m(&spec.spheres));
+    let reduction = match (radii, &options.cylinder) {
+        (Some(_), _) | (None, Some(_)) => {
+            match reduce_simulated_records(apparatus, options, radii, &t, &gauges) {
+                Ok(red) => {
+                    summary.extend(reduced_summary(&red));
+                    if let Some(c) = &options.cylinder {
+                        summary.push(item("specimen_cells", c.cells_at(chain.dt_s) as f64, "1"));
+                        match reduced_cylinder_summary(apparatus, c, &red) {
+                            Ok(items) => summary.extend(items),
+                            Err(e) => warnings.push(format!("cylinder reduction failed: {e}")),
+                        }
+                    }
+                    warnings.extend(red.warnings.iter().map(|w| format!("reduction: {w}")));
+                    Some(red)
+                }
+                Err(e) => {
+                    warnings.push(format!("reduction of the simulated records failed: {e}"));
+                    None
+                }
             }
-            Err(e) => {
-                warnings.push(format!("reduction of the simulated records failed: {e}"));
-                None
-            }
-        },
-        None => None,
+        }
+        (None, None) => None,
     };
     Ok(RunOutput {
         contact: r.contact,
@@ -642,17 +656,12 @@ fn run_free_chain(
     Ok(out)
 }
 
-/// Moving-average width applied to simulated records before their reduction, s: 2 µs (20
-/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
-/// < 0.02 % of its peak.
-pub const SIMULATED_RECORD_SMOOTHING_S: f64 = 2e-6;
-
 /// The lab's reduction of a simulated test: the digitised voltages read back through each
 /// channel's bridge (as the lab gets them), dispersion correction only when the bars disperse.
 fn reduce_simulated_records(
     apparatus: &Apparatus,
     options: &PulseOptions,
-    spec: &crate::apparatus::SpecimenSetup,
+    specimen_radii: Option<(f64, f64)>,
     time_s: &[f64],
     gauges: &[crate::run::GaugeTrace],
 ) -> Result<crate::reduce::Reduction> {
@@ -674,9 +683,13 @@ fn reduce_simulated_records(
         transmission_strain: strain("transmission")?,
     };
     let reduction_options = crate::reduce::ReductionOptions {
-        dispersion_correction: options.dispersion != Dispersion::None,
-        specimen_radii_m: Some(specimen_radii_m(&spec.spheres)),
-        smoothing_window_s: SIMULATED_RECORD_SMOOTHING_S,
+        dispersion: if options.dispersion == Dispersion::None {
+            crate::reduce::DispersionCorrection::None
+        } else {
+            crate::reduce::DispersionCorrection::Bancroft
+        },
+        specimen_radii_m: specimen_radii,
+        smoothing_window_s: crate::reduce::DEFAULT_SMOOTHING_S,
         ..Default::default()
     };
     crate::reduce::reduce(
@@ -692,6 +705,41 @@ fn reduce_simulated_records(
 pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
     let r = &chain.spheres;
     (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
+}
+
+/// Summary items of a simulated cylinder's reduction (docs/physics.md §7.8): 1-wave peak
+/// stress, strain at peak, mean strain rate, and the modulus fitted to the 3-wave curve on
+/// 30–90 % of its peak (`reduce_cylinder::MODULUS_WINDOW`).
+fn reduced_cylinder_summary(
+    apparatus: &Apparatus,
+    c: &crate::apparatus::CylinderSpecimen,
+    red: &crate::reduce::Reduction,
+) -> Result<Vec<SummaryItem>> {
+    use crate::reduce_cylinder::{CylinderGeometry, loading_modulus, reduce_cylinder};
+    let g = CylinderGeometry {
+        length_m: c.length_m,
+        diameter_m: c.diameter_m,
+    };
+    let setup = crate::reduce::ReductionSetup::from_apparatus(apparatus)?;
+    let cyl = reduce_cylinder(red, &setup, &g)?;
+    let mut v = vec![
+        item("reduced_peak_stress", cyl.peak_stress_pa, "Pa"),
+        item("reduced_strain_at_peak_stress", cyl.strain_at_peak, "1"),
+        item(
+            "reduced_mean_strain_rate",
+            cyl.mean_strain_rate_per_s,
+            "1/s",
+        ),
+    ];
+    if let Ok(fit) = loading_modulus(
+        &cyl.three_wave,
+        &red.equilibrium_ratio,
+        crate::reduce_cylinder::MODULUS_WINDOW.0,
+        crate::reduce_cylinder::MODULUS_WINDOW.1,
+    ) {
+        v.push(item("reduced_loading_modulus", fit.modulus_pa, "Pa"));
+    }
+    Ok(v)
 }
 
 /// Summary items of the reduction of a simulated test (`reduced_*`).

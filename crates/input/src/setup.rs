@@ -97,6 +97,19 @@ struct ApparatusToml {
     shaper: Option<ShaperToml>,
 }
 
+/// Validates a bar material given as a TOML value (a cylindrical specimen's `material` table),
+/// with the keys and ranges of a set-up's `[material]`; `v` is the table holding `material`.
+pub(crate) fn bar_material_value(value: &toml::Value, v: &Validator) -> Result<BarMaterial> {
+    let m: MaterialToml = value.clone().try_into().map_err(|e: toml::de::Error| {
+        v.error(
+            "material",
+            e.message().trim().to_string(),
+            "a table of density_kg_m3, youngs_modulus_pa and poisson_ratio",
+        )
+    })?;
+    bar_material(&m, &v.table("material"))
+}
+
 /// Validates a bar material table (`[material]`, an insert's `material`).
 fn bar_material(m: &MaterialToml, mv: &Validator) -> Result<BarMaterial> {
     Ok(BarMaterial {

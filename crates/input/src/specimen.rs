@@ -46,13 +46,23 @@ pub struct SpecimenSpec {
     pub sphere2: Option<SphereSpec>,
     /// Number of identical spheres of a chain (2 or more).
     pub count: Option<i64>,
-    /// Material of the `count` spheres: a built-in name or a material `.toml`.
-    pub material: Option<String>,
+    /// Material of the `count` spheres (a built-in name or a material `.toml`), or of a
+    /// cylinder: such a name (its E, ν, ρ are used), or a table `{ density_kg_m3,
+    /// youngs_modulus_pa, poisson_ratio }` as a set-up's `[material]` or an insert's `material`.
+    pub material: Option<toml::Value>,
+    /// `"spheres"` (default) or `"cylinder"` (`shpb` scenes: an elastic cylinder between the
+    /// bars, docs/physics.md §6.9).
+    pub shape: Option<String>,
+    /// Length of a cylinder along the bar axis, m.
+    pub length_m: Option<f64>,
     /// Diameter of the `count` spheres, m.
     pub diameter_m: Option<f64>,
     /// One table per sphere of a chain, sphere 1 first.
     pub sphere: Option<Vec<SphereSpec>>,
 }
+
+/// What a cylindrical specimen is given as, for messages.
+pub const CYLINDER_FORM: &str = "shape = \"cylinder\" with length_m and diameter_m (each greater than 0, at most 0.1 m) and material (a built-in name such as \"al2017\", a material .toml, or a table { density_kg_m3, youngs_modulus_pa, poisson_ratio })";
 
 /// Most spheres a chain may have.
 pub const MAX_CHAIN_SPHERES: i64 = 100_000;
@@ -127,6 +137,108 @@ pub fn resolve_pair(
 }
 
 impl SpecimenSpec {
+    /// Whether the table asks for a cylinder (`shape = "cylinder"`); an unknown `shape` is an
+    /// error naming the allowed ones.
+    pub fn is_cylinder(&self, v: &Validator) -> Result<bool> {
+        match self.shape.as_deref() {
+            None | Some("spheres") => Ok(false),
+            Some("cylinder") => Ok(true),
+            Some(other) => Err(v.error(
+                "shape",
+                format!("unknown shape `{other}`"),
+                "spheres (default), cylinder",
+            )),
+        }
+    }
+
+    /// Refuses the cylinder's keys in a sphere specimen.
+    fn refuse_cylinder_keys(&self, v: &Validator) -> Result<()> {
+        if self.is_cylinder(v)? {
+            return Err(v.error(
+                "shape",
+                "a cylindrical specimen needs kind = \"shpb\"",
+                "shape = \"spheres\" (or no shape) in this scene kind",
+            ));
+        }
+        if self.length_m.is_some() {
+            return Err(v.error(
+                "length_m",
+                "`length_m` belongs to a cylinder",
+                "shape = \"cylinder\" (kind = \"shpb\") for a cylindrical specimen",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The sphere material's name or file, if given (a table is a cylinder's).
+    fn material_name(&self, v: &Validator) -> Result<Option<String>> {
+        match &self.material {
+            None => Ok(None),
+            Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+            Some(_) => Err(v.error(
+                "material",
+                "a sphere's material is a name, not a table",
+                "a built-in material name or a material .toml file",
+            )),
+        }
+    }
+
+    /// Validates a cylindrical specimen (`shape = "cylinder"`, docs/physics.md §6.9).
+    pub fn build_cylinder(
+        &self,
+        base_dir: &Path,
+        v: &Validator,
+    ) -> Result<shpb_core::apparatus::CylinderSpecimen> {
+        for (key, given) in [
+            ("pair", self.pair.is_some()),
+            ("sphere1", self.sphere1.is_some()),
+            ("sphere2", self.sphere2.is_some()),
+            ("count", self.count.is_some()),
+            ("sphere", self.sphere.is_some()),
+        ] {
+            if given {
+                return Err(v.error(
+                    key,
+                    format!("`{key}` describes spheres, not a cylinder"),
+                    CYLINDER_FORM,
+                ));
+            }
+        }
+        let (Some(length), Some(diameter), Some(material)) =
+            (self.length_m, self.diameter_m, &self.material)
+        else {
+            let key = match (self.length_m, self.diameter_m) {
+                (None, _) => "length_m",
+                (_, None) => "diameter_m",
+                _ => "material",
+            };
+            return Err(v.error(key, "missing", CYLINDER_FORM));
+        };
+        let material = match material {
+            toml::Value::String(name) => {
+                let m = Material::resolve(name, base_dir, v, "material")?;
+                shpb_core::bar::BarMaterial {
+                    density_kg_m3: m.density_kg_m3,
+                    youngs_modulus_pa: m.youngs_modulus_pa,
+                    poisson_ratio: m.poisson_ratio,
+                }
+            }
+            table @ toml::Value::Table(_) => crate::setup::bar_material_value(table, v)?,
+            other => {
+                return Err(v.error(
+                    "material",
+                    format!("a value of type {} is not a material", other.type_str()),
+                    CYLINDER_FORM,
+                ));
+            }
+        };
+        Ok(shpb_core::apparatus::CylinderSpecimen {
+            material,
+            length_m: v.positive("length_m", length, 0.1, "m")?,
+            diameter_m: v.positive("diameter_m", diameter, 0.1, "m")?,
+        })
+    }
+
     /// Whether the table gives a chain (`count`, `material`, `diameter_m` or `sphere`) rather
     /// than a pair.
     pub fn is_chain_form(&self) -> bool {
@@ -138,6 +250,7 @@ impl SpecimenSpec {
 
     /// Validates the specimen of a chain (`chain` and `shpb` scenes): any of [`CHAIN_FORMS`].
     pub fn build_chain(&self, base_dir: &Path, v: &Validator) -> Result<SphereChain> {
+        self.refuse_cylinder_keys(v)?;
         if !self.is_chain_form() {
             return self.build(base_dir, v).map(|p| SphereChain::from_pair(&p));
         }
@@ -168,7 +281,7 @@ impl SpecimenSpec {
                         format!("2 to {MAX_CHAIN_SPHERES}"),
                     ));
                 }
-                let (Some(material), Some(d)) = (&self.material, self.diameter_m) else {
+                let (Some(material), Some(d)) = (self.material_name(v)?, self.diameter_m) else {
                     return Err(v.error(
                         if self.material.is_none() { "material" } else { "diameter_m" },
                         "missing: `count` spheres need a material and a diameter_m",
@@ -176,7 +289,7 @@ impl SpecimenSpec {
                     ));
                 };
                 let sphere = SphereSpec {
-                    material: material.clone(),
+                    material,
                     diameter_m: Some(d),
                     radius_m: None,
                     mass_kg: None,
@@ -224,6 +337,7 @@ impl SpecimenSpec {
 
     /// Validates the specimen table of a scene.
     pub fn build(&self, base_dir: &Path, v: &Validator) -> Result<SpherePair> {
+        self.refuse_cylinder_keys(v)?;
         if self.is_chain_form() {
             return Err(v.error(
                 "count",

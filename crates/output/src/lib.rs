@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod batch;
 pub mod h5;
 pub mod io;
 pub mod plot;

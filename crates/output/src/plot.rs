@@ -318,6 +318,26 @@ pub fn test_figure(
     })
 }
 
+/// A grid of x–y panels (`columns` across, row by row), 800 × 600 pixels each, in one PNG.
+pub fn panels_figure(
+    path: &Path,
+    force: bool,
+    columns: usize,
+    panels: &[(Axes, Vec<Curve>)],
+) -> Result<()> {
+    let columns = columns.max(1);
+    let rows = panels.len().div_ceil(columns).max(1);
+    write_atomically(path, force, |tmp| {
+        let root =
+            BitMapBackend::new(tmp, (800 * columns as u32, 600 * rows as u32)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        for (area, (axes, curves)) in root.split_evenly((rows, columns)).iter().zip(panels) {
+            draw_xy(area, path, axes, curves)?;
+        }
+        root.present().map_err(perr(path))
+    })
+}
+
 /// Sequential colour (white → dark blue) of `v` within [lo, hi].
 fn level_colour(v: f64, lo: f64, hi: f64) -> RGBColor {
     let a = if hi > lo {

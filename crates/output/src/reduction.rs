@@ -4,6 +4,7 @@
 use crate::atomic::{write_atomically, write_text_atomically};
 use crate::h5::{h5err, string_attr, write_dataset};
 use shpb_core::reduce::{Reduction, ReductionInput};
+use shpb_core::reduce_cylinder::{CylinderReduction, WaveAnalysis};
 use shpb_input::{Error, Result};
 use std::path::Path;
 
@@ -111,6 +112,37 @@ pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
     if let Some(m) = r.measured_reflected_delay_s {
         v.push(("measured_reflected_delay", m, "s"));
     }
+    let a = &r.alignment;
+    v.push((
+        "geometric_reflected_delay",
+        a.geometric_reflected_delay_s,
+        "s",
+    ));
+    v.push((
+        "geometric_transmitted_delay",
+        a.geometric_transmitted_delay_s,
+        "s",
+    ));
+    if let Some(m) = a.measured_transmitted_delay_s {
+        v.push(("measured_transmitted_delay", m, "s"));
+    }
+    if let Some((sr, st)) = a.balance_shift_s {
+        v.push(("balance_shift_reflected", sr, "s"));
+        v.push(("balance_shift_transmitted", st, "s"));
+    }
+    let q = &r.quality;
+    v.extend([
+        ("equilibrium_mean_loading", q.equilibrium_mean, "1"),
+        ("equilibrium_max_loading", q.equilibrium_max, "1"),
+        ("loading_start", q.loading_span_s.0, "s"),
+        ("loading_end", q.loading_span_s.1, "s"),
+        ("incident_duration", q.incident_duration_s, "s"),
+        ("pulse_overlap", q.pulse_overlap_s, "s"),
+        ("noise_incident_strain", q.noise_strain.0, "1"),
+        ("noise_transmission_strain", q.noise_strain.1, "1"),
+        ("signal_to_noise_incident", q.signal_to_noise.0, "1"),
+        ("signal_to_noise_transmission", q.signal_to_noise.1, "1"),
+    ]);
     v
 }
 
@@ -118,6 +150,58 @@ pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
 /// command line), `/reduction/<series>` with `units` attributes, `/summary` scalar attributes
 /// with a `units` list.
 pub fn write_reduction_hdf5(path: &Path, force: bool, scene: &str, r: &Reduction) -> Result<()> {
+    write_reduction_hdf5_with(path, force, scene, r, None)
+}
+
+/// The analyses of a cylinder's reduction: (group name, analysis) for `/reduction/cylinder`.
+pub fn cylinder_analyses(c: &CylinderReduction) -> [(&'static str, &WaveAnalysis); 3] {
+    [
+        ("one_wave", &c.one_wave),
+        ("two_wave", &c.two_wave),
+        ("three_wave", &c.three_wave),
+    ]
+}
+
+/// The series of one analysis: (name, data, units, CSV column suffix) (docs/physics.md §7.8).
+pub fn analysis_columns(
+    a: &WaveAnalysis,
+) -> [(&'static str, &[f64], &'static str, &'static str); 5] {
+    [
+        ("stress", &a.stress_pa, "Pa", "stress_Pa"),
+        ("strain", &a.strain, "1", "strain"),
+        (
+            "strain_rate",
+            &a.strain_rate_per_s,
+            "1/s",
+            "strain_rate_per_s",
+        ),
+        ("true_stress", &a.true_stress_pa, "Pa", "true_stress_Pa"),
+        ("true_strain", &a.true_strain, "1", "true_strain"),
+    ]
+}
+
+/// Scalar results of a cylinder's reduction, as `/summary` attributes: (key, value, unit).
+pub fn cylinder_summary_items(c: &CylinderReduction) -> Vec<(&'static str, f64, &'static str)> {
+    vec![
+        ("specimen_length", c.geometry.length_m, "m"),
+        ("specimen_diameter", c.geometry.diameter_m, "m"),
+        ("peak_stress", c.peak_stress_pa, "Pa"),
+        ("peak_stress_time", c.peak_time_s, "s"),
+        ("strain_at_peak_stress", c.strain_at_peak, "1"),
+        ("mean_strain_rate", c.mean_strain_rate_per_s, "1/s"),
+    ]
+}
+
+/// [`write_reduction_hdf5`] with a cylinder's analyses under `/reduction/cylinder/<analysis>/
+/// {stress, strain, strain_rate, true_stress, true_strain}` (`units` attributes; the group has
+/// `length_m`, `diameter_m` and `sign` attributes) and its scalars in `/summary`.
+pub fn write_reduction_hdf5_with(
+    path: &Path,
+    force: bool,
+    scene: &str,
+    r: &Reduction,
+    cylinder: Option<&CylinderReduction>,
+) -> Result<()> {
     write_atomically(path, force, |tmp| {
         let f = hdf5::File::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
@@ -126,8 +210,34 @@ pub fn write_reduction_hdf5(path: &Path, force: bool, scene: &str, r: &Reduction
         for (name, data, units, _) in reduction_columns(r) {
             write_dataset(&g, name, data, units, path)?;
         }
+        let mut items = summary_items(r);
+        if let Some(c) = cylinder {
+            let cg = g.create_group("cylinder").map_err(h5err(path))?;
+            for (key, value) in [
+                ("length_m", c.geometry.length_m),
+                ("diameter_m", c.geometry.diameter_m),
+            ] {
+                cg.new_attr::<f64>()
+                    .shape(())
+                    .create(key)
+                    .and_then(|a| a.write_scalar(&value))
+                    .map_err(h5err(path))?;
+            }
+            string_attr(
+                &cg,
+                "sign",
+                "compression positive (stress, strain, strain rate); docs/physics.md §7.8",
+                path,
+            )?;
+            for (group, a) in cylinder_analyses(c) {
+                let ag = cg.create_group(group).map_err(h5err(path))?;
+                for (name, data, units, _) in analysis_columns(a) {
+                    write_dataset(&ag, name, data, units, path)?;
+                }
+            }
+            items.extend(cylinder_summary_items(c));
+        }
         let s = f.create_group("summary").map_err(h5err(path))?;
-        let items = summary_items(r);
         for (key, value, _) in &items {
             s.new_attr::<f64>()
                 .shape(())
@@ -142,14 +252,41 @@ pub fn write_reduction_hdf5(path: &Path, force: bool, scene: &str, r: &Reduction
             .join(", ");
         string_attr(&s, "units", &units, path)?;
         string_attr(&s, "warnings", &r.warnings.join("\n"), path)?;
+        string_attr(&s, "alignment", r.alignment.strategy.name(), path)?;
+        string_attr(&s, "equilibrium_verdict", r.quality.verdict.name(), path)?;
         f.close().map_err(h5err(path))
     })
 }
 
 /// Writes the reduction series as CSV (one header line, units in the column names).
 pub fn write_reduction_csv(path: &Path, force: bool, r: &Reduction) -> Result<()> {
-    let cols = reduction_columns(r);
-    let mut text = cols.iter().map(|c| c.3).collect::<Vec<_>>().join(",");
+    write_reduction_csv_with(path, force, r, None)
+}
+
+/// [`write_reduction_csv`] with a cylinder's columns after the reduction's:
+/// `<analysis>_<series>` (e.g. `one_wave_stress_Pa`, `three_wave_true_strain`).
+pub fn write_reduction_csv_with(
+    path: &Path,
+    force: bool,
+    r: &Reduction,
+    cylinder: Option<&CylinderReduction>,
+) -> Result<()> {
+    let mut cols: Vec<(String, &[f64])> = reduction_columns(r)
+        .into_iter()
+        .map(|c| (c.3.to_string(), c.1))
+        .collect();
+    if let Some(c) = cylinder {
+        for (group, a) in cylinder_analyses(c) {
+            for (_, data, _, column) in analysis_columns(a) {
+                cols.push((format!("{group}_{column}"), data));
+            }
+        }
+    }
+    let mut text = cols
+        .iter()
+        .map(|c| c.0.as_str())
+        .collect::<Vec<_>>()
+        .join(",");
     text.push('\n');
     for i in 0..r.time_s.len() {
         let row: Vec<String> = cols.iter().map(|c| format!("{:e}", c.1[i])).collect();

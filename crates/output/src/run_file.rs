@@ -100,6 +100,21 @@ pub fn reduction_datasets(r: &Reduction) -> Vec<Dataset<'_>> {
         .collect()
 }
 
+/// The `/reduction/cylinder/<analysis>/<series>` datasets of a cylinder's reduction (as
+/// `shpb reduce --specimen-length --specimen-diameter -o` writes them; docs/physics.md §7.8).
+pub fn cylinder_datasets(c: &shpb_core::reduce_cylinder::CylinderReduction) -> Vec<Dataset<'_>> {
+    crate::reduction::cylinder_analyses(c)
+        .into_iter()
+        .flat_map(|(group, a)| {
+            crate::reduction::analysis_columns(a)
+                .into_iter()
+                .map(move |(name, data, units, _)| {
+                    one_d(format!("reduction/cylinder/{group}/{name}"), data, units)
+                })
+        })
+        .collect()
+}
+
 /// A run file (of `shpb run -o`) or reduction file (of `shpb reduce -o`) read back.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RunFile {

@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
-use shpb_core::reduce::Reduction;
+use shpb_core::reduce::{DispersionCorrection, Reduction};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::Params;
 use shpb_input::Error;
@@ -193,6 +193,8 @@ enum Source {
     Reduced {
         scene: String,
         reduction: Box<Reduction>,
+        /// A cylinder's 1/2/3-wave curves, when its geometry was given.
+        cylinder: Option<Box<shpb_core::reduce_cylinder::CylinderReduction>>,
     },
     /// A run or reduction file read back.
     Loaded { path: PathBuf, file: Box<RunFile> },
@@ -208,8 +210,16 @@ impl RunData {
     fn datasets(&self) -> Vec<Dataset<'_>> {
         let mut v = match &self.source {
             Source::Simulated { out, .. } => shpb_output::run_file::run_datasets(out),
-            Source::Reduced { reduction, .. } => {
-                shpb_output::run_file::reduction_datasets(reduction)
+            Source::Reduced {
+                reduction,
+                cylinder,
+                ..
+            } => {
+                let mut v = shpb_output::run_file::reduction_datasets(reduction);
+                if let Some(c) = cylinder {
+                    v.extend(shpb_output::run_file::cylinder_datasets(c));
+                }
+                v
             }
             Source::Loaded { file, .. } => file
                 .datasets
@@ -247,8 +257,17 @@ impl RunData {
                 .iter()
                 .map(|i| (i.key.clone(), i.value, i.unit.to_string()))
                 .collect(),
-            Source::Reduced { reduction, .. } => shpb_output::reduction::summary_items(reduction)
+            Source::Reduced {
+                reduction,
+                cylinder,
+                ..
+            } => shpb_output::reduction::summary_items(reduction)
                 .into_iter()
+                .chain(
+                    cylinder
+                        .iter()
+                        .flat_map(|c| shpb_output::reduction::cylinder_summary_items(c)),
+                )
                 .map(|(k, v, u)| (k.to_string(), v, u.to_string()))
                 .collect(),
             Source::Loaded { file, .. } => file.summary.clone(),
@@ -343,9 +362,17 @@ impl RunData {
                     }
                     .write_run(&path, force, params, out)
                 }
-                Source::Reduced { scene, reduction } => {
-                    shpb_output::reduction::write_reduction_hdf5(&path, force, scene, reduction)
-                }
+                Source::Reduced {
+                    scene,
+                    reduction,
+                    cylinder,
+                } => shpb_output::reduction::write_reduction_hdf5_with(
+                    &path,
+                    force,
+                    scene,
+                    reduction,
+                    cylinder.as_deref(),
+                ),
                 Source::Loaded { path: source, .. } => {
                     check_not_input(&path, "path", std::slice::from_ref(source))?;
                     shpb_output::atomic::write_atomically(&path, force, |tmp| {
@@ -471,25 +498,83 @@ fn curve<'py>(
     ))
 }
 
-/// The lab's reduction of a raw record or run file (`shpb reduce`).
+/// The lab's reduction of a raw record or run file (`shpb reduce`): `dispersion` is `none`,
+/// `bancroft` or `pochhammer-chree` (`--dispersion`), `tyas_pope` adds the Tyas–Pope factors,
+/// `align` is `geometric`, `foot` or `balance` (`--align`), `smooth` the moving-average width in
+/// s (`--smooth`); with a cylinder's length and diameter (m, both or neither) also its 1/2/3-wave
+/// curves (docs/physics.md §7.6–7.9).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = true))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None))]
+#[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
     record: PathBuf,
     bars: Option<PathBuf>,
-    dispersion: bool,
+    dispersion: String,
+    tyas_pope: bool,
+    align: String,
+    smooth: f64,
+    specimen_length_m: Option<f64>,
+    specimen_diameter_m: Option<f64>,
 ) -> PyResult<RunData> {
+    let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
+        return Err(input_error(
+            "dispersion",
+            format!("unknown dispersion correction `{dispersion}`"),
+            DispersionCorrection::ALL
+                .iter()
+                .map(|d| d.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ));
+    };
+    let Some(alignment) = shpb_core::reduce::Alignment::from_name(&align) else {
+        return Err(input_error(
+            "align",
+            format!("unknown alignment `{align}`"),
+            shpb_core::reduce::Alignment::ALL
+                .iter()
+                .map(|a| a.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ));
+    };
     let (reduced, scene) = detached(py, || {
-        let r = api::reduce_record(&record, bars.as_deref(), !dispersion)?;
+        let geometry = api::cylinder_geometry(
+            specimen_length_m,
+            specimen_diameter_m,
+            ("specimen_length_m", "specimen_diameter_m"),
+        )?;
+        let choices = api::RecordOptions {
+            dispersion: correction,
+            tyas_pope,
+            alignment,
+            smoothing_s: smooth,
+            window: None,
+            cylinder: geometry,
+        };
+        let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;
         let mut scene = format!(
             "shpb reduce {} --bars {}",
             record.display(),
             bars.as_deref()
                 .map_or(r.apparatus.source.clone(), |b| b.display().to_string())
         );
-        if !dispersion {
-            scene.push_str(" --no-dispersion");
+        if correction != DispersionCorrection::Bancroft {
+            scene.push_str(&format!(" --dispersion {}", correction.name()));
+        }
+        if tyas_pope {
+            scene.push_str(" --tyas-pope");
+        }
+        scene.push_str(&format!(
+            " --align {} --smooth {smooth:e}",
+            alignment.name()
+        ));
+        if let Some(g) = &geometry {
+            scene.push_str(&format!(
+                " --specimen-length {} --specimen-diameter {}",
+                g.length_m, g.diameter_m
+            ));
         }
         Ok((r, scene))
     })?;
@@ -497,6 +582,7 @@ fn reduce(
         source: Source::Reduced {
             scene,
             reduction: Box::new(reduced.reduction),
+            cylinder: reduced.cylinder.map(Box::new),
         },
     })
 }

@@ -239,17 +239,148 @@ pub struct Reduced {
     pub apparatus: Apparatus,
     /// Whether the record was a run file's gauge strains (else raw gauge voltages).
     pub hdf5_input: bool,
+    /// A cylindrical specimen's 1/2/3-wave stress and strain, when its geometry was given
+    /// (docs/physics.md §7.8).
+    pub cylinder: Option<shpb_core::reduce_cylinder::CylinderReduction>,
+}
+
+/// The cylinder of `shpb reduce --specimen-length L --specimen-diameter D` (both or neither;
+/// `keys` name the two options in messages): each greater than 0, at most 1 m.
+pub fn cylinder_geometry(
+    length_m: Option<f64>,
+    diameter_m: Option<f64>,
+    keys: (&str, &str),
+) -> Result<Option<shpb_core::reduce_cylinder::CylinderGeometry>> {
+    let (length_m, diameter_m) = match (length_m, diameter_m) {
+        (None, None) => return Ok(None),
+        (Some(l), Some(d)) => (l, d),
+        (l, _) => {
+            let (given, missing) = if l.is_some() {
+                (keys.0, keys.1)
+            } else {
+                (keys.1, keys.0)
+            };
+            return Err(input_err(
+                missing,
+                format!("missing: {given} is given"),
+                format!(
+                    "both {} and {} (a cylinder's length and diameter, m), or neither",
+                    keys.0, keys.1
+                ),
+            ));
+        }
+    };
+    for (key, v) in [(keys.0, length_m), (keys.1, diameter_m)] {
+        if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+            return Err(input_err(
+                key,
+                format!("{v} m is out of range"),
+                "greater than 0, at most 1 (m)",
+            ));
+        }
+    }
+    Ok(Some(shpb_core::reduce_cylinder::CylinderGeometry {
+        length_m,
+        diameter_m,
+    }))
 }
 
 /// `shpb reduce`: reduces a raw record (the authors' CSV) or a run file of `shpb run`
 /// (recognised by its signature, reduced with its own set-up and spheres) with the set-up
 /// `bars_flag` (default [`DEFAULT_BARS`]; for a run file, a set-up that differs from the run's
-/// is refused).
+/// is refused); with `cylinder`, also that specimen's 1/2/3-wave stress and strain
+/// (`shpb_core::reduce_cylinder`) — for a run file of a cylinder, its own cylinder by default.
 pub fn reduce_record(
     record: &Path,
     bars_flag: Option<&Path>,
-    no_dispersion: bool,
+    dispersion: shpb_core::reduce::DispersionCorrection,
+    tyas_pope: bool,
+    cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
 ) -> Result<Reduced> {
+    reduce_record_with(
+        record,
+        bars_flag,
+        &RecordOptions {
+            dispersion,
+            tyas_pope,
+            cylinder,
+            ..RecordOptions::default()
+        },
+    )
+}
+
+/// The choices of `shpb reduce` beyond the record and set-up (its flags; docs/physics.md §7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordOptions {
+    /// Dispersion correction (`--dispersion`, default Bancroft; `--no-dispersion` is `none`).
+    pub dispersion: shpb_core::reduce::DispersionCorrection,
+    /// Apply the Tyas–Pope amplitude factors (`--tyas-pope`).
+    pub tyas_pope: bool,
+    /// Window alignment (`--align`, default geometric).
+    pub alignment: shpb_core::reduce::Alignment,
+    /// Moving-average width applied to both channels, s (`--smooth`, default
+    /// [`shpb_core::reduce::DEFAULT_SMOOTHING_S`], as `shpb run` smooths simulated records).
+    pub smoothing_s: f64,
+    /// Manual windows (`--incident-start`, `--reflected-delay`, `--transmitted-delay`,
+    /// `--duration`).
+    pub window: Option<shpb_core::reduce::WindowOverride>,
+    /// A cylindrical specimen's geometry (`--specimen-length`, `--specimen-diameter`; default: a
+    /// run file's own cylinder, if it has one).
+    pub cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+}
+
+impl Default for RecordOptions {
+    fn default() -> Self {
+        RecordOptions {
+            dispersion: shpb_core::reduce::DispersionCorrection::Bancroft,
+            tyas_pope: false,
+            alignment: shpb_core::reduce::Alignment::Geometric,
+            smoothing_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+            window: None,
+            cylinder: None,
+        }
+    }
+}
+
+/// [`reduce_record`] with every choice of `shpb reduce` ([`RecordOptions`]).
+pub fn reduce_record_with(
+    record: &Path,
+    bars_flag: Option<&Path>,
+    choices: &RecordOptions,
+) -> Result<Reduced> {
+    if !(choices.smoothing_s.is_finite() && choices.smoothing_s >= 0.0) {
+        return Err(input_err(
+            "--smooth",
+            format!("{} s is out of range", choices.smoothing_s),
+            "0 (off) or a positive width in seconds, e.g. 2e-6",
+        ));
+    }
+    if let Some(w) = choices.window {
+        for (flag, v) in [
+            ("--reflected-delay", w.reflected_delay_s),
+            ("--transmitted-delay", w.transmitted_delay_s),
+            ("--duration", w.duration_s),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && v > 0.0)
+            {
+                return Err(input_err(
+                    flag,
+                    format!("{v} s is out of range"),
+                    "a positive number of seconds",
+                ));
+            }
+        }
+        if let Some(v) = w.incident_start_s
+            && !v.is_finite()
+        {
+            return Err(input_err(
+                "--incident-start",
+                format!("{v} s"),
+                "a finite time on the record clock, s",
+            ));
+        }
+    }
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
     if !record.is_file() {
@@ -261,8 +392,8 @@ pub fn reduce_record(
     }
     let hdf5_input = shpb_output::reduction::is_hdf5(record)?;
     let run = if hdf5_input { run_setup(record)? } else { None };
-    let (apparatus, radii) = match run {
-        Some((run_apparatus, radii)) => {
+    let (apparatus, radii, run_cylinder) = match run {
+        Some((run_apparatus, radii, run_cylinder)) => {
             if let Some(flag) = bars_flag {
                 let given = load_apparatus(flag)?;
                 if ReductionSetup::from_apparatus(&given)?
@@ -282,13 +413,20 @@ pub fn reduce_record(
                     ));
                 }
             }
-            (run_apparatus, radii)
+            (run_apparatus, radii, run_cylinder)
         }
-        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M),
+        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M, None),
     };
+    // A cylinder run file is reduced as its own specimen unless the geometry is given.
+    let cylinder = choices.cylinder.or(run_cylinder);
     let options = ReductionOptions {
-        dispersion_correction: !no_dispersion,
-        specimen_radii_m: Some(radii),
+        dispersion: choices.dispersion,
+        tyas_pope: choices.tyas_pope,
+        // A cylinder's rate is its own (reduce_cylinder); the spheres' δ̇/(r1 + r2) is not.
+        specimen_radii_m: cylinder.is_none().then_some(radii),
+        alignment: choices.alignment,
+        smoothing_window_s: choices.smoothing_s,
+        window: choices.window,
         ..ReductionOptions::default()
     };
     let reduction = if hdf5_input {
@@ -302,16 +440,35 @@ pub fn reduce_record(
     } else {
         shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
     };
+    let cylinder = match cylinder {
+        Some(g) => Some(shpb_core::reduce_cylinder::reduce_cylinder(
+            &reduction,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &g,
+        )?),
+        None => None,
+    };
     Ok(Reduced {
         reduction,
         apparatus,
         hdf5_input,
+        cylinder,
     })
 }
 
-/// The set-up and sphere radii a run file was simulated with, from the scene and inputs stored
-/// in its `/provenance` (None for a file without a stored bar scene, e.g. `shpb strain`'s).
-fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
+/// The set-up, sphere radii and cylinder (if any) a run file was simulated with, from the scene
+/// and inputs stored in its `/provenance` (None for a file without a stored bar scene, e.g.
+/// `shpb strain`'s).
+#[allow(clippy::type_complexity)]
+fn run_setup(
+    record: &Path,
+) -> Result<
+    Option<(
+        Apparatus,
+        (f64, f64),
+        Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+    )>,
+> {
     let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
         return Ok(None);
     };
@@ -329,7 +486,13 @@ fn run_setup(record: &Path) -> Result<Option<(Apparatus, (f64, f64))>> {
                 Some(sp) => shpb_core::scene::specimen_radii_m(&sp.spheres),
                 None => (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
             };
-            Some((*apparatus, radii))
+            let cylinder = options
+                .cylinder
+                .map(|c| shpb_core::reduce_cylinder::CylinderGeometry {
+                    length_m: c.length_m,
+                    diameter_m: c.diameter_m,
+                });
+            Some((*apparatus, radii, cylinder))
         }
         _ => None,
     })

@@ -9,7 +9,7 @@ use crate::setup::{ApparatusFile, ShaperOverride};
 use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
-use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
+use shpb_core::apparatus::{Apparatus, CYLINDER_MIN_CELLS, IncidentEnd, PulseOptions};
 use shpb_core::bar::Dispersion;
 use shpb_core::contact::{LawKind, Region2Form, Unloading};
 use shpb_core::fidelity::Fidelity;
@@ -154,7 +154,12 @@ pub(super) fn parse_bars(
 ) -> Result<Parsed> {
     let sv = v.table("specimen");
     let f: PulseFile = parse_as(text, file)?;
+    let mut cylinder = None;
     let specimen = match (&f.specimen, is_test) {
+        (Some(spec), true) if spec.is_cylinder(&sv)? => {
+            cylinder = Some(spec.build_cylinder(base_dir, &sv)?);
+            None
+        }
         (Some(spec), true) => Some(shpb_core::apparatus::SpecimenSetup {
             spheres: spec.build_chain(base_dir, &sv)?,
             law: f.law,
@@ -224,14 +229,32 @@ pub(super) fn parse_bars(
             ));
         }
     };
+    let c0 = apparatus.material.wave_speed_m_s();
+    // A cylinder gets at least CYLINDER_MIN_CELLS cells (docs/physics.md §6.9): the default
+    // cell is refined to it, an explicit one that cannot is refused.
+    let cylinder_cell = cylinder.map(|c| c.largest_bar_cell_m(c0, CYLINDER_MIN_CELLS));
+    let default_cell = cylinder_cell.map_or(knobs.cell_size_m, |c| c.min(knobs.cell_size_m));
     let cell = v.in_range(
         "cell_size_m",
-        f.cell_size_m.unwrap_or(knobs.cell_size_m),
+        f.cell_size_m.unwrap_or(default_cell),
         1e-5,
         0.05,
         "m",
     )?;
-    let c0 = apparatus.material.wave_speed_m_s();
+    if let (Some(c), Some(largest)) = (&cylinder, cylinder_cell)
+        && c.cells_at(cell / c0) < CYLINDER_MIN_CELLS
+    {
+        return Err(v.error(
+            "cell_size_m",
+            format!(
+                "{cell} m gives the cylindrical specimen {} cell(s)",
+                c.cells_at(cell / c0)
+            ),
+            format!(
+                "1e-5 to {largest:.4e} m (at least {CYLINDER_MIN_CELLS} cells in the specimen, or leave cell_size_m out)"
+            ),
+        ));
+    }
     let gauge_d = apparatus
         .gauges
         .channels
@@ -249,6 +272,7 @@ pub(super) fn parse_bars(
     let gauge_length_m = v.in_range("gauge_length_m", f.gauge_length_m, 0.0, 0.05, "m")?;
     let options = PulseOptions {
         specimen: specimen.clone(),
+        cylinder,
         striker_velocity_m_s: velocity,
         shaper,
         end,

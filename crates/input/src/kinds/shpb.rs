@@ -2,7 +2,7 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
-use super::{CHAIN_SPECIMEN, LAW, Parsed, REGION2, SceneKind, UNLOADING};
+use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
 use shpb_core::fidelity::Fidelity;
 use std::path::Path;
@@ -10,9 +10,9 @@ use std::path::Path;
 /// The registry entry.
 pub(super) const KIND: SceneKind = SceneKind {
     name: "shpb",
-    help: "the whole virtual test: gun, striker, shaper, bars, two (or more) spheres, gauges and the lab's reduction",
+    help: "the whole virtual test: gun, striker, shaper, bars, spheres or a cylinder, gauges and the lab's reduction",
     keys: &[
-        CHAIN_SPECIMEN,
+        SPECIMEN,
         LAW,
         REGION2,
         UNLOADING,
@@ -27,6 +27,14 @@ pub(super) const KIND: SceneKind = SceneKind {
     example: "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nspecimen = { pair = \"ss440c\" }\n",
     example_dir: None,
     parse,
+};
+
+/// `[specimen]` of a full test: spheres (as a chain scene's) or a cylinder (docs/physics.md §6.9).
+const SPECIMEN: Key = Key {
+    key: "specimen",
+    unit: "",
+    default: "required",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio)",
 };
 
 fn parse(
@@ -70,6 +78,53 @@ mod tests {
             options.snapshot_interval_s,
             Some(Fidelity::Fast.bar_knobs().snapshot_interval_s)
         );
+    }
+
+    /// A cylinder of a named material takes its E, ν, ρ; one given as a table takes the table's;
+    /// the fast fidelity's 4 mm cell is refined so the specimen has CYLINDER_MIN_CELLS cells
+    /// (docs/physics.md §6.9), an explicit cell is kept when fine enough.
+    #[test]
+    fn a_cylinder_specimen_is_read_and_resolved() {
+        use shpb_core::apparatus::CYLINDER_MIN_CELLS;
+        use shpb_core::material::Material;
+        let v = Validator::new("c.toml");
+        let head = "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n";
+        let named = format!(
+            "{head}[specimen]\nshape = \"cylinder\"\nmaterial = \"al2017\"\nlength_m = 6e-3\ndiameter_m = 12e-3\n"
+        );
+        let (_, _, _, p) = parse(&named, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let SceneParams::Pulse {
+            options, apparatus, ..
+        } = p
+        else {
+            panic!("not a bar scene")
+        };
+        let c = options.cylinder.expect("a cylinder");
+        let al = <Material as crate::material::MaterialFile>::builtin("al2017").unwrap();
+        assert_eq!(
+            (
+                c.material.youngs_modulus_pa,
+                c.material.poisson_ratio,
+                c.material.density_kg_m3
+            ),
+            (al.youngs_modulus_pa, al.poisson_ratio, al.density_kg_m3)
+        );
+        assert_eq!((c.length_m, c.diameter_m), (6e-3, 12e-3));
+        assert!(options.specimen.is_none());
+        assert_eq!(options.end, IncidentEnd::Specimen);
+        let c0 = apparatus.material.wave_speed_m_s();
+        assert!(options.cell_size_m < Fidelity::Fast.bar_knobs().cell_size_m);
+        assert_eq!(c.cells_at(options.cell_size_m / c0), CYLINDER_MIN_CELLS);
+        let table = format!(
+            "{head}cell_size_m = 5e-4\n[specimen]\nshape = \"cylinder\"\nlength_m = 5e-3\ndiameter_m = 5e-3\nmaterial = {{ density_kg_m3 = 7850.0, youngs_modulus_pa = 200e9, poisson_ratio = 0.3 }}\n"
+        );
+        let (_, _, _, p) = parse(&table, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let SceneParams::Pulse { options, .. } = p else {
+            panic!("not a bar scene")
+        };
+        let c = options.cylinder.unwrap();
+        assert_eq!(c.material.youngs_modulus_pa, 200e9);
+        assert_eq!(options.cell_size_m, 5e-4);
     }
 
     #[test]

@@ -1,0 +1,225 @@
+//! `shpb reduce` as a lab uses it (issue 19): window alignment strategies and what they chose,
+//! smoothing, quality checks, and batches of records with a summary and a report.
+
+mod common;
+use common::{repo_path, shpb, stderr, stdout};
+
+/// The eight 2013-05-22 records.
+fn records() -> Vec<String> {
+    [
+        "1_ss440c", "2_ss440c", "3_ss440c", "4_al2017", "5_al2017", "6_ss302", "7_ss302", "8_ss302",
+    ]
+    .iter()
+    .map(|s| {
+        repo_path(&format!(
+            "validation/gauge-records/data/2013-05-22_sample{s}.csv"
+        ))
+    })
+    .collect()
+}
+
+/// A number field of a JSON text (first occurrence).
+fn number(json: &str, name: &str) -> f64 {
+    let key = format!("\"{name}\":");
+    let at = json
+        .find(&key)
+        .unwrap_or_else(|| panic!("no {name}: {json}"))
+        + key.len();
+    json[at..]
+        .split([',', '}', ']'])
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap_or_else(|e| panic!("{name}: {e}: {json}"))
+}
+
+#[test]
+fn a_batch_of_the_eight_records_writes_summary_report_and_figures_in_one_command() {
+    let tmp = tempfile::tempdir().unwrap();
+    let recs = records();
+    let mut args = vec!["-q", "reduce"];
+    args.extend(recs.iter().map(String::as_str));
+    args.extend([
+        "--bars",
+        "authors",
+        "--summary",
+        "summary.csv",
+        "--report",
+        "report.md",
+    ]);
+    let out = shpb(tmp.path(), &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let summary = std::fs::read_to_string(tmp.path().join("summary.csv")).unwrap();
+    let lines: Vec<&str> = summary.lines().collect();
+    assert_eq!(lines.len(), 9, "{summary}");
+    assert!(lines[0].starts_with("record,status,alignment,peak_back_force_N,"));
+    let columns = lines[0].split(',').count();
+    let verdict = lines[0]
+        .split(',')
+        .position(|c| c == "equilibrium_verdict")
+        .unwrap();
+    let peak = lines[0]
+        .split(',')
+        .position(|c| c == "peak_back_force_N")
+        .unwrap();
+    for (line, rec) in lines[1..].iter().zip(&recs) {
+        assert!(line.starts_with(&format!("{rec},ok,geometric,")), "{line}");
+        // The warnings column is quoted text; the fields before it are plain.
+        let fields: Vec<&str> = line.splitn(columns, ',').collect();
+        assert!(
+            ["equilibrium", "marginal", "not in equilibrium"].contains(&fields[verdict]),
+            "{line}"
+        );
+        let f: f64 = fields[peak].parse().unwrap();
+        // The 2013-05-22 back forces lie between 3 and 15 kN (validation/gauge-records).
+        assert!((3e3..15e3).contains(&f), "{line}");
+    }
+    let report = std::fs::read_to_string(tmp.path().join("report.md")).unwrap();
+    assert!(report.starts_with("# Reduction of 8 records"));
+    for rec in &recs {
+        let name = std::path::Path::new(rec)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy();
+        let png = tmp.path().join(format!("report-{name}.png"));
+        assert!(png.is_file(), "{}", png.display());
+        assert!(report.contains(&format!("](report-{name}.png)")));
+    }
+    // Nothing is overwritten without --force, figures included.
+    std::fs::remove_file(tmp.path().join("summary.csv")).unwrap();
+    std::fs::remove_file(tmp.path().join("report.md")).unwrap();
+    let again = shpb(tmp.path(), &args);
+    assert!(!again.status.success());
+    assert!(stderr(&again).contains("report-2013-05-22_sample1_ss440c.png"));
+    assert!(!tmp.path().join("summary.csv").exists());
+}
+
+#[test]
+fn one_output_file_takes_one_record() {
+    let tmp = tempfile::tempdir().unwrap();
+    let recs = records();
+    let out = shpb(tmp.path(), &["reduce", &recs[0], &recs[1], "-o", "both.h5"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("`--output`: 2 records were given"), "{err}");
+    assert!(err.contains("--summary"), "{err}");
+}
+
+#[test]
+fn each_alignment_reports_what_it_chose_on_a_real_record() {
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = &records()[1];
+    let run = |align: &str| {
+        let out = shpb(tmp.path(), &["--json", "reduce", rec, "--align", align]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        (stdout(&out), stderr(&out))
+    };
+    let (geometric, warned) = run("geometric");
+    let (foot, foot_warned) = run("foot");
+    let (balance, _) = run("balance");
+    assert!(geometric.contains("\"strategy\":\"geometric\""));
+    let g_r = number(&geometric, "geometric_reflected_delay_s");
+    let m_r = number(&geometric, "measured_reflected_delay_s");
+    assert_eq!(number(&geometric, "reflected_delay"), g_r);
+    // The record's reflected foot is ≈ 17 µs before 2 d_I/c0 (validation/gauge-records), and
+    // moving the window there changes δ at peak by more than 5 %: the warning says so.
+    assert!((g_r - m_r - 16.6e-6).abs() < 1.5e-6, "{g_r} {m_r}");
+    assert!(
+        warned.contains("on the record's own delay δ at peak would be"),
+        "{warned}"
+    );
+    // `foot` uses the measured delays and has nothing to warn about the reflected delay.
+    assert_eq!(number(&foot, "reflected_delay"), m_r);
+    assert_eq!(
+        number(&foot, "transmitted_delay"),
+        number(&foot, "measured_transmitted_delay_s")
+    );
+    assert!(
+        !foot_warned.contains("reflected pulse starts"),
+        "{foot_warned}"
+    );
+    // `balance` reports its shifts, within the ±20 µs bound, as used.
+    let s_r = number(&balance, "balance_shift_reflected_s");
+    let s_t = number(&balance, "balance_shift_transmitted_s");
+    assert!(s_r.abs() <= 20e-6 + 1e-12 && s_t.abs() <= 20e-6 + 1e-12);
+    assert!((number(&balance, "reflected_delay") - (g_r + s_r)).abs() < 1e-12);
+    // The balance search finds the reflected offset the record's foot shows, within 2 µs.
+    assert!((g_r + s_r - m_r).abs() < 2e-6, "{s_r} vs {}", m_r - g_r);
+}
+
+#[test]
+fn on_a_simulated_test_the_alignments_agree_with_the_geometry_and_nothing_is_warned() {
+    // A simulated test shares one geometry with its reduction: the balance search must find
+    // (almost) no shift and the geometric windows must not draw the reflected-delay warning.
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = repo_path("scenes/shpb-ss440c-10psi.toml");
+    let out = shpb(tmp.path(), &["-q", "run", &scene, "-o", "test.h5"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let reduce = |align: &str| {
+        let out = shpb(
+            tmp.path(),
+            &["--json", "reduce", "test.h5", "--align", align],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        (stdout(&out), stderr(&out))
+    };
+    let (geometric, warned) = reduce("geometric");
+    assert!(!warned.contains("reflected pulse starts"), "{warned}");
+    // The reduction of `shpb run`'s own record, with the same 2 µs smoothing, is in equilibrium
+    // at peak as the run's summary says (≈ 0.01).
+    assert!(
+        number(&geometric, "equilibrium_ratio_at_peak") < 0.05,
+        "{geometric}"
+    );
+    let (balance, _) = reduce("balance");
+    // Within 1 µs (10 samples): the shifts a 2 % change of the 3-wave force would allow.
+    for key in ["balance_shift_reflected_s", "balance_shift_transmitted_s"] {
+        let s = number(&balance, key);
+        assert!(s.abs() <= 1e-6, "{key} = {s}: {balance}");
+    }
+    let d_g = number(&geometric, "displacement_at_peak_force_m");
+    let d_b = number(&balance, "displacement_at_peak_force_m");
+    assert!((d_b / d_g - 1.0).abs() < 0.02, "{d_g} {d_b}");
+}
+
+#[test]
+fn smoothing_and_window_flags_are_checked_and_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = &records()[0];
+    for (args, flag) in [
+        (vec!["--smooth", "-1e-6"], "--smooth"),
+        (vec!["--reflected-delay", "0"], "--reflected-delay"),
+        (vec!["--duration", "nan"], "--duration"),
+    ] {
+        let mut all = vec!["reduce", rec.as_str()];
+        all.extend(args);
+        let out = shpb(tmp.path(), &all);
+        assert!(!out.status.success());
+        assert!(
+            stderr(&out).contains(&format!("`{flag}`")),
+            "{}",
+            stderr(&out)
+        );
+    }
+    // A manual reflected delay wins over the alignment for that delay only.
+    let out = shpb(
+        tmp.path(),
+        &[
+            "--json",
+            "reduce",
+            rec,
+            "--align",
+            "foot",
+            "--reflected-delay",
+            "250e-6",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json = stdout(&out);
+    assert_eq!(number(&json, "reflected_delay"), 250e-6);
+    assert_eq!(
+        number(&json, "transmitted_delay"),
+        number(&json, "measured_transmitted_delay_s")
+    );
+}

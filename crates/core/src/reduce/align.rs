@@ -1,0 +1,241 @@
+//! Where the reflected and transmitted windows start relative to the incident one
+//! (docs/physics.md §7.6): the gauge distances (`geometric`), the feet detected in the record
+//! (`foot`), or a bounded search for the shifts that balance the front and back forces over the
+//! loading (`balance`).
+
+use crate::gauge::pulse_foot;
+
+/// Window alignment strategy of the reduction (docs/physics.md §7.6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Alignment {
+    /// Delays from the gauge distances and c0: 2 d_I/c0 and d_I/c0 + d_T/c0 (the lab's rule).
+    #[default]
+    Geometric,
+    /// Delays from the feet of the reflected and transmitted pulses detected in the record.
+    Foot,
+    /// The geometric delays shifted, within a bound, to minimise the front/back force imbalance
+    /// over the loading.
+    Balance,
+}
+
+impl Alignment {
+    /// The three strategies, in the order of the command line's help.
+    pub const ALL: [Alignment; 3] = [Alignment::Geometric, Alignment::Foot, Alignment::Balance];
+
+    /// The command-line and file name (`geometric`, `foot`, `balance`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Alignment::Geometric => "geometric",
+            Alignment::Foot => "foot",
+            Alignment::Balance => "balance",
+        }
+    }
+
+    /// The strategy of a name (`geometric`, `foot`, `balance`).
+    pub fn from_name(name: &str) -> Option<Alignment> {
+        Alignment::ALL.into_iter().find(|a| a.name() == name)
+    }
+}
+
+/// What the alignment chose and what it measured (record clock differences, s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlignmentReport {
+    /// The strategy asked for.
+    pub strategy: Alignment,
+    /// Reflected delay the gauge distance predicts, 2 d_I/c0, s.
+    pub geometric_reflected_delay_s: f64,
+    /// Transmitted delay the gauge distances predict, d_I/c0 + d_T/c0 (+ specimen transit), s.
+    pub geometric_transmitted_delay_s: f64,
+    /// Foot of the reflected pulse minus foot of the incident pulse, in the record, s.
+    pub measured_reflected_delay_s: Option<f64>,
+    /// Foot of the transmitted pulse minus foot of the incident pulse, in the record, s.
+    pub measured_transmitted_delay_s: Option<f64>,
+    /// Shifts the balance search added to the geometric delays (reflected, transmitted), s.
+    pub balance_shift_s: Option<(f64, f64)>,
+    /// Bound of the balance search on each shift, s.
+    pub balance_bound_s: f64,
+    /// Whether a balance shift stopped at its bound (the optimum may lie beyond it).
+    pub at_bound: bool,
+}
+
+/// Foot of the first tensile pulse of the incident gauge after the incident foot — the reflected
+/// pulse — minus the incident foot, s. Searched from half the geometric delay to twice it; kept
+/// only when that pulse reaches 10 % of the incident peak (a specimen that reflects almost
+/// nothing has no foot to measure). `s_i`: incident foot, fractional sample index.
+pub(crate) fn reflected_foot_delay_s(
+    eps_i: &[f64],
+    dt: f64,
+    s_i: f64,
+    geometric_s: f64,
+    incident_peak: f64,
+    fraction: f64,
+) -> Option<f64> {
+    let from = (s_i + 0.5 * geometric_s / dt).max(0.0) as usize;
+    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps_i.len());
+    if from + 2 >= to || incident_peak <= 0.0 {
+        return None;
+    }
+    let y = &eps_i[from..to];
+    pulse_foot(y, fraction)
+        .filter(|f| y[f.peak_index] >= 0.1 * incident_peak)
+        .map(|f| (from as f64 + f.index as f64 - s_i) * dt)
+}
+
+/// Foot of the first compressive pulse of the transmission gauge after the incident foot minus
+/// the incident foot, s; searched from half the geometric delay to twice it. None when that
+/// gauge shows no pulse above 10 times its baseline RMS `noise`.
+pub(crate) fn transmitted_foot_delay_s(
+    eps_t: &[f64],
+    dt: f64,
+    s_i: f64,
+    geometric_s: f64,
+    noise: f64,
+    fraction: f64,
+) -> Option<f64> {
+    let from = (s_i + 0.5 * geometric_s / dt).max(0.0) as usize;
+    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps_t.len());
+    if from + 2 >= to {
+        return None;
+    }
+    let y: Vec<f64> = eps_t[from..to].iter().map(|e| -e).collect();
+    pulse_foot(&y, fraction)
+        .filter(|f| y[f.peak_index] > 10.0 * noise)
+        .map(|f| (from as f64 + f.index as f64 - s_i) * dt)
+}
+
+/// The balance search's inputs: the incident wave at the face and the reflected and transmitted
+/// waves at the faces cut from `margin` samples before their geometric starts, `window + 2
+/// margin` long (so that a shift of j samples is the slice `margin + j ..`).
+pub(crate) struct BalanceProblem<'a> {
+    /// Incident strain at the face over the window.
+    pub incident: &'a [f64],
+    /// Reflected strain at the face, extended by `margin` on both sides.
+    pub reflected: &'a [f64],
+    /// Transmitted strain at the face, extended by `margin` on both sides.
+    pub transmitted: &'a [f64],
+    /// Largest shift, samples.
+    pub margin: usize,
+    /// E A of the incident bar, N.
+    pub ea_incident_n: f64,
+    /// E A of the transmission bar, N.
+    pub ea_transmission_n: f64,
+}
+
+/// The loading span of an incident wave at the face (compression negative): from the first
+/// sample reaching 10 % of its peak to the peak, as sample indices (docs/physics.md §7.6).
+pub(crate) fn loading_span(incident: &[f64]) -> (usize, usize) {
+    let y: Vec<f64> = incident.iter().map(|e| -e).collect();
+    let k_peak = crate::numeric::argmax(&y);
+    let level = 0.1 * y[k_peak];
+    let k_start = (0..=k_peak).find(|&k| y[k] >= level).unwrap_or(k_peak);
+    (k_start, k_peak)
+}
+
+impl BalanceProblem<'_> {
+    /// Σ (F_front − F_back)² / Σ F_back² over the loading span for shifts (jr, jt) in samples.
+    fn cost(&self, span: (usize, usize), jr: isize, jt: isize) -> f64 {
+        let m = self.margin as isize;
+        let (r0, t0) = ((m + jr) as usize, (m + jt) as usize);
+        let (mut num, mut den) = (0.0, 0.0);
+        for k in span.0..=span.1 {
+            let front = -self.ea_incident_n * (self.incident[k] + self.reflected[r0 + k]);
+            let back = -self.ea_transmission_n * self.transmitted[t0 + k];
+            num += (front - back) * (front - back);
+            den += back * back;
+        }
+        if den > 0.0 { num / den } else { f64::INFINITY }
+    }
+
+    /// The shifts (reflected, transmitted), in samples within ±margin, that minimise the
+    /// imbalance over the loading span: a grid of step ⌈margin/50⌉, then every sample within one
+    /// step of its best point. Returns the shifts and whether one of them is at ±margin.
+    pub fn solve(&self) -> ((isize, isize), bool) {
+        let span = loading_span(self.incident);
+        let m = self.margin as isize;
+        let step = (self.margin.div_ceil(50)).max(1) as isize;
+        let mut best = (f64::INFINITY, 0isize, 0isize);
+        let consider = |jr: isize, jt: isize, best: &mut (f64, isize, isize)| {
+            let c = self.cost(span, jr, jt);
+            if c < best.0 {
+                *best = (c, jr, jt);
+            }
+        };
+        let mut jr = -m;
+        while jr <= m {
+            let mut jt = -m;
+            while jt <= m {
+                consider(jr, jt, &mut best);
+                jt += step;
+            }
+            jr += step;
+        }
+        if step > 1 {
+            let (_, br, bt) = best;
+            for jr in (br - step).max(-m)..=(br + step).min(m) {
+                for jt in (bt - step).max(-m)..=(bt + step).min(m) {
+                    consider(jr, jt, &mut best);
+                }
+            }
+        }
+        let (_, jr, jt) = best;
+        ((jr, jt), jr.abs() == m || jt.abs() == m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for a in Alignment::ALL {
+            assert_eq!(Alignment::from_name(a.name()), Some(a));
+        }
+        assert_eq!(Alignment::from_name("auto"), None);
+    }
+
+    /// A balanced test (F_front = F_back at every instant) whose reflected and transmitted waves
+    /// were cut 7 and −4 samples off: the search recovers both shifts exactly.
+    #[test]
+    fn the_balance_search_recovers_known_shifts() {
+        let n = 400;
+        let margin = 30;
+        let pulse = |k: f64| {
+            let x = k / 200.0;
+            if (0.0..=1.0).contains(&x) {
+                (std::f64::consts::PI * x).sin().powi(2)
+            } else {
+                0.0
+            }
+        };
+        // εI = −p, εT = −0.4 p(k − 3) (a later, smaller back force), εR from balance:
+        // −(εI + εR) = −εT  ⇒  εR = εT − εI.
+        let incident: Vec<f64> = (0..n).map(|k| -pulse(k as f64)).collect();
+        let transmitted_at = |k: f64| -0.4 * pulse(k - 3.0);
+        let reflected_at = |k: f64| transmitted_at(k) + pulse(k);
+        let (sr, st) = (7isize, -4isize);
+        let ext = |f: &dyn Fn(f64) -> f64, s: isize| -> Vec<f64> {
+            (0..n + 2 * margin)
+                .map(|i| f((i as isize - margin as isize - s) as f64))
+                .collect()
+        };
+        let (reflected, transmitted) = (ext(&reflected_at, sr), ext(&transmitted_at, st));
+        let p = BalanceProblem {
+            incident: &incident,
+            reflected: &reflected,
+            transmitted: &transmitted,
+            margin,
+            ea_incident_n: 1.0,
+            ea_transmission_n: 1.0,
+        };
+        let ((jr, jt), at_bound) = p.solve();
+        assert_eq!((jr, jt), (sr, st));
+        assert!(!at_bound);
+    }
+
+    #[test]
+    fn the_loading_span_runs_from_ten_percent_to_the_peak() {
+        let incident: Vec<f64> = (0..100).map(|k| -(k.min(50) as f64)).collect();
+        assert_eq!(loading_span(&incident), (5, 50));
+    }
+}

@@ -1,0 +1,424 @@
+//! Several records reduced in one command (`shpb reduce A.csv B.csv --summary S.csv --report
+//! R.md`): one summary row per record, a Markdown report with one figure per record.
+
+use crate::atomic::write_text_atomically;
+use crate::plot::{Axes, Curve, panels_figure};
+use shpb_core::reduce::{BarProperties, Reduction, WaveMetrics, wave_metrics};
+use shpb_input::Result;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One record of a batch: its name and its reduction, or why it could not be reduced.
+pub struct BatchRecord<'a> {
+    /// The record as given on the command line.
+    pub record: String,
+    /// The reduction, or the error message.
+    pub reduction: std::result::Result<&'a Reduction, String>,
+    /// The incident and transmission bars (for the waves' stresses and energies).
+    pub bars: Option<(BarProperties, BarProperties)>,
+    /// The record's figure, as the report links it (relative to the report).
+    pub figure: Option<String>,
+}
+
+/// Metrics of the incident, reflected and transmitted waves at the faces of a reduction.
+pub fn wave_table(
+    r: &Reduction,
+    bars: &(BarProperties, BarProperties),
+) -> [Option<WaveMetrics>; 3] {
+    [
+        wave_metrics(&r.time_s, &r.incident_strain, &bars.0, true),
+        wave_metrics(&r.time_s, &r.reflected_strain, &bars.0, false),
+        wave_metrics(&r.time_s, &r.transmitted_strain, &bars.1, true),
+    ]
+}
+
+/// Strain rate at the peak back force and its mean over the loading span (sphere specimens).
+fn strain_rates(r: &Reduction) -> (f64, f64) {
+    match &r.strain_rate_per_s {
+        Some(rate) => {
+            let (a, b) = r.quality.loading_span_s;
+            let span: Vec<f64> = r
+                .time_s
+                .iter()
+                .zip(rate)
+                .filter(|(t, _)| (a..=b).contains(*t))
+                .map(|(_, v)| *v)
+                .collect();
+            let mean = if span.is_empty() {
+                f64::NAN
+            } else {
+                span.iter().sum::<f64>() / span.len() as f64
+            };
+            (rate[r.peak_index], mean)
+        }
+        None => (f64::NAN, f64::NAN),
+    }
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// A number for the CSV (empty when unknown).
+fn num(v: Option<f64>) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{v:e}"),
+        _ => String::new(),
+    }
+}
+
+/// Column names of the batch summary (SI units in the names).
+pub const SUMMARY_COLUMNS: [&str; 33] = [
+    "record",
+    "status",
+    "alignment",
+    "peak_back_force_N",
+    "peak_front_force_N",
+    "displacement_at_peak_m",
+    "strain_rate_at_peak_per_s",
+    "mean_strain_rate_loading_per_s",
+    "equilibrium_ratio_at_peak",
+    "equilibrium_mean_loading",
+    "equilibrium_max_loading",
+    "equilibrium_verdict",
+    "reflected_delay_s",
+    "geometric_reflected_delay_s",
+    "measured_reflected_delay_s",
+    "transmitted_delay_s",
+    "measured_transmitted_delay_s",
+    "incident_peak_Pa",
+    "incident_rise_s",
+    "incident_duration_s",
+    "incident_energy_J",
+    "reflected_peak_Pa",
+    "reflected_rise_s",
+    "reflected_duration_s",
+    "reflected_energy_J",
+    "transmitted_peak_Pa",
+    "transmitted_rise_s",
+    "transmitted_duration_s",
+    "transmitted_energy_J",
+    "signal_to_noise_incident",
+    "signal_to_noise_transmission",
+    "pulse_overlap_s",
+    "warnings",
+];
+
+/// The summary CSV text: a header of [`SUMMARY_COLUMNS`], then one row per record.
+pub fn summary_csv(records: &[BatchRecord]) -> String {
+    let mut text = SUMMARY_COLUMNS.join(",");
+    text.push('\n');
+    for b in records {
+        let mut row = vec![csv_field(&b.record)];
+        match &b.reduction {
+            Err(e) => {
+                row.push(csv_field(&format!("error: {e}")));
+                row.extend((2..SUMMARY_COLUMNS.len()).map(|_| String::new()));
+            }
+            Ok(r) => {
+                let (rate_peak, rate_mean) = strain_rates(r);
+                let a = &r.alignment;
+                let q = &r.quality;
+                row.push("ok".into());
+                row.push(a.strategy.name().into());
+                for v in [
+                    r.peak_back_force_n,
+                    r.peak_front_force_n,
+                    r.displacement_at_peak_force_m,
+                    rate_peak,
+                    rate_mean,
+                    r.equilibrium_ratio_at_peak,
+                    q.equilibrium_mean,
+                    q.equilibrium_max,
+                ] {
+                    row.push(num(Some(v)));
+                }
+                row.push(q.verdict.name().into());
+                row.push(num(Some(r.windows.reflected_delay_s)));
+                row.push(num(Some(a.geometric_reflected_delay_s)));
+                row.push(num(a.measured_reflected_delay_s));
+                row.push(num(Some(r.windows.transmitted_delay_s)));
+                row.push(num(a.measured_transmitted_delay_s));
+                let waves = b.bars.as_ref().map(|bars| wave_table(r, bars));
+                for k in 0..3 {
+                    let w = waves.as_ref().and_then(|w| w[k]);
+                    row.push(num(w.map(|w| w.peak_stress_pa)));
+                    row.push(num(w.map(|w| w.rise_10_90_s)));
+                    row.push(num(w.map(|w| w.duration_10_s)));
+                    row.push(num(w.map(|w| w.energy_j)));
+                }
+                row.push(num(Some(q.signal_to_noise.0)));
+                row.push(num(Some(q.signal_to_noise.1)));
+                row.push(num(Some(q.pulse_overlap_s)));
+                row.push(csv_field(&r.warnings.join("; ")));
+            }
+        }
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    text
+}
+
+/// Writes the summary CSV atomically (no clobbering without `force`).
+pub fn write_summary(path: &Path, force: bool, records: &[BatchRecord]) -> Result<()> {
+    write_text_atomically(path, force, &summary_csv(records))
+}
+
+/// A number with `digits` decimals after scaling, or `—` when unknown.
+fn cell(v: Option<f64>, scale: f64, digits: usize) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{:.digits$}", v * scale),
+        _ => "—".into(),
+    }
+}
+
+/// The Markdown report: the command, a table of every record, then a section per record with
+/// its figure, windows, pulse metrics, quality checks and warnings.
+pub fn report_markdown(command: &str, records: &[BatchRecord]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(md, "# Reduction of {} records\n", records.len());
+    let _ = writeln!(md, "Generated by `{command}`.\n");
+    md.push_str(
+        "Forces are compression positive; δ is the sphere approach; the equilibrium ratio is \
+         |F_front − F_back| / F_3wave, judged over the loading span (25 % of the 3-wave peak to \
+         the peak) against 0.05 (Ravichandran & Subhash 1994): *equilibrium* if every sample \
+         passes, *marginal* if the mean does, else *not in equilibrium*.\n\n",
+    );
+    md.push_str(
+        "| record | peak back force (kN) | peak front force (kN) | δ at peak (µm) | strain rate at peak (1/s) | equilibrium at peak | mean / max over loading | verdict | alignment |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for b in records {
+        match &b.reduction {
+            Err(e) => {
+                let _ = writeln!(
+                    md,
+                    "| {} | error: {} | | | | | | | |",
+                    file_name(&b.record),
+                    e
+                );
+            }
+            Ok(r) => {
+                let (rate, _) = strain_rates(r);
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {} | {} | {} / {} | {} | {} |",
+                    file_name(&b.record),
+                    cell(Some(r.peak_back_force_n), 1e-3, 2),
+                    cell(Some(r.peak_front_force_n), 1e-3, 2),
+                    cell(Some(r.displacement_at_peak_force_m), 1e6, 1),
+                    cell(Some(rate), 1.0, 0),
+                    cell(Some(r.equilibrium_ratio_at_peak), 1.0, 3),
+                    cell(Some(r.quality.equilibrium_mean), 1.0, 3),
+                    cell(Some(r.quality.equilibrium_max), 1.0, 3),
+                    r.quality.verdict.name(),
+                    r.alignment.strategy.name()
+                );
+            }
+        }
+    }
+    for b in records {
+        let _ = writeln!(md, "\n## {}\n", b.record);
+        let r = match &b.reduction {
+            Err(e) => {
+                let _ = writeln!(md, "Not reduced: {e}");
+                continue;
+            }
+            Ok(r) => r,
+        };
+        if let Some(f) = &b.figure {
+            let _ = writeln!(md, "![{}]({})\n", b.record, f);
+        }
+        let a = &r.alignment;
+        let us = |v: Option<f64>| cell(v, 1e6, 2);
+        let _ = writeln!(
+            md,
+            "Windows ({} alignment): incident foot at {} µs on the record clock; reflected +{} µs \
+             (geometric {}, record's foot {}); transmitted +{} µs (geometric {}, record's foot \
+             {}); {} µs long.{}\n",
+            a.strategy.name(),
+            us(Some(r.windows.incident_start_s)),
+            us(Some(r.windows.reflected_delay_s)),
+            us(Some(a.geometric_reflected_delay_s)),
+            us(a.measured_reflected_delay_s),
+            us(Some(r.windows.transmitted_delay_s)),
+            us(Some(a.geometric_transmitted_delay_s)),
+            us(a.measured_transmitted_delay_s),
+            cell(Some(r.windows.duration_s), 1e6, 1),
+            match a.balance_shift_s {
+                Some((sr, st)) => format!(
+                    " Balance search (±{} µs): reflected shifted {} µs, transmitted {} µs{}.",
+                    cell(Some(a.balance_bound_s), 1e6, 1),
+                    us(Some(sr)),
+                    us(Some(st)),
+                    if a.at_bound { ", at the bound" } else { "" }
+                ),
+                None => String::new(),
+            }
+        );
+        if let Some(bars) = &b.bars {
+            md.push_str(
+                "| wave (at the face) | peak (MPa) | rise 10–90 % (µs) | duration at 10 % (µs) | energy (J) |\n\
+                 |---|---|---|---|---|\n",
+            );
+            for (name, w) in ["incident", "reflected", "transmitted"]
+                .iter()
+                .zip(wave_table(r, bars))
+            {
+                let _ = writeln!(
+                    md,
+                    "| {name} | {} | {} | {} | {} |",
+                    cell(w.map(|w| w.peak_stress_pa), 1e-6, 1),
+                    cell(w.map(|w| w.rise_10_90_s), 1e6, 1),
+                    cell(w.map(|w| w.duration_10_s), 1e6, 1),
+                    cell(w.map(|w| w.energy_j), 1.0, 3)
+                );
+            }
+            md.push('\n');
+        }
+        let q = &r.quality;
+        let _ = writeln!(
+            md,
+            "Quality: equilibrium over the loading ({}–{} µs) mean {}, max {}: **{}**; incident \
+             pulse {} µs at its gauge, overlap with the reflected one {} µs; signal/noise {} \
+             (incident), {} (transmission).\n",
+            cell(Some(q.loading_span_s.0), 1e6, 1),
+            cell(Some(q.loading_span_s.1), 1e6, 1),
+            cell(Some(q.equilibrium_mean), 1.0, 3),
+            cell(Some(q.equilibrium_max), 1.0, 3),
+            q.verdict.name(),
+            cell(Some(q.incident_duration_s), 1e6, 1),
+            cell(Some(q.pulse_overlap_s), 1e6, 1),
+            cell(Some(q.signal_to_noise.0), 1.0, 0),
+            cell(Some(q.signal_to_noise.1), 1.0, 0)
+        );
+        for w in &r.warnings {
+            let _ = writeln!(md, "- warning: {w}");
+        }
+    }
+    md
+}
+
+/// Writes the Markdown report atomically (no clobbering without `force`).
+pub fn write_report(
+    path: &Path,
+    force: bool,
+    command: &str,
+    records: &[BatchRecord],
+) -> Result<()> {
+    write_text_atomically(path, force, &report_markdown(command, records))
+}
+
+/// The figure of one reduction: the three waves at the faces, the 1-, 2- and 3-wave forces, the
+/// equilibrium ratio (shown up to 1), and force against sphere approach.
+pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) -> Result<()> {
+    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
+    let waves_title = format!("{title}: waves at the faces");
+    let panels = vec![
+        (
+            Axes {
+                title: &waves_title,
+                x_label: "time at the faces (µs)",
+                y_label: "bar strain (µε), tension positive",
+                x_scale: 1e6,
+                y_scale: 1e6,
+            },
+            vec![
+                curve("incident", &r.time_s, &r.incident_strain),
+                curve("reflected", &r.time_s, &r.reflected_strain),
+                curve("transmitted", &r.time_s, &r.transmitted_strain),
+            ],
+        ),
+        (
+            Axes {
+                title: "face forces",
+                x_label: "time at the faces (µs)",
+                y_label: "force, compression positive (kN)",
+                x_scale: 1e6,
+                y_scale: 1e-3,
+            },
+            vec![
+                curve("front (2-wave)", &r.time_s, &r.force_front_n),
+                curve("back (1-wave)", &r.time_s, &r.force_back_n),
+                curve("3-wave", &r.time_s, &r.force_3wave_n),
+            ],
+        ),
+        (
+            Axes {
+                title: "equilibrium |F_front − F_back| / F_3wave (shown up to 1)",
+                x_label: "time at the faces (µs)",
+                y_label: "equilibrium ratio",
+                x_scale: 1e6,
+                y_scale: 1.0,
+            },
+            vec![Curve {
+                label: "equilibrium ratio".into(),
+                x: &r.time_s,
+                y: &ratio,
+                measured: false,
+            }],
+        ),
+        (
+            Axes {
+                title: "force against sphere approach",
+                x_label: "sphere approach δ (µm)",
+                y_label: "force (kN)",
+                x_scale: 1e6,
+                y_scale: 1e-3,
+            },
+            vec![
+                curve("back", &r.displacement_m, &r.force_back_n),
+                curve("front", &r.displacement_m, &r.force_front_n),
+            ],
+        ),
+    ];
+    panels_figure(path, force, 2, &panels)
+}
+
+/// The last component of a record's path (the table's record column).
+fn file_name(record: &str) -> String {
+    Path::new(record)
+        .file_name()
+        .map_or_else(|| record.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// A model-line curve.
+fn curve<'a>(label: &str, x: &'a [f64], y: &'a [f64]) -> Curve<'a> {
+    Curve {
+        label: label.into(),
+        x,
+        y,
+        measured: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_fields_with_commas_or_quotes_are_quoted() {
+        assert_eq!(csv_field("a.csv"), "a.csv");
+        assert_eq!(csv_field("a,b.csv"), "\"a,b.csv\"");
+        assert_eq!(csv_field("say \"x\""), "\"say \"\"x\"\"\"");
+    }
+
+    #[test]
+    fn a_failed_record_keeps_its_row_with_every_column() {
+        let rows = [BatchRecord {
+            record: "bad.csv".into(),
+            reduction: Err("no incident pulse".into()),
+            bars: None,
+            figure: None,
+        }];
+        let text = summary_csv(&rows);
+        let line = text.lines().nth(1).unwrap();
+        assert!(line.starts_with("bad.csv,error: no incident pulse,"));
+        assert_eq!(line.split(',').count(), SUMMARY_COLUMNS.len());
+    }
+}
