@@ -55,8 +55,10 @@ fn fig4_record(root: &Path, m: &str, p: &str) -> Option<(f64, f64)> {
 fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(usize, Peak, Peak)> {
     let scene = format!("{m}-{p}psi");
     let s = SAMPLES.iter().find(|r| r.scene == scene)?;
+    // Like for like with the authors' reduction, which did not smooth (`shpb reduce --smooth 0`).
     let options = ReductionOptions {
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
+        smoothing_window_s: 0.0,
         ..Default::default()
     };
     let r = reduce_record_file(&s.record_path(root), app, &options).unwrap();
