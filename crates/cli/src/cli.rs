@@ -379,6 +379,11 @@ pub enum Command {
         /// Window length, s (default: the longest clean window the record holds).
         #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
         duration: Option<f64>,
+        /// How to read a text record that is not the authors' CSV: a layout file (header lines,
+        /// delimiter, time column or sample rate, channel columns, units, polarities; README,
+        /// "Record layouts"), e.g. layouts/authors-lvm.toml.
+        #[arg(long, value_name = "FILE.toml")]
+        layout: Option<PathBuf>,
         /// Batch summary: one CSV row per record (forces, δ at peak, strain rate, equilibrium
         /// verdict, windows, pulse metrics, warnings).
         #[arg(long, value_name = "FILE.csv")]
@@ -402,6 +407,13 @@ pub enum Command {
         /// HDF5 output (/time, /gauges/<name>/{strain,voltage}).
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// How to read a text record that is not the authors' CSV (see `shpb reduce --layout`).
+        #[arg(long, value_name = "FILE.toml")]
+        layout: Option<PathBuf>,
+        /// Samples at the start of each channel whose mean is removed (the pre-trigger baseline,
+        /// as `shpb reduce` removes it); 0 keeps the record's offsets.
+        #[arg(long, value_name = "N", default_value_t = shpb_core::reduce::ReductionOptions::default().baseline_samples)]
+        baseline_samples: usize,
         /// CSV output.
         #[arg(long)]
         csv: Option<PathBuf>,
@@ -530,6 +542,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             duration,
             summary,
             report,
+            layout,
             specimen_length,
             specimen_diameter,
             force,
@@ -560,6 +573,10 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                     alignment: align.into(),
                     smoothing_s: smooth,
                     window: (window != Default::default()).then_some(window),
+                    layout: layout
+                        .as_deref()
+                        .map(shpb_input::layout::RecordLayout::from_file)
+                        .transpose()?,
                     cylinder: shpb_study::api::cylinder_geometry(
                         specimen_length,
                         specimen_diameter,
@@ -572,9 +589,21 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             record,
             bars,
             output,
+            layout,
+            baseline_samples,
             csv,
             force,
-        } => cmd::strain::strain(&record, &bars, output.as_deref(), csv.as_deref(), force),
+        } => cmd::strain::strain(
+            &record,
+            &bars,
+            cmd::strain::StrainOptions {
+                layout: layout.as_deref(),
+                baseline_samples,
+            },
+            output.as_deref(),
+            csv.as_deref(),
+            force,
+        ),
         Command::Validate {
             cases,
             data,

@@ -223,3 +223,152 @@ fn smoothing_and_window_flags_are_checked_and_named() {
         number(&json, "measured_transmitted_delay_s")
     );
 }
+
+/// The authors' CSV record as (time, incident V, transmission V) rows.
+fn csv_rows(path: &str) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("time_s") && !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn a_scope_export_and_a_labview_file_reduce_as_the_authors_csv() {
+    // The same record written two other ways a lab's equipment writes it: (a) a scope export
+    // with three header lines, semicolons, decimal commas, time in µs, channels in mV and the
+    // transmission channel inverted; (b) the authors' own LabVIEW layout (four tab-separated
+    // columns, no header), read with the shipped layouts/authors-lvm.toml.
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = &records()[1];
+    let rows = csv_rows(rec);
+    let comma = |x: f64| format!("{x:e}").replace('.', ",");
+    let mut scope = String::from("Model X\nSample rate 10 MS/s\nTime(us);CH1(mV);CH2(mV)\n");
+    let mut lvm = String::new();
+    for [t, i, tr] in &rows {
+        scope.push_str(&format!(
+            "{};{};{}\n",
+            comma(t * 1e6),
+            comma(i * 1e3),
+            comma(-tr * 1e3)
+        ));
+        lvm.push_str(&format!("{t:e}\t{i:e}\t{t:e}\t{tr:e}\n"));
+    }
+    std::fs::write(tmp.path().join("scope.txt"), scope).unwrap();
+    std::fs::write(tmp.path().join("sample2.lvm"), lvm).unwrap();
+    std::fs::write(
+        tmp.path().join("scope.toml"),
+        "description = \"scope\"\ndelimiter = \"semicolon\"\ndecimal = \",\"\nskip_lines = 3\n\
+         time_column = 1\ntime_unit = \"us\"\n[incident]\ncolumn = 2\nunit = \"mV\"\n\
+         [transmission]\ncolumn = 3\nunit = \"mV\"\npolarity = -1\n",
+    )
+    .unwrap();
+    let json = |args: &[&str]| {
+        let mut all = vec!["--json", "reduce"];
+        all.extend_from_slice(args);
+        let out = shpb(tmp.path(), &all);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let reference = json(&[rec, "--bars", "authors"]);
+    let lvm_layout = repo_path("layouts/authors-lvm.toml");
+    for got in [
+        json(&["scope.txt", "--layout", "scope.toml", "--bars", "authors"]),
+        json(&["sample2.lvm", "--layout", &lvm_layout, "--bars", "authors"]),
+    ] {
+        for key in [
+            "peak_back_force_N",
+            "displacement_at_peak_force_m",
+            "equilibrium_ratio_at_peak",
+        ] {
+            let (a, b) = (number(&reference, key), number(&got, key));
+            // Only the text round trip of each sample (17 significant digits) differs.
+            assert!((a - b).abs() <= 1e-9 * a.abs(), "{key}: {a} vs {b}");
+        }
+    }
+    // A record that the layout does not fit is refused naming the line and the column.
+    let out = shpb(
+        tmp.path(),
+        &["reduce", rec, "--layout", "scope.toml", "--bars", "authors"],
+    );
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains(":4: `time_column`"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
+    // `shpb strain` removes each channel's pre-trigger mean as the reduction does; its CSV,
+    // read back through a strain layout, reduces to the raw record's numbers.
+    let tmp = tempfile::tempdir().unwrap();
+    let rec = &records()[0];
+    let out = shpb(
+        tmp.path(),
+        &[
+            "-q",
+            "strain",
+            rec,
+            "--bars",
+            "authors",
+            "--csv",
+            "strain.csv",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = std::fs::read_to_string(tmp.path().join("strain.csv")).unwrap();
+    let strains: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .take(900)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    let mean = strains.iter().sum::<f64>() / strains.len() as f64;
+    let rms = (strains.iter().map(|e| e * e).sum::<f64>() / strains.len() as f64).sqrt();
+    // The voltages' pre-trigger mean is removed exactly; the bridge's conversion is nonlinear by
+    // O(V/V_ex) ≈ 1e-5, which is all that is left of it in the strains.
+    assert!(mean.abs() < 1e-4 * rms, "baseline mean {mean}, noise RMS {rms}");
+    std::fs::write(
+        tmp.path().join("strain.toml"),
+        "skip_lines = 1\ntime_column = 1\n[incident]\ncolumn = 2\nunit = \"strain\"\n\
+         [transmission]\ncolumn = 4\nunit = \"strain\"\n",
+    )
+    .unwrap();
+    let json = |args: &[&str]| {
+        let mut all = vec!["--json", "reduce"];
+        all.extend_from_slice(args);
+        let out = shpb(tmp.path(), &all);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stdout(&out)
+    };
+    let raw = json(&[rec, "--bars", "authors"]);
+    let via = json(&["strain.csv", "--layout", "strain.toml", "--bars", "authors"]);
+    for key in ["peak_back_force_N", "displacement_at_peak_force_m"] {
+        let (a, b) = (number(&raw, key), number(&via, key));
+        assert!((a - b).abs() <= 1e-9 * a.abs(), "{key}: {a} vs {b}");
+    }
+    // `--baseline-samples 0` keeps the record's offsets.
+    let out = shpb(
+        tmp.path(),
+        &[
+            "-q",
+            "strain",
+            rec,
+            "--bars",
+            "authors",
+            "--csv",
+            "raw.csv",
+            "--baseline-samples",
+            "0",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let raw_text = std::fs::read_to_string(tmp.path().join("raw.csv")).unwrap();
+    assert_ne!(raw_text.lines().nth(1), text.lines().nth(1));
+}

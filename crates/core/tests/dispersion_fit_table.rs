@@ -2,10 +2,9 @@
 //! six-parameter fits to Bancroft's (1941) solution, `tests/data/bancroft_fit_coefficients.csv`
 //! (its header says where the coefficients come from).
 //!
-//! This is NOT the table test the issue asked for: no digits of Bancroft's (or Davies', or
-//! Follansbee & Frantz's) tabulated c/c0 were found, so the solver is checked against the fits
-//! instead. A fit of this form cannot follow the exact curve closely everywhere: its residual
-//! oscillates about it, and the fits' own accuracy is not stated in the transcription. The
+//! The table test of the issue is `dispersion_bancroft_table.rs`; this one checks the solver
+//! against the fits as well. A fit of this form cannot follow the exact curve closely
+//! everywhere: its residual oscillates about it, and the fits' own accuracy is not stated in the transcription. The
 //! tolerance below, 0.35 %, is the largest residual this test measures for ν = 0.29 and 0.31
 //! (0.30 % and 0.26 % at a/Λ ≈ 0.62) rounded up; a solver error of the fit's own size would show
 //! as a residual that does not oscillate, which the sign-change count below excludes.

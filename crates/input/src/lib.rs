@@ -13,6 +13,7 @@ pub mod error;
 pub mod files;
 pub mod gauges;
 pub mod kinds;
+pub mod layout;
 pub mod material;
 pub mod provenance;
 pub mod resources;

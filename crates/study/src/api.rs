@@ -11,6 +11,7 @@ use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_core::solver::ContactSeries;
 use shpb_input::files::{self, InputFile, Provenance};
+use shpb_input::layout::LayoutRecord;
 use shpb_input::prelude::*;
 use shpb_input::scene::Value;
 use shpb_input::{Error, Result, Validator};
@@ -310,7 +311,7 @@ pub fn reduce_record(
 }
 
 /// The choices of `shpb reduce` beyond the record and set-up (its flags; docs/physics.md §7).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RecordOptions {
     /// Dispersion correction (`--dispersion`, default Bancroft; `--no-dispersion` is `none`).
     pub dispersion: shpb_core::reduce::DispersionCorrection,
@@ -327,6 +328,8 @@ pub struct RecordOptions {
     /// A cylindrical specimen's geometry (`--specimen-length`, `--specimen-diameter`; default: a
     /// run file's own cylinder, if it has one).
     pub cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+    /// How to read a text record that is not the authors' CSV (`--layout`).
+    pub layout: Option<shpb_input::layout::RecordLayout>,
 }
 
 impl Default for RecordOptions {
@@ -338,6 +341,7 @@ impl Default for RecordOptions {
             smoothing_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
             window: None,
             cylinder: None,
+            layout: None,
         }
     }
 }
@@ -391,6 +395,17 @@ pub fn reduce_record_with(
         ));
     }
     let hdf5_input = shpb_output::reduction::is_hdf5(record)?;
+    if hdf5_input && let Some(layout) = &choices.layout {
+        return Err(input_err(
+            "--layout",
+            format!(
+                "{} is a run file (HDF5); the layout {} reads text exports",
+                record.display(),
+                layout.source
+            ),
+            "--layout only with text records",
+        ));
+    }
     let run = if hdf5_input { run_setup(record)? } else { None };
     let (apparatus, radii, run_cylinder) = match run {
         Some((run_apparatus, radii, run_cylinder)) => {
@@ -436,6 +451,20 @@ pub fn reduce_record_with(
             &ReductionSetup::from_apparatus(&apparatus)?,
             &options,
             &record.display().to_string(),
+        )?
+    } else if let Some(layout) = &choices.layout {
+        let name = record.display().to_string();
+        let input = match layout.read(record)? {
+            LayoutRecord::Voltages(raw) => {
+                shpb_core::reduce::record_strains(&raw, &apparatus, options.baseline_samples)?
+            }
+            LayoutRecord::Strains(input) => input,
+        };
+        shpb_core::reduce::reduce_named(
+            &input,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &options,
+            &name,
         )?
     } else {
         shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?

@@ -7,10 +7,21 @@ use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, check_output_path};
 use std::path::Path;
 
-/// `shpb strain RECORD [--bars SET-UP] [-o OUT.h5] [--csv OUT.csv] [--force]`.
+/// How `shpb strain` reads the record.
+pub struct StrainOptions<'a> {
+    /// A layout for a text record that is not the authors' CSV (`--layout`).
+    pub layout: Option<&'a Path>,
+    /// Samples at the start of each channel whose mean is removed (`--baseline-samples`; 0: off).
+    pub baseline_samples: usize,
+}
+
+/// `shpb strain RECORD [--bars SET-UP] [--layout FILE] [--baseline-samples N] [-o OUT.h5]
+/// [--csv OUT.csv] [--force]`: the record's bridge voltages, each channel's pre-trigger baseline
+/// removed as `shpb reduce` removes it, converted to bar strain through the set-up's channels.
 pub fn strain(
     record: &Path,
     bars: &Path,
+    read_as: StrainOptions,
     output: Option<&Path>,
     csv: Option<&Path>,
     force: bool,
@@ -19,19 +30,43 @@ pub fn strain(
         (output, "--output", &["h5", "hdf5"][..]),
         (csv, "--csv", &["csv"][..]),
     ];
+    let mut inputs_given = vec![record.to_path_buf(), bars.to_path_buf()];
+    inputs_given.extend(read_as.layout.map(Path::to_path_buf));
     for (p, flag, extensions) in outputs {
         if let Some(p) = p {
             check_output_path(p, force, flag, extensions)?;
-            check_not_input(p, flag, &[record.to_path_buf(), bars.to_path_buf()])?;
+            check_not_input(p, flag, &inputs_given)?;
         }
     }
     let (read, inputs) = shpb_input::files::capture(|| -> Result<_> {
-        Ok((
-            load_apparatus(bars)?,
-            shpb_core::gauge::RawRecord::read(record)?,
-        ))
+        let apparatus = load_apparatus(bars)?;
+        let rec = match read_as.layout {
+            None => shpb_core::gauge::RawRecord::read(record)?,
+            Some(l) => {
+                let layout = shpb_input::layout::RecordLayout::from_file(l)?;
+                match layout.read(record)? {
+                    shpb_input::layout::LayoutRecord::Voltages(r) => r,
+                    shpb_input::layout::LayoutRecord::Strains(_) => {
+                        return Err(Error::Input {
+                            file: layout.source.clone(),
+                            key: "incident.unit".into(),
+                            problem: "the layout reads bar strains; `shpb strain` converts bridge \
+                                      voltages"
+                                .into(),
+                            allowed: "a layout with V or mV channels (strain records go to \
+                                      `shpb reduce --layout` directly)"
+                                .into(),
+                        });
+                    }
+                }
+            }
+        };
+        Ok((apparatus, rec))
     });
-    let (apparatus, rec) = read?;
+    let (apparatus, mut rec) = read?;
+    let n = read_as.baseline_samples.min(rec.time_s.len() / 2);
+    rec.incident_v = shpb_core::gauge::remove_baseline(&rec.incident_v, n);
+    rec.transmission_v = shpb_core::gauge::remove_baseline(&rec.transmission_v, n);
     let mut gauges = Vec::new();
     for (name, volts) in [
         ("incident", &rec.incident_v),
@@ -61,7 +96,7 @@ pub fn strain(
         chain: None,
     };
     let text = format!(
-        "record = \"{}\"\nbars = \"{}\"\n",
+        "record = \"{}\"\nbars = \"{}\"\nbaseline_samples = {n}\n",
         record.display(),
         bars.display()
     );
