@@ -305,6 +305,7 @@ def reduce(
     smooth: float = 2e-6,
     specimen_length_m: Optional[float] = None,
     specimen_diameter_m: Optional[float] = None,
+    layout: Optional[PathLike] = None,
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -318,7 +319,8 @@ def reduce(
     ``reduction/cylinder/{one_wave,two_wave,three_wave}/
     {stress,strain,strain_rate,true_stress,true_strain}``, compression positive
     (docs/physics.md §7.8), and ``peak_stress``, ``strain_at_peak_stress``,
-    ``mean_strain_rate`` in the summary."""
+    ``mean_strain_rate`` in the summary. ``layout``: a record layout file (``--layout``) for a
+    lab's own text export."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -331,6 +333,7 @@ def reduce(
             float(smooth),
             specimen_length_m,
             specimen_diameter_m,
+            None if layout is None else os.fspath(layout),
         )
     )
 

@@ -50,6 +50,7 @@ def reduce(
     smooth: float = 2e-6,
     specimen_length_m: Optional[float] = None,
     specimen_diameter_m: Optional[float] = None,
+    layout: Optional[str] = None,
 ) -> RunData: ...
 def sweep(
     scene: str, set: Sequence[str], jobs: int = 1

@@ -333,7 +333,10 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
     let rms = (strains.iter().map(|e| e * e).sum::<f64>() / strains.len() as f64).sqrt();
     // The voltages' pre-trigger mean is removed exactly; the bridge's conversion is nonlinear by
     // O(V/V_ex) ≈ 1e-5, which is all that is left of it in the strains.
-    assert!(mean.abs() < 1e-4 * rms, "baseline mean {mean}, noise RMS {rms}");
+    assert!(
+        mean.abs() < 1e-4 * rms,
+        "baseline mean {mean}, noise RMS {rms}"
+    );
     std::fs::write(
         tmp.path().join("strain.toml"),
         "skip_lines = 1\ntime_column = 1\n[incident]\ncolumn = 2\nunit = \"strain\"\n\

@@ -501,10 +501,10 @@ fn curve<'py>(
 /// The lab's reduction of a raw record or run file (`shpb reduce`): `dispersion` is `none`,
 /// `bancroft` or `pochhammer-chree` (`--dispersion`), `tyas_pope` adds the Tyas–Pope factors,
 /// `align` is `geometric`, `foot` or `balance` (`--align`), `smooth` the moving-average width in
-/// s (`--smooth`); with a cylinder's length and diameter (m, both or neither) also its 1/2/3-wave
+/// s (`--smooth`), `layout` a record layout file (`--layout`); with a cylinder's length and diameter (m, both or neither) also its 1/2/3-wave
 /// curves (docs/physics.md §7.6–7.9).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None))]
 #[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
@@ -516,6 +516,7 @@ fn reduce(
     smooth: f64,
     specimen_length_m: Option<f64>,
     specimen_diameter_m: Option<f64>,
+    layout: Option<PathBuf>,
 ) -> PyResult<RunData> {
     let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
         return Err(input_error(
@@ -552,6 +553,10 @@ fn reduce(
             smoothing_s: smooth,
             window: None,
             cylinder: geometry,
+            layout: layout
+                .as_deref()
+                .map(shpb_input::layout::RecordLayout::from_file)
+                .transpose()?,
         };
         let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;
         let mut scene = format!(
