@@ -66,6 +66,13 @@
 //! [`Bar::kinetic_energy_j`]). Against the trapezoidal energy `½vᵀMv + ¼(u^{n−1}ᵀKu^{n−1} + u^nᵀKu^n)`
 //! it differs by `(Δt²/4) vᵀKv`: O((κ c Δt)²) relative for smooth waves, but m Δv²/4 per velocity
 //! step Δv of a sampled discontinuity (an impact), a quadrature error of the sampled field, not a loss.
+//!
+//! That identity is the bar's **energy ledger**: [`Bar::energy_j`] is carried from step to step by
+//! the end work less the absorbed energy (O(1) a step), rebased on a full recomputation
+//! ([`Bar::recomputed_energy_j`], a whole-bar pass) whenever masses or velocities are set outside a
+//! step. The ledger therefore proves nothing by itself; [`Bar::check_energy_ledger`] compares it
+//! with the recomputation, and the chain solver does so at a fixed interval and at the end of a
+//! run (`solver::chain::CHECK_INTERVAL_STEPS`).
 
 use crate::error::{Error, Named, Result};
 use std::f64::consts::PI;
@@ -544,7 +551,20 @@ pub struct Bar {
     last_force: [f64; 2],
     absorbed_j: f64,
     work_j: f64,
+    /// Kinetic + strain energy at n − 1/2 carried by the ledger: the last full recomputation plus
+    /// the end work and minus the absorbed energy of every step since (module docs, "Energy"), J.
+    ledger_j: f64,
+    /// The energy that has passed through the ledger (|energy| at the last full recomputation plus
+    /// every step's |work| and absorbed energy since): the scale of its rounding error, J.
+    ledger_turnover_j: f64,
 }
+
+/// Largest accepted difference between a bar's energy ledger and its full recomputation, relative
+/// to the energy that has passed through the ledger or, if larger, the energy in play around the
+/// bar (e.g. the whole chain's: [`Bar::check_energy_ledger`]). The two agree to rounding: each step
+/// adds a few ulp of the turnover, so 10⁶ steps stay near 1e-10; 1e-9 is the output tolerance of
+/// the results ("results unchanged", `validation/perf/REPORT.md`).
+pub const ENERGY_LEDGER_TOLERANCE: f64 = 1e-9;
 
 impl Bar {
     /// Builds the grid for time step Δt: n_k = ⌊L_k/(c_k Δt)⌋ ≥ 1 cells in segment k (Courant ≤ 1,
@@ -628,6 +648,8 @@ impl Bar {
             last_force: [0.0; 2],
             absorbed_j: 0.0,
             work_j: 0.0,
+            ledger_j: 0.0,
+            ledger_turnover_j: 0.0,
         };
         if spec.dispersion == Dispersion::LoveRod {
             bar.love = Some(LoveOperator {
@@ -700,6 +722,14 @@ impl Bar {
             }
         }
         self.update_free_rate();
+        self.rebase_energy_ledger();
+    }
+
+    /// Restarts the energy ledger from a full recomputation (after the masses or the velocities
+    /// were set outside a step).
+    fn rebase_energy_ledger(&mut self) {
+        self.ledger_j = self.recomputed_energy_j();
+        self.ledger_turnover_j = self.ledger_j.abs();
     }
 
     /// w = A⁻¹ (f_int(u^n) − D v^{n−1/2}): the free velocity change per unit time of the coming step.
@@ -900,6 +930,7 @@ impl Bar {
             self.v[n - 1] = 0.0;
         }
         self.update_free_rate();
+        self.rebase_energy_ledger();
     }
 
     /// Advances one step with external axial forces (N, toward +x) on the first and last node at the
@@ -941,8 +972,13 @@ impl Bar {
         }
         for (end, &node) in [0, last].iter().enumerate() {
             let mean = 0.5 * (v_before[end] + self.v[node]);
-            self.work_j += f[end] * mean * dt;
-            self.absorbed_j += self.end_impedance[end] * mean * mean * dt;
+            let work = f[end] * mean * dt;
+            let absorbed = self.end_impedance[end] * mean * mean * dt;
+            self.work_j += work;
+            self.absorbed_j += absorbed;
+            // The scheme's energy identity: E^{n+1/2} − E^{n−1/2} = Σ_ends (F − Z v̄) v̄ Δt.
+            self.ledger_j += work - absorbed;
+            self.ledger_turnover_j += work.abs() + absorbed;
         }
         self.last_force = f;
         self.step_index += 1;
@@ -1020,6 +1056,67 @@ impl Bar {
                 k * du * (du - dt * (vv[1] - vv[0]))
             })
             .sum::<f64>()
+    }
+
+    /// Kinetic plus strain energy at the half level n − 1/2 from the energy ledger: the last full
+    /// recomputation plus the end work less the absorbed energy of each step since, O(1), J. Equal
+    /// to [`Bar::recomputed_energy_j`] to rounding ([`Bar::check_energy_ledger`]).
+    pub fn energy_j(&self) -> f64 {
+        self.ledger_j
+    }
+
+    /// The energy that has passed through the ledger since its last rebase (|energy| then, plus
+    /// every step's |work| and absorbed energy), J: the scale of the ledger's rounding.
+    pub fn energy_turnover_j(&self) -> f64 {
+        self.ledger_turnover_j
+    }
+
+    /// Kinetic plus strain energy at the half level n − 1/2 summed over every node and element
+    /// (a whole-bar pass), J.
+    pub fn recomputed_energy_j(&self) -> f64 {
+        self.kinetic_energy_j() + self.strain_energy_j()
+    }
+
+    /// Compares the energy ledger with a full recomputation: Error::Unstable (naming step, time,
+    /// bar and the difference) if they differ by more than [`ENERGY_LEDGER_TOLERANCE`] of the
+    /// larger of the energy that has passed through the ledger and `scale_j` (the energy in play
+    /// around the bar, J: a bar reached only by a tiny precursor has a turnover of 1e-315 J, whose
+    /// rounding is judged against the energy of the test), or if the ledger is not finite.
+    pub fn check_energy_ledger(&self, scale_j: f64) -> Result<()> {
+        let full = self.recomputed_energy_j();
+        let difference = self.ledger_j - full;
+        let scale = self.ledger_turnover_j.max(scale_j);
+        if difference.is_finite() && difference.abs() <= ENERGY_LEDGER_TOLERANCE * scale {
+            return Ok(());
+        }
+        Err(Error::Unstable {
+            step: self.step_index,
+            time_s: self.time_s(),
+            quantity: format!(
+                "bar {}: energy ledger {:e} J minus its recomputation {full:e} J (allowed: {ENERGY_LEDGER_TOLERANCE:e} of {scale:e} J)",
+                self.name, self.ledger_j
+            ),
+            value: difference,
+        })
+    }
+
+    /// O(1) check of one step: the energy ledger is finite (it takes the end velocities every
+    /// step, so a non-finite value at an end, where the joints read the bar, shows at once); if it
+    /// is not, the whole-bar [`Bar::check_finite`] names the node.
+    pub fn check_step(&self) -> Result<()> {
+        if self.ledger_j.is_finite() {
+            return Ok(());
+        }
+        self.check_finite()?;
+        self.check_energy_ledger(0.0)
+    }
+
+    /// Test hook: sets v_i^{n−1/2} of node i and shifts the energy ledger by `ledger_offset_j`
+    /// without rebasing it (a state corrupted behind the ledger's back).
+    #[cfg(test)]
+    pub(crate) fn corrupt_for_test(&mut self, i: usize, v_m_s: f64, ledger_offset_j: f64) {
+        self.v[i] = v_m_s;
+        self.ledger_j += ledger_offset_j;
     }
 
     /// Energy that left through absorbing ends so far, Σ Z Δt ((v^{n+1/2} + v^{n−1/2})/2)², J.

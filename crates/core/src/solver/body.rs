@@ -177,11 +177,29 @@ impl Body {
         }
     }
 
-    /// Kinetic plus strain energy at the half level n − 1/2 (the scheme's conserved energy), J.
+    /// Kinetic plus strain energy at the half level n − 1/2 (the scheme's conserved energy), J: a
+    /// bar's from its energy ledger ([`Bar::energy_j`], O(1)), a mass's from its velocity.
     pub fn energy_j(&self) -> f64 {
         match self {
-            Body::Bar(b) => b.kinetic_energy_j() + b.strain_energy_j(),
+            Body::Bar(b) => b.energy_j(),
             Body::Mass(m) => 0.5 * m.mass_kg * m.velocity_m_s * m.velocity_m_s,
+        }
+    }
+
+    /// The energy that has passed through the body: a bar's ledger turnover
+    /// ([`Bar::energy_turnover_j`]), a mass's kinetic energy, J.
+    pub fn energy_turnover_j(&self) -> f64 {
+        match self {
+            Body::Bar(b) => b.energy_turnover_j(),
+            Body::Mass(_) => self.energy_j(),
+        }
+    }
+
+    /// [`Body::energy_j`] recomputed over the whole body (a bar: every node and element), J.
+    pub fn recomputed_energy_j(&self) -> f64 {
+        match self {
+            Body::Bar(b) => b.recomputed_energy_j(),
+            Body::Mass(_) => self.energy_j(),
         }
     }
 
@@ -190,6 +208,25 @@ impl Body {
         match self {
             Body::Bar(b) => b.absorbed_energy_j(),
             Body::Mass(_) => 0.0,
+        }
+    }
+
+    /// The O(1) check of every step: a bar's energy ledger is finite ([`Bar::check_step`]), a
+    /// mass's state is finite (Error::Unstable naming step, time and quantity).
+    pub fn check_step(&self) -> Result<()> {
+        match self {
+            Body::Bar(b) => b.check_step(),
+            Body::Mass(_) => self.check_finite(),
+        }
+    }
+
+    /// The full check of the interval: every value is finite, then a bar's energy ledger agrees
+    /// with its recomputation ([`Bar::check_energy_ledger`] with the energy in play `scale_j`, J).
+    pub fn check_full(&self, scale_j: f64) -> Result<()> {
+        self.check_finite()?;
+        match self {
+            Body::Bar(b) => b.check_energy_ledger(scale_j),
+            Body::Mass(_) => Ok(()),
         }
     }
 

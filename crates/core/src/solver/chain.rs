@@ -11,6 +11,14 @@
 //! changes by more than 1e-12 of the largest, which converges because the coupled system is
 //! monotone (each force falls as its neighbour's rises less than it rises with its own closure).
 //! Every joint then commits its memory once, and every body steps with its end forces.
+//!
+//! **Checks.** Every step costs O(1) per body beyond the leapfrog: the bars' energy ledgers are
+//! updated from their end work and absorbed energy and checked to be finite ([`Body::check_step`]),
+//! which catches at once a non-finite value at a bar's end, where the joints read it. Every
+//! [`CHECK_INTERVAL_STEPS`] steps and at the end of [`Chain::run`] each body is checked in full
+//! ([`Body::check_full`]: every value finite, each bar's ledger equal to its recomputation within
+//! [`crate::bar::ENERGY_LEDGER_TOLERANCE`]), so a non-finite value inside a bar is reported, with
+//! the step and time of detection and the bar and node, at most one interval after it appeared.
 
 use super::body::{Body, BodySpec};
 use super::joint::{Joint, JointPrediction, JointState};
@@ -19,6 +27,15 @@ use super::record::{
     SnapshotRecorder,
 };
 use crate::error::{Error, Result};
+
+/// Steps between two full checks of every body ([`Body::check_full`]: all values finite, energy
+/// ledgers equal to their recomputation). A full check costs about what one step of the leapfrog
+/// costs (three whole-bar passes), so every 256 steps it adds under 0.5 % to a run, while a
+/// non-finite value inside a bar is still reported at most 256 steps after it appeared: 53 µs of
+/// simulated time in a `standard` run (Δt = 0.21 µs, 3,228 steps: 13 checks with the one at the
+/// end), 6.6 µs in a `reference` run (Δt = 26 ns). A non-finite value at a bar's end, where the
+/// joints read it, is reported in the step it appears (the ledger, checked every step).
+pub const CHECK_INTERVAL_STEPS: usize = 256;
 
 /// Inputs of a chain run: bodies joined end to end, the first moving at the striker speed.
 #[derive(Debug, Clone)]
@@ -176,10 +193,25 @@ impl Chain {
             let left = if k > 0 { self.forces[k - 1] } else { 0.0 };
             let right = if k + 1 < n { -self.forces[k] } else { 0.0 };
             body.step(left, right);
-            body.check_finite()?;
+            body.check_step()?;
         }
         self.step_index += 1;
+        if self.step_index.is_multiple_of(CHECK_INTERVAL_STEPS) {
+            self.check()?;
+        }
         Ok(())
+    }
+
+    /// The full check of every body ([`Body::check_full`], each bar's ledger judged against the
+    /// larger of its own turnover and the largest of the chain's), made every
+    /// [`CHECK_INTERVAL_STEPS`] steps by [`Chain::step`] and at the end of [`Chain::run`].
+    pub fn check(&self) -> Result<()> {
+        let scale_j = self
+            .bodies
+            .iter()
+            .map(Body::energy_turnover_j)
+            .fold(0.0, f64::max);
+        self.bodies.iter().try_for_each(|b| b.check_full(scale_j))
     }
 
     /// Runs `steps` steps, calling every recorder before the first and after each step; stops
@@ -199,6 +231,9 @@ impl Chain {
                     time_s: self.time_s(),
                 });
             }
+        }
+        if !self.step_index.is_multiple_of(CHECK_INTERVAL_STEPS) {
+            self.check()?;
         }
         Ok(())
     }
@@ -290,6 +325,7 @@ mod tests {
     //! Chains of rigid spheres through the general chain solver, against Hertz impact theory
     //! (Johnson, Contact Mechanics §11.4) and the conservation of momentum and energy.
     use super::*;
+    use crate::bar::{BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
     use crate::contact::{LawKind, Region2Form, Unloading};
     use crate::solver::body::MassSpec;
     use crate::solver::{hertz_impact_duration, record::Recorder};
@@ -350,6 +386,114 @@ mod tests {
             snapshot_spacing_m: 1e-3,
         };
         (setup, tc, pair.sphere1.mass_kg)
+    }
+
+    /// A 0.2 m striker at 5 m/s on a 2 m incident bar of two diameters (an impedance step),
+    /// absorbing at its far end, through a butt joint; 1 mm cells.
+    fn bar_pair(dispersion: Dispersion) -> ChainSetup {
+        let material = BarMaterial {
+            density_kg_m3: 8000.0,
+            youngs_modulus_pa: 200e9,
+            poisson_ratio: 0.29,
+        };
+        let segment = |length_m: f64, diameter_m: f64| Segment {
+            length_m,
+            diameter_m,
+            material,
+        };
+        let bar = |name: &str, segments: Vec<Segment>, right_end: EndCondition| {
+            BodySpec::Bar(BarSpec {
+                name: name.into(),
+                segments,
+                left_end: EndCondition::Free,
+                right_end,
+                dispersion,
+            })
+        };
+        ChainSetup {
+            bodies: vec![
+                bar("striker", vec![segment(0.2, 0.02)], EndCondition::Free),
+                bar(
+                    "incident",
+                    vec![segment(1.0, 0.02), segment(1.0, 0.025)],
+                    EndCondition::Absorbing,
+                ),
+            ],
+            joints: vec![Joint::Butt],
+            striker_velocity_m_s: 5.0,
+            dt_s: 1e-3 / material.wave_speed_m_s(),
+            end_time_s: 1e-3,
+            gauges: vec![],
+            record_every: 1,
+            end_masses: vec![],
+            snapshot_every: None,
+            snapshot_spacing_m: 1e-3,
+        }
+    }
+
+    /// The O(1) ledgers carry the bars' energy through impact, transmission at a step in
+    /// impedance and absorption at the far end: equal to the whole-bar recomputation at every
+    /// step to rounding (1e-12 of the striker's energy), elementary and Love rod.
+    #[test]
+    fn energy_ledgers_equal_their_recomputation_at_every_step() {
+        for dispersion in [Dispersion::None, Dispersion::LoveRod] {
+            let setup = bar_pair(dispersion);
+            let mut chain = Chain::new(&setup).unwrap();
+            let e0 = chain.bodies[0].energy_j();
+            assert_eq!(e0, chain.bodies[0].recomputed_energy_j());
+            let steps = (setup.end_time_s / setup.dt_s) as usize;
+            let mut moved = 0.0f64;
+            for _ in 0..steps {
+                chain.step().unwrap();
+                for body in &chain.bodies {
+                    let (ledger, full) = (body.energy_j(), body.recomputed_energy_j());
+                    assert!(
+                        (ledger - full).abs() <= 1e-12 * e0,
+                        "{dispersion:?} {} step {}: {ledger} vs {full}",
+                        body.name(),
+                        chain.step_index()
+                    );
+                }
+                moved = moved.max(chain.bodies[1].energy_j());
+            }
+            // The test has teeth: most of the blow reached the incident bar.
+            assert!(moved > 0.5 * e0, "{dispersion:?}: {moved} of {e0}");
+            chain.check().unwrap();
+        }
+    }
+
+    /// A NaN inside a bar, 1000 nodes from either end (where the every-step ledger check would
+    /// see it at once), is reported by the full check at the end of its interval, naming the bar
+    /// and the node; a ledger shifted behind the bar's back is reported the same way.
+    #[test]
+    fn a_corrupted_bar_is_reported_within_one_check_interval() {
+        for (value, offset, what) in [(f64::NAN, 0.0, "of node"), (0.0, 1e-3, "energy ledger")] {
+            let setup = bar_pair(Dispersion::None);
+            let mut chain = Chain::new(&setup).unwrap();
+            let start = 10;
+            for _ in 0..start {
+                chain.step().unwrap();
+            }
+            let Body::Bar(bar) = &mut chain.bodies[1] else {
+                unreachable!("the incident bar")
+            };
+            let mid = bar.node_count() / 2;
+            bar.corrupt_for_test(mid, value, offset);
+            match chain.run(2 * CHECK_INTERVAL_STEPS, &mut []).unwrap_err() {
+                Error::Unstable {
+                    step,
+                    time_s,
+                    quantity,
+                    ..
+                } => {
+                    assert_eq!(step, CHECK_INTERVAL_STEPS, "{quantity}");
+                    assert!((time_s - step as f64 * setup.dt_s).abs() < 1e-9 * time_s);
+                    assert!(quantity.contains("bar incident"), "{quantity}");
+                    assert!(quantity.contains(what), "{quantity}");
+                }
+                other => panic!("expected Unstable, got {other}"),
+            }
+        }
     }
 
     #[test]
