@@ -224,6 +224,15 @@ fn smoothing_and_window_flags_are_checked_and_named() {
     );
 }
 
+/// The JSON text of `shpb --json reduce ARGS` run in `dir` (which must succeed).
+fn reduce_json(dir: &std::path::Path, args: &[&str]) -> String {
+    let mut all = vec!["--json", "reduce"];
+    all.extend_from_slice(args);
+    let out = shpb(dir, &all);
+    assert!(out.status.success(), "{}", stderr(&out));
+    stdout(&out)
+}
+
 /// The authors' CSV record as (time, incident V, transmission V) rows.
 fn csv_rows(path: &str) -> Vec<[f64; 3]> {
     std::fs::read_to_string(path)
@@ -267,13 +276,7 @@ fn a_scope_export_and_a_labview_file_reduce_as_the_authors_csv() {
          [transmission]\ncolumn = 3\nunit = \"mV\"\npolarity = -1\n",
     )
     .unwrap();
-    let json = |args: &[&str]| {
-        let mut all = vec!["--json", "reduce"];
-        all.extend_from_slice(args);
-        let out = shpb(tmp.path(), &all);
-        assert!(out.status.success(), "{}", stderr(&out));
-        stdout(&out)
-    };
+    let json = |args: &[&str]| reduce_json(tmp.path(), args);
     let reference = json(&[rec, "--bars", "authors"]);
     let lvm_layout = repo_path("layouts/authors-lvm.toml");
     for got in [
@@ -343,13 +346,7 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
          [transmission]\ncolumn = 4\nunit = \"strain\"\n",
     )
     .unwrap();
-    let json = |args: &[&str]| {
-        let mut all = vec!["--json", "reduce"];
-        all.extend_from_slice(args);
-        let out = shpb(tmp.path(), &all);
-        assert!(out.status.success(), "{}", stderr(&out));
-        stdout(&out)
-    };
+    let json = |args: &[&str]| reduce_json(tmp.path(), args);
     let raw = json(&[rec, "--bars", "authors"]);
     let via = json(&["strain.csv", "--layout", "strain.toml", "--bars", "authors"]);
     for key in ["peak_back_force_N", "displacement_at_peak_force_m"] {
