@@ -372,3 +372,47 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
     let raw_text = std::fs::read_to_string(tmp.path().join("raw.csv")).unwrap();
     assert_ne!(raw_text.lines().nth(1), text.lines().nth(1));
 }
+
+#[test]
+fn a_run_and_shpb_reduce_of_its_file_agree_at_any_smoothing() {
+    // The same smoothing option for simulated and real records: the scene key `smooth_s` sets
+    // the run's own reduction, `--smooth` any record's; equal widths give equal numbers.
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo_path("scenes/shpb-ss440c-10psi.toml"))
+        .unwrap()
+        .replace("bars = \"../bars/authors.toml\"", "bars = \"authors\"");
+    for (width, flag) in [("0", "0"), ("5e-6", "5e-6")] {
+        let scene = tmp.path().join(format!("s{flag}.toml"));
+        std::fs::write(&scene, format!("smooth_s = {width}\n{text}")).unwrap();
+        let h5 = format!("run{flag}.h5");
+        let out = shpb(
+            tmp.path(),
+            &["--json", "run", scene.to_str().unwrap(), "-o", &h5],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let run = stdout(&out);
+        // The bars of this scene do not disperse, so its run reduces without a correction.
+        let reduced = reduce_json(tmp.path(), &[&h5, "--smooth", flag, "--dispersion", "none"]);
+        let (a, b) = (
+            number(&run, "reduced_peak_back_force_N"),
+            number(&reduced, "peak_back_force_N"),
+        );
+        assert_eq!(a, b, "smooth_s = {width}");
+    }
+    // Out of range, and in a scene without a reduction, named.
+    let scene = tmp.path().join("bad.toml");
+    std::fs::write(&scene, format!("smooth_s = -1e-6\n{text}")).unwrap();
+    let out = shpb(tmp.path(), &["run", scene.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("`smooth_s`"), "{}", stderr(&out));
+    let pulse = std::fs::read_to_string(repo_path("scenes/pulse-10psi.toml"))
+        .unwrap()
+        .replace("bars = \"../bars/authors.toml\"", "bars = \"authors\"");
+    std::fs::write(&scene, format!("smooth_s = 2e-6\n{pulse}")).unwrap();
+    let out = shpb(tmp.path(), &["run", scene.to_str().unwrap()]);
+    assert!(
+        stderr(&out).contains("only in shpb scenes"),
+        "{}",
+        stderr(&out)
+    );
+}
