@@ -457,7 +457,11 @@ pub fn reduce_record_with(
             None
         };
         let input = match voltages {
-            Some((time_s, incident_v, transmission_v)) => {
+            Some(shpb_core::gauge::RawRecord {
+                time_s,
+                incident_v,
+                transmission_v,
+            }) => {
                 let channel = |name: &str| {
                     apparatus.gauges.channel(name).ok_or_else(|| {
                         input_err(
