@@ -98,11 +98,7 @@ pub mod quality;
 pub use align::{Alignment, AlignmentReport};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
 
-/// Default width of the moving average applied to a record before its reduction, s: 2 µs (20
-/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
-/// < 0.02 % of its peak. `shpb run` applies it to simulated records, `shpb reduce` to any record,
-/// so that the two read alike.
-pub const DEFAULT_SMOOTHING_S: f64 = 2e-6;
+pub use crate::gauge::DEFAULT_SMOOTHING_S;
 
 /// Default bound of the balance search on each window shift, s: 20 µs, more than the 14 µs by
 /// which the authors' reflected pulses precede their stated gauge distance.
