@@ -32,7 +32,12 @@ def h5_datasets(path):
 def h5_summary(path):
     with h5py.File(path, "r") as f:
         s = f["summary"]
-        return {k: float(v) for k, v in s.attrs.items() if k not in ("units", "warnings")}
+        # Numbers only: the text attributes (units, warnings, alignment, verdict) are not items.
+        return {
+            k: float(v)
+            for k, v in s.attrs.items()
+            if not isinstance(v, (str, bytes)) and k not in ("units", "warnings")
+        }
 
 
 def same(a, b):

@@ -316,10 +316,11 @@ pub enum Command {
     },
     /// Reduce a gauge record like the lab: forces at both faces, sphere approach, strain rate.
     ///
-    /// Accepts the authors' raw CSV (time_s, incident_V, transmission_V) or an HDF5 file written by
-    /// `shpb run` (/time, /gauges/{incident,transmission}/strain). Writes /reduction/{time,
-    /// displacement, force_front, force_back, force_3wave, strain_rate, equilibrium_ratio,
-    /// approach_velocity}.
+    /// Accepts the authors' raw CSV (time_s, incident_V, transmission_V), any text record with
+    /// --layout, or an HDF5 file written by `shpb run` (its digitised /gauges/*/voltage read
+    /// through the run's own bridges; a file without voltages by its /gauges/*/strain). Writes
+    /// /reduction/{time, displacement, force_front, force_back, force_3wave, strain_rate,
+    /// equilibrium_ratio, approach_velocity}; several records make a batch.
     Reduce {
         /// The records (.csv or .h5); several reduce as a batch (see --summary, --report).
         #[arg(required = true, num_args = 1..)]

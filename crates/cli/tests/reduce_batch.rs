@@ -224,6 +224,15 @@ fn smoothing_and_window_flags_are_checked_and_named() {
     );
 }
 
+/// The JSON text of `shpb --json reduce ARGS` run in `dir` (which must succeed).
+fn reduce_json(dir: &std::path::Path, args: &[&str]) -> String {
+    let mut all = vec!["--json", "reduce"];
+    all.extend_from_slice(args);
+    let out = shpb(dir, &all);
+    assert!(out.status.success(), "{}", stderr(&out));
+    stdout(&out)
+}
+
 /// The authors' CSV record as (time, incident V, transmission V) rows.
 fn csv_rows(path: &str) -> Vec<[f64; 3]> {
     std::fs::read_to_string(path)
@@ -267,13 +276,7 @@ fn a_scope_export_and_a_labview_file_reduce_as_the_authors_csv() {
          [transmission]\ncolumn = 3\nunit = \"mV\"\npolarity = -1\n",
     )
     .unwrap();
-    let json = |args: &[&str]| {
-        let mut all = vec!["--json", "reduce"];
-        all.extend_from_slice(args);
-        let out = shpb(tmp.path(), &all);
-        assert!(out.status.success(), "{}", stderr(&out));
-        stdout(&out)
-    };
+    let json = |args: &[&str]| reduce_json(tmp.path(), args);
     let reference = json(&[rec, "--bars", "authors"]);
     let lvm_layout = repo_path("layouts/authors-lvm.toml");
     for got in [
@@ -343,13 +346,7 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
          [transmission]\ncolumn = 4\nunit = \"strain\"\n",
     )
     .unwrap();
-    let json = |args: &[&str]| {
-        let mut all = vec!["--json", "reduce"];
-        all.extend_from_slice(args);
-        let out = shpb(tmp.path(), &all);
-        assert!(out.status.success(), "{}", stderr(&out));
-        stdout(&out)
-    };
+    let json = |args: &[&str]| reduce_json(tmp.path(), args);
     let raw = json(&[rec, "--bars", "authors"]);
     let via = json(&["strain.csv", "--layout", "strain.toml", "--bars", "authors"]);
     for key in ["peak_back_force_N", "displacement_at_peak_force_m"] {
@@ -374,4 +371,48 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
     assert!(out.status.success(), "{}", stderr(&out));
     let raw_text = std::fs::read_to_string(tmp.path().join("raw.csv")).unwrap();
     assert_ne!(raw_text.lines().nth(1), text.lines().nth(1));
+}
+
+#[test]
+fn a_run_and_shpb_reduce_of_its_file_agree_at_any_smoothing() {
+    // The same smoothing option for simulated and real records: the scene key `smooth_s` sets
+    // the run's own reduction, `--smooth` any record's; equal widths give equal numbers.
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo_path("scenes/shpb-ss440c-10psi.toml"))
+        .unwrap()
+        .replace("bars = \"../bars/authors.toml\"", "bars = \"authors\"");
+    for (width, flag) in [("0", "0"), ("5e-6", "5e-6")] {
+        let scene = tmp.path().join(format!("s{flag}.toml"));
+        std::fs::write(&scene, format!("smooth_s = {width}\n{text}")).unwrap();
+        let h5 = format!("run{flag}.h5");
+        let out = shpb(
+            tmp.path(),
+            &["--json", "run", scene.to_str().unwrap(), "-o", &h5],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let run = stdout(&out);
+        // The bars of this scene do not disperse, so its run reduces without a correction.
+        let reduced = reduce_json(tmp.path(), &[&h5, "--smooth", flag, "--dispersion", "none"]);
+        let (a, b) = (
+            number(&run, "reduced_peak_back_force_N"),
+            number(&reduced, "peak_back_force_N"),
+        );
+        assert_eq!(a, b, "smooth_s = {width}");
+    }
+    // Out of range, and in a scene without a reduction, named.
+    let scene = tmp.path().join("bad.toml");
+    std::fs::write(&scene, format!("smooth_s = -1e-6\n{text}")).unwrap();
+    let out = shpb(tmp.path(), &["run", scene.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("`smooth_s`"), "{}", stderr(&out));
+    let pulse = std::fs::read_to_string(repo_path("scenes/pulse-10psi.toml"))
+        .unwrap()
+        .replace("bars = \"../bars/authors.toml\"", "bars = \"authors\"");
+    std::fs::write(&scene, format!("smooth_s = 2e-6\n{pulse}")).unwrap();
+    let out = shpb(tmp.path(), &["run", scene.to_str().unwrap()]);
+    assert!(
+        stderr(&out).contains("only in shpb scenes"),
+        "{}",
+        stderr(&out)
+    );
 }

@@ -254,6 +254,10 @@ pub struct PulseOptions {
     pub gauge_length_m: f64,
     /// Interval of the x–t stress snapshots of the bars, s (None: none).
     pub snapshot_interval_s: Option<f64>,
+    /// Width of the moving average applied to the simulated records before their reduction, s
+    /// (scene key `smooth_s`; `crate::gauge::DEFAULT_SMOOTHING_S` unless set), as
+    /// `shpb reduce --smooth` applies it to any record.
+    pub reduction_smoothing_s: f64,
 }
 
 impl Apparatus {
@@ -466,6 +470,7 @@ impl Apparatus {
             end_time_s,
             gauge_length_m,
             snapshot_interval_s: None,
+            reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
         });
         let k = setup
             .gauges

@@ -98,11 +98,7 @@ pub mod quality;
 pub use align::{Alignment, AlignmentReport};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
 
-/// Default width of the moving average applied to a record before its reduction, s: 2 µs (20
-/// samples at 10 MHz) cuts the digitiser noise √20-fold and changes a pulse rising in ≥ 40 µs by
-/// < 0.02 % of its peak. `shpb run` applies it to simulated records, `shpb reduce` to any record,
-/// so that the two read alike.
-pub const DEFAULT_SMOOTHING_S: f64 = 2e-6;
+pub use crate::gauge::DEFAULT_SMOOTHING_S;
 
 /// Default bound of the balance search on each window shift, s: 20 µs, more than the 14 µs by
 /// which the authors' reflected pulses precede their stated gauge distance.
@@ -996,21 +992,30 @@ pub fn reduce_named(
     let geometric_r = 2.0 * d_i / c_i;
     let geometric_t = d_i / c_i + d_t / c_t + options.specimen_transit_s;
     let s_i = (incident_start_s - t0) / dt;
-    let measured_reflected_delay_s = align::reflected_foot_delay_s(
-        &eps_i,
-        dt,
-        s_i,
-        geometric_r,
-        incident_peak,
-        options.start_fraction,
-    );
+    // The reflected pulse: the first tensile one, at least 10 % of the incident peak (a
+    // specimen that reflects almost nothing has no foot to measure).
+    let measured_reflected_delay_s = (incident_peak > 0.0)
+        .then(|| {
+            align::foot_delay_s(
+                &eps_i,
+                1.0,
+                dt,
+                s_i,
+                geometric_r,
+                0.1 * incident_peak,
+                options.start_fraction,
+            )
+        })
+        .flatten();
     let noise_t = quality::baseline_rms(&eps_t, nb);
-    let measured_transmitted_delay_s = align::transmitted_foot_delay_s(
+    // The transmitted pulse: the first compressive one, above 10 times the gauge's noise.
+    let measured_transmitted_delay_s = align::foot_delay_s(
         &eps_t,
+        -1.0,
         dt,
         s_i,
         geometric_t,
-        noise_t,
+        10.0 * noise_t,
         options.start_fraction,
     );
     // One exact first mode per bar, its roots shared by all its windows.

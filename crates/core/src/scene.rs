@@ -689,7 +689,7 @@ fn reduce_simulated_records(
             crate::reduce::DispersionCorrection::Bancroft
         },
         specimen_radii_m: specimen_radii,
-        smoothing_window_s: crate::reduce::DEFAULT_SMOOTHING_S,
+        smoothing_window_s: options.reduction_smoothing_s,
         ..Default::default()
     };
     crate::reduce::reduce(

@@ -30,6 +30,29 @@ pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
     })
 }
 
+/// `/time` and `/gauges/{incident,transmission}/voltage` of a run file (the digitised bridge
+/// outputs, V), or None when the file has no such datasets.
+pub fn read_hdf5_voltages(path: &Path) -> Result<Option<shpb_core::gauge::RawRecord>> {
+    let f = hdf5::File::open(path).map_err(h5err(path))?;
+    let read = |name: &str| -> Option<Vec<f64>> { f.dataset(name).ok()?.read_raw::<f64>().ok() };
+    Ok(
+        match (
+            read("time"),
+            read("gauges/incident/voltage"),
+            read("gauges/transmission/voltage"),
+        ) {
+            (Some(time_s), Some(incident_v), Some(transmission_v)) => {
+                Some(shpb_core::gauge::RawRecord {
+                    time_s,
+                    incident_v,
+                    transmission_v,
+                })
+            }
+            _ => None,
+        },
+    )
+}
+
 /// Whether `path` starts with the HDF5 signature.
 pub fn is_hdf5(path: &Path) -> Result<bool> {
     use std::io::Read;

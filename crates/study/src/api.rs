@@ -6,7 +6,9 @@ use crate::sweep::{Axis, RunSummary};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
-use shpb_core::reduce::{PAPER_SPHERE_RADII_M, Reduction, ReductionOptions, ReductionSetup};
+use shpb_core::reduce::{
+    PAPER_SPHERE_RADII_M, Reduction, ReductionInput, ReductionOptions, ReductionSetup,
+};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_core::solver::ContactSeries;
@@ -407,6 +409,7 @@ pub fn reduce_record_with(
         ));
     }
     let run = if hdf5_input { run_setup(record)? } else { None };
+    let own_set_up = run.is_some();
     let (apparatus, radii, run_cylinder) = match run {
         Some((run_apparatus, radii, run_cylinder)) => {
             if let Some(flag) = bars_flag {
@@ -445,7 +448,41 @@ pub fn reduce_record_with(
         ..ReductionOptions::default()
     };
     let reduction = if hdf5_input {
-        let input = shpb_output::reduction::read_hdf5_strains(record)?;
+        // A run file with its own set-up is read as the lab reads a record: its digitised
+        // voltages through the set-up's bridges, exactly as the run reduced them; otherwise (a
+        // file of `shpb strain`, or without voltages) its strains.
+        let voltages = if own_set_up {
+            shpb_output::reduction::read_hdf5_voltages(record)?
+        } else {
+            None
+        };
+        let input = match voltages {
+            Some(shpb_core::gauge::RawRecord {
+                time_s,
+                incident_v,
+                transmission_v,
+            }) => {
+                let channel = |name: &str| {
+                    apparatus.gauges.channel(name).ok_or_else(|| {
+                        input_err(
+                            "RECORD",
+                            format!(
+                                "the run's set-up {} has no `{name}` gauge",
+                                apparatus.source
+                            ),
+                            "a run file of a set-up with incident and transmission gauges",
+                        )
+                    })
+                };
+                ReductionInput {
+                    time_s,
+                    incident_strain: channel("incident")?.strains_from_voltages(&incident_v),
+                    transmission_strain: channel("transmission")?
+                        .strains_from_voltages(&transmission_v),
+                }
+            }
+            None => shpb_output::reduction::read_hdf5_strains(record)?,
+        };
         shpb_core::reduce::reduce_named(
             &input,
             &ReductionSetup::from_apparatus(&apparatus)?,

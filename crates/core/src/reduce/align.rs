@@ -58,48 +58,27 @@ pub struct AlignmentReport {
     pub at_bound: bool,
 }
 
-/// Foot of the first tensile pulse of the incident gauge after the incident foot — the reflected
-/// pulse — minus the incident foot, s. Searched from half the geometric delay to twice it; kept
-/// only when that pulse reaches 10 % of the incident peak (a specimen that reflects almost
-/// nothing has no foot to measure). `s_i`: incident foot, fractional sample index.
-pub(crate) fn reflected_foot_delay_s(
-    eps_i: &[f64],
+/// Foot of the first pulse of sense `sign` (+1 tensile, −1 compressive) on a gauge's strain
+/// `eps` after the incident foot (fractional sample `s_i`) minus that foot, s: searched from half
+/// the geometric delay to twice it, and kept only when the pulse's peak (in that sense) reaches
+/// `least` — a pulse that does not stand out has no foot to measure.
+pub(crate) fn foot_delay_s(
+    eps: &[f64],
+    sign: f64,
     dt: f64,
     s_i: f64,
     geometric_s: f64,
-    incident_peak: f64,
+    least: f64,
     fraction: f64,
 ) -> Option<f64> {
     let from = (s_i + 0.5 * geometric_s / dt).max(0.0) as usize;
-    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps_i.len());
-    if from + 2 >= to || incident_peak <= 0.0 {
-        return None;
-    }
-    let y = &eps_i[from..to];
-    pulse_foot(y, fraction)
-        .filter(|f| y[f.peak_index] >= 0.1 * incident_peak)
-        .map(|f| (from as f64 + f.index as f64 - s_i) * dt)
-}
-
-/// Foot of the first compressive pulse of the transmission gauge after the incident foot minus
-/// the incident foot, s; searched from half the geometric delay to twice it. None when that
-/// gauge shows no pulse above 10 times its baseline RMS `noise`.
-pub(crate) fn transmitted_foot_delay_s(
-    eps_t: &[f64],
-    dt: f64,
-    s_i: f64,
-    geometric_s: f64,
-    noise: f64,
-    fraction: f64,
-) -> Option<f64> {
-    let from = (s_i + 0.5 * geometric_s / dt).max(0.0) as usize;
-    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps_t.len());
+    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps.len());
     if from + 2 >= to {
         return None;
     }
-    let y: Vec<f64> = eps_t[from..to].iter().map(|e| -e).collect();
+    let y: Vec<f64> = eps[from..to].iter().map(|e| sign * e).collect();
     pulse_foot(&y, fraction)
-        .filter(|f| y[f.peak_index] > 10.0 * noise)
+        .filter(|f| y[f.peak_index] > least)
         .map(|f| (from as f64 + f.index as f64 - s_i) * dt)
 }
 

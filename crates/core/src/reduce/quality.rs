@@ -131,35 +131,13 @@ pub fn wave_metrics(
     compressive: bool,
 ) -> Option<WaveMetrics> {
     let sign = if compressive { -1.0 } else { 1.0 };
-    let y: Vec<f64> = strain.iter().map(|e| sign * e).collect();
-    if time_s.len() != y.len() || y.len() < 3 {
-        return None;
-    }
-    let k = crate::numeric::argmax(&y);
-    let p = y[k];
-    if p.is_nan() || p <= 0.0 {
-        return None;
-    }
-    let cross = |i: usize, level: f64| {
-        time_s[i] + (level - y[i]) * (time_s[i + 1] - time_s[i]) / (y[i + 1] - y[i])
-    };
-    let rising = |level: f64| {
-        (0..k)
-            .rev()
-            .find(|&i| y[i] < level)
-            .map(|i| cross(i, level))
-    };
-    let start = rising(0.1 * p)?;
-    let t90 = rising(0.9 * p)?;
-    let end = (k + 1..y.len())
-        .find(|&j| y[j] < 0.1 * p)
-        .map_or(f64::NAN, |j| cross(j - 1, 0.1 * p));
+    let e = crate::gauge::pulse_edges(time_s, strain, sign)?;
     let dt = time_s[1] - time_s[0];
     let e_a_c = bar.youngs_modulus_pa * bar.area_m2 * bar.wave_speed_m_s;
     Some(WaveMetrics {
-        peak_stress_pa: bar.youngs_modulus_pa * p,
-        rise_10_90_s: t90 - start,
-        duration_10_s: end - start,
+        peak_stress_pa: bar.youngs_modulus_pa * e.peak,
+        rise_10_90_s: e.rise_90_s - e.start_10_s,
+        duration_10_s: e.fall_10_s.map_or(f64::NAN, |end| end - e.start_10_s),
         energy_j: e_a_c * strain.iter().map(|e| e * e).sum::<f64>() * dt,
     })
 }

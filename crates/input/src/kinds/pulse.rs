@@ -97,6 +97,14 @@ pub(super) const GAUGE_LENGTH: Key = Key {
     meaning: "grid length of the strain gauges (they read the mean strain over it), 0 to 0.05",
 };
 
+/// `smooth_s` (shpb only).
+pub(super) const SMOOTH: Key = Key {
+    key: "smooth_s",
+    unit: "s",
+    default: "2e-6",
+    meaning: "width of the moving average applied to the simulated gauge records before the lab's reduction, as `shpb reduce --smooth` applies it to real ones; 0 (off) to 1e-4",
+};
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PulseFile {
@@ -122,6 +130,7 @@ struct PulseFile {
     end_time_s: Option<f64>,
     #[serde(default = "default_gauge_length")]
     gauge_length_m: f64,
+    smooth_s: Option<f64>,
 }
 
 fn default_gauge_length() -> f64 {
@@ -270,6 +279,17 @@ pub(super) fn parse_bars(
         None => default_end,
     };
     let gauge_length_m = v.in_range("gauge_length_m", f.gauge_length_m, 0.0, 0.05, "m")?;
+    let reduction_smoothing_s = match (f.smooth_s, is_test) {
+        (None, _) => shpb_core::reduce::DEFAULT_SMOOTHING_S,
+        (Some(w), true) => v.in_range("smooth_s", w, 0.0, 1e-4, "s")?,
+        (Some(_), false) => {
+            return Err(v.error(
+                "smooth_s",
+                "given in a pulse scene, which has no reduction",
+                "smooth_s only in shpb scenes",
+            ));
+        }
+    };
     let options = PulseOptions {
         specimen: specimen.clone(),
         cylinder,
@@ -281,6 +301,7 @@ pub(super) fn parse_bars(
         end_time_s,
         gauge_length_m,
         snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
+        reduction_smoothing_s,
     };
     // Refuse a run too large for this machine before its bars are built (below), then a grid
     // the bars cannot run (time step over the stability limit) now, not mid-run.
@@ -349,7 +370,10 @@ mod tests {
     fn registry_entry() {
         // A pulse scene accepts but refuses `specimen`, and has no use for `law`, `region2` and
         // `unloading`.
-        super::super::check_kind(&KIND, &["specimen", "law", "region2", "unloading"]);
+        super::super::check_kind(
+            &KIND,
+            &["specimen", "law", "region2", "unloading", "smooth_s"],
+        );
         check_bar_key_docs();
         assert_eq!(KIND.keys[4].default, default_incident_end());
     }

@@ -1,7 +1,9 @@
 //! `kind = "shpb"`: the whole virtual test, a pulse scene ([`super::pulse`]) with two spheres
 //! between the bars, gauges and the lab's reduction.
 
-use super::pulse::{self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER};
+use super::pulse::{
+    self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER, SMOOTH,
+};
 use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
 use shpb_core::fidelity::Fidelity;
@@ -23,6 +25,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         DISPERSION,
         END_TIME,
         GAUGE_LENGTH,
+        SMOOTH,
     ],
     example: "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nspecimen = { pair = \"ss440c\" }\n",
     example_dir: None,
