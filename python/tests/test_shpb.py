@@ -545,3 +545,23 @@ def test_bad_records_raise_input_error_with_the_cli_message(cli, tmp_path):
         with pytest.raises(shpb.InputError) as e:
             shpb.reduce(record)
         assert str(e.value).strip() == message, record
+
+
+def test_reduce_layout_keyword_equals_the_flag(cli, tmp_path):
+    # A record in the authors' LabVIEW layout (four tab-separated columns, no header), written
+    # from the CSV, reduced by `shpb reduce --layout` and by shpb.reduce(layout=): the same
+    # datasets, and the same numbers as the CSV itself.
+    rows = [
+        l.split(",")
+        for l in (ROOT / RECORD).read_text().splitlines()
+        if l and not l.startswith("#") and not l.startswith("time_s")
+    ]
+    lvm = tmp_path / "record.lvm"
+    lvm.write_text("".join(f"{t}\t{i}\t{t}\t{tr}\n" for t, i, tr in rows))
+    layout = ROOT / "layouts" / "authors-lvm.toml"
+    cli("reduce", lvm, "--layout", layout, "--bars", "authors", "-o", tmp_path / "lvm.h5")
+    r = shpb.reduce(lvm, bars="authors", layout=layout)
+    for k, (data, units) in h5_datasets(tmp_path / "lvm.h5").items():
+        assert same(r[k], data), k
+    csv = shpb.reduce(RECORD, bars="authors")
+    assert same(r["reduction/force_back"], csv["reduction/force_back"])
