@@ -233,6 +233,23 @@ fn reduce_json(dir: &std::path::Path, args: &[&str]) -> String {
     stdout(&out)
 }
 
+/// Asserts that the JSON texts `a` and `b` give the numbers `keys` within 1e-9 of each other.
+fn same_numbers(a: &str, b: &str, keys: &[&str]) {
+    for key in keys {
+        let (x, y) = (number(a, key), number(b, key));
+        assert!((x - y).abs() <= 1e-9 * x.abs(), "{key}: {x} vs {y}");
+    }
+}
+
+/// The CSV text of `shpb strain RECORD --bars authors --csv NAME [EXTRA]` run in `dir`.
+fn strain_csv(dir: &std::path::Path, record: &str, name: &str, extra: &[&str]) -> String {
+    let mut args = vec!["-q", "strain", record, "--bars", "authors", "--csv", name];
+    args.extend_from_slice(extra);
+    let out = shpb(dir, &args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::read_to_string(dir.join(name)).unwrap()
+}
+
 /// The authors' CSV record as (time, incident V, transmission V) rows.
 fn csv_rows(path: &str) -> Vec<[f64; 3]> {
     std::fs::read_to_string(path)
@@ -283,15 +300,16 @@ fn a_scope_export_and_a_labview_file_reduce_as_the_authors_csv() {
         json(&["scope.txt", "--layout", "scope.toml", "--bars", "authors"]),
         json(&["sample2.lvm", "--layout", &lvm_layout, "--bars", "authors"]),
     ] {
-        for key in [
-            "peak_back_force_N",
-            "displacement_at_peak_force_m",
-            "equilibrium_ratio_at_peak",
-        ] {
-            let (a, b) = (number(&reference, key), number(&got, key));
-            // Only the text round trip of each sample (17 significant digits) differs.
-            assert!((a - b).abs() <= 1e-9 * a.abs(), "{key}: {a} vs {b}");
-        }
+        // Only the text round trip of each sample (17 significant digits) differs.
+        same_numbers(
+            &reference,
+            &got,
+            &[
+                "peak_back_force_N",
+                "displacement_at_peak_force_m",
+                "equilibrium_ratio_at_peak",
+            ],
+        );
     }
     // A record that the layout does not fit is refused naming the line and the column.
     let out = shpb(
@@ -312,20 +330,7 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
     // read back through a strain layout, reduces to the raw record's numbers.
     let tmp = tempfile::tempdir().unwrap();
     let rec = &records()[0];
-    let out = shpb(
-        tmp.path(),
-        &[
-            "-q",
-            "strain",
-            rec,
-            "--bars",
-            "authors",
-            "--csv",
-            "strain.csv",
-        ],
-    );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let text = std::fs::read_to_string(tmp.path().join("strain.csv")).unwrap();
+    let text = strain_csv(tmp.path(), rec, "strain.csv", &[]);
     let strains: Vec<f64> = text
         .lines()
         .skip(1)
@@ -349,27 +354,13 @@ fn shpb_strain_removes_the_baseline_and_its_strains_reduce_as_the_raw_record() {
     let json = |args: &[&str]| reduce_json(tmp.path(), args);
     let raw = json(&[rec, "--bars", "authors"]);
     let via = json(&["strain.csv", "--layout", "strain.toml", "--bars", "authors"]);
-    for key in ["peak_back_force_N", "displacement_at_peak_force_m"] {
-        let (a, b) = (number(&raw, key), number(&via, key));
-        assert!((a - b).abs() <= 1e-9 * a.abs(), "{key}: {a} vs {b}");
-    }
-    // `--baseline-samples 0` keeps the record's offsets.
-    let out = shpb(
-        tmp.path(),
-        &[
-            "-q",
-            "strain",
-            rec,
-            "--bars",
-            "authors",
-            "--csv",
-            "raw.csv",
-            "--baseline-samples",
-            "0",
-        ],
+    same_numbers(
+        &raw,
+        &via,
+        &["peak_back_force_N", "displacement_at_peak_force_m"],
     );
-    assert!(out.status.success(), "{}", stderr(&out));
-    let raw_text = std::fs::read_to_string(tmp.path().join("raw.csv")).unwrap();
+    // `--baseline-samples 0` keeps the record's offsets.
+    let raw_text = strain_csv(tmp.path(), rec, "raw.csv", &["--baseline-samples", "0"]);
     assert_ne!(raw_text.lines().nth(1), text.lines().nth(1));
 }
 

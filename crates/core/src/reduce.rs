@@ -546,12 +546,7 @@ const POLARITY_SIGNAL_TO_NOISE: f64 = 10.0;
 /// samples (module docs, "Windows" 2); None for a channel without a clear pulse.
 fn first_pulse(eps: &[f64], baseline: usize) -> Option<(usize, f64)> {
     let largest = eps.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    let nb = baseline.min(eps.len());
-    let noise = if nb > 0 {
-        (eps[..nb].iter().map(|e| e * e).sum::<f64>() / nb as f64).sqrt()
-    } else {
-        0.0
-    };
+    let noise = quality::baseline_rms(eps, baseline);
     if !(largest > 0.0 && largest > POLARITY_SIGNAL_TO_NOISE * noise) {
         return None;
     }

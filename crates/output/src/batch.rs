@@ -356,12 +356,7 @@ pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) ->
                 x_scale: 1e6,
                 y_scale: 1.0,
             },
-            vec![Curve {
-                label: "equilibrium ratio".into(),
-                x: &r.time_s,
-                y: &ratio,
-                measured: false,
-            }],
+            vec![curve("equilibrium ratio", &r.time_s, &ratio)],
         ),
         (
             Axes {

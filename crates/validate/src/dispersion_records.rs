@@ -9,7 +9,7 @@ use shpb_core::gauge::RawRecord;
 use shpb_core::numeric::spectral_filter;
 use shpb_core::reduce::{
     BANCROFT_FIT, DispersionCorrection, Reduction, ReductionOptions, ReductionSetup,
-    record_strains, reduce_named,
+    quality::baseline_rms, record_strains, reduce_named,
 };
 use shpb_input::Result;
 use shpb_input::prelude::*;
@@ -139,12 +139,6 @@ impl RecordComparison {
     }
 }
 
-/// RMS of the first `n` samples of `v` (already baseline-free).
-fn rms_head(v: &[f64], n: usize) -> f64 {
-    let n = n.min(v.len()).max(1);
-    (v[..n].iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt()
-}
-
 /// Reduces each of the eight records (`validation/gauge-records/data` below `root`) with the
 /// authors' set-up (`bars/authors.toml`), once with the Bancroft fit and once with the exact
 /// first mode, on the raw samples (no smoothing: the comparison is with the records' own noise),
@@ -202,11 +196,11 @@ pub fn compare_records(root: &Path) -> Result<Vec<RecordComparison>> {
             bancroft: b,
             exact: e,
             exact_tyas_pope: tp,
-            back_noise_n: ea_t * rms_head(tra, nb),
-            front_noise_n: ea_i * rms_head(inc, nb) * std::f64::consts::SQRT_2,
-            back_noise_band_n: ea_t * rms_head(&low_pass(tra, dt_s), nb),
+            back_noise_n: ea_t * baseline_rms(tra, nb),
+            front_noise_n: ea_i * baseline_rms(inc, nb) * std::f64::consts::SQRT_2,
+            back_noise_band_n: ea_t * baseline_rms(&low_pass(tra, dt_s), nb),
             front_noise_band_n: ea_i
-                * rms_head(&low_pass(inc, dt_s), nb)
+                * baseline_rms(&low_pass(inc, dt_s), nb)
                 * std::f64::consts::SQRT_2,
             dt_s,
             front_offset_bound_n,

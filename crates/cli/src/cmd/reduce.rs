@@ -23,14 +23,16 @@ pub struct Outputs<'a> {
     pub force: bool,
 }
 
+/// A file's name without its extension (`record` if it has none): figure names and titles.
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "record".into())
+}
+
 /// The figure of record `k` of a report: `<report stem>-<record stem>.png` beside the report
 /// (`-<k>` appended when two records share a stem).
 fn figure_path(report: &Path, records: &[PathBuf], k: usize) -> PathBuf {
-    let stem = |p: &Path| {
-        p.file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "record".into())
-    };
     let own = stem(&records[k]);
     let shared = records.iter().filter(|r| stem(r) == own).count() > 1;
     let name = if shared {
@@ -178,11 +180,7 @@ pub fn reduce_command(
     for (k, (record, result)) in records.iter().zip(&reduced).enumerate() {
         let figure = match (result, figures.get(k)) {
             (Ok(r), Some(path)) => {
-                let title = record
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                reduction_figure(path, o.force, &title, &r.reduction)?;
+                reduction_figure(path, o.force, &stem(record), &r.reduction)?;
                 wrote(path);
                 path.file_name().map(|n| n.to_string_lossy().into_owned())
             }

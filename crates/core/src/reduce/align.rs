@@ -104,10 +104,7 @@ pub(crate) struct BalanceProblem<'a> {
 /// sample reaching 10 % of its peak to the peak, as sample indices (docs/physics.md §7.6).
 pub(crate) fn loading_span(incident: &[f64]) -> (usize, usize) {
     let y: Vec<f64> = incident.iter().map(|e| -e).collect();
-    let k_peak = crate::numeric::argmax(&y);
-    let level = 0.1 * y[k_peak];
-    let k_start = (0..=k_peak).find(|&k| y[k] >= level).unwrap_or(k_peak);
-    (k_start, k_peak)
+    super::quality::rising_span(&y, 0.1)
 }
 
 impl BalanceProblem<'_> {

@@ -56,8 +56,16 @@ pub struct Quality {
     pub signal_to_noise: (f64, f64),
 }
 
-/// RMS of the first `n` samples (0 when n is 0).
-pub(crate) fn baseline_rms(v: &[f64], n: usize) -> f64 {
+/// The rise of `y` to its peak: (first sample at `fraction` of the peak, peak), sample indices.
+pub(crate) fn rising_span(y: &[f64], fraction: f64) -> (usize, usize) {
+    let k_peak = crate::numeric::argmax(y);
+    let level = fraction * y[k_peak];
+    let k_start = (0..=k_peak).find(|&k| y[k] >= level).unwrap_or(k_peak);
+    (k_start, k_peak)
+}
+
+/// RMS of the first `n` samples (0 when n is 0): a record's pre-trigger noise.
+pub fn baseline_rms(v: &[f64], n: usize) -> f64 {
     let n = n.min(v.len());
     if n == 0 {
         return 0.0;
@@ -71,11 +79,7 @@ pub(crate) fn equilibrium_over_loading(
     force_3wave_n: &[f64],
     equilibrium_ratio: &[f64],
 ) -> ((usize, usize), f64, f64, EquilibriumVerdict) {
-    let k_peak = crate::numeric::argmax(force_3wave_n);
-    let level = 0.25 * force_3wave_n[k_peak];
-    let k_start = (0..=k_peak)
-        .find(|&k| force_3wave_n[k] >= level)
-        .unwrap_or(k_peak);
+    let (k_start, k_peak) = rising_span(force_3wave_n, 0.25);
     let span = &equilibrium_ratio[k_start..=k_peak];
     let mean = span.iter().sum::<f64>() / span.len() as f64;
     let max = span.iter().copied().fold(0.0, f64::max);
