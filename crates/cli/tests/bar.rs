@@ -137,10 +137,14 @@ fn striker_impact_gives_the_elementary_pulse_and_conserves_energy() {
     let mut totals = Vec::with_capacity(steps);
     let mut ledger_error: f64 = 0.0;
     let mut last_contact_step = 0;
+    let mut peak_force: f64 = 0.0;
     for n in 0..steps {
         let f = rigid_contact_force_n(&striker, &bar, 0.0);
         assert!(f >= 0.0);
-        if f > 0.0 {
+        // A force above rounding (a delay line leaves ~1e-16 v0 at the separated faces, whose
+        // contact then carries ~1e-26 N).
+        peak_force = peak_force.max(f);
+        if f > 1e-12 * peak_force {
             last_contact_step = n;
         }
         striker.step(0.0, -f);

@@ -32,23 +32,6 @@ pub struct GaugeProbe {
     pub length_m: f64,
 }
 
-/// Axial displacement at position `x_m` along a bar (linear between nodes), m.
-fn displacement_at(bar: &Bar, x_m: f64) -> f64 {
-    let n = bar.node_count();
-    let (mut lo, mut hi) = (0, n - 1);
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if bar.node_position_m(mid) <= x_m {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let (x0, x1) = (bar.node_position_m(lo), bar.node_position_m(hi));
-    let w = ((x_m - x0) / (x1 - x0)).clamp(0.0, 1.0);
-    bar.displacement_m(lo) * (1.0 - w) + bar.displacement_m(hi) * w
-}
-
 /// Strain a gauge reads: the mean bar strain over its grid, (u(x+L/2) − u(x−L/2))/L, exactly what a
 /// bonded foil gauge of length L averages (and, over an even number of cells, free of the grid's
 /// two-cell zigzag); a point value for L = 0.
@@ -56,9 +39,7 @@ pub fn gauge_strain(bar: &Bar, g: &GaugeProbe) -> f64 {
     if g.length_m <= 0.0 {
         return bar.strain_at(g.x_m);
     }
-    (displacement_at(bar, g.x_m + 0.5 * g.length_m)
-        - displacement_at(bar, g.x_m - 0.5 * g.length_m))
-        / g.length_m
+    bar.stretch_between_m(g.x_m - 0.5 * g.length_m, g.x_m + 0.5 * g.length_m) / g.length_m
 }
 
 /// Gauge strains every `every` steps, on a common time axis.
