@@ -1227,13 +1227,19 @@ impl Bar {
     pub fn strain_at(&self, x_m: f64) -> f64 {
         let s = &self.segments[self.segment_at(x_m)];
         let e0 = s.first_element;
+        // [`Bar::element_strain`] of an element of segment s.
+        let strain = |e: usize| match &self.waves {
+            Some(w) => w.stretch(e) / s.dx_m,
+            None => (self.u[e + 1] - self.u[e]) / s.dx_m,
+        };
         if s.cells == 1 {
-            return self.element_strain(e0);
+            return strain(e0);
         }
         let xi = ((x_m - s.x0_m) / s.dx_m - 0.5).clamp(0.0, (s.cells - 1) as f64);
-        let j = (xi.floor() as usize).min(s.cells - 2);
+        // xi ≥ 0 (NaN → 0): truncation is the floor, without a libm call.
+        let j = (xi as usize).min(s.cells - 2);
         let t = xi - j as f64;
-        (1.0 - t) * self.element_strain(e0 + j) + t * self.element_strain(e0 + j + 1)
+        (1.0 - t) * strain(e0 + j) + t * strain(e0 + j + 1)
     }
 
     /// Axial stress E·ε at x with E of the segment there, Pa (tension positive).
@@ -1252,11 +1258,18 @@ impl Bar {
 
     /// Kinetic energy ½ v^{n−1/2}ᵀ M v^{n−1/2} at the half level n − 1/2 (with the Love lateral part), J.
     pub fn kinetic_energy_j(&self) -> f64 {
-        if self.waves.is_some() {
-            let lumped: f64 = (0..self.mass.len())
-                .map(|i| self.mass[i] * self.half_step_velocity_m_s(i).powi(2))
+        if let Some(w) = &self.waves {
+            let last = self.mass.len() - 1;
+            let dt = self.dt_s;
+            let interior: f64 = (1..last)
+                .map(|i| {
+                    let v = w.last_move(i) / dt;
+                    self.mass[i] * v * v
+                })
                 .sum();
-            return 0.5 * lumped;
+            let ends = self.mass[0] * self.v[0] * self.v[0]
+                + self.mass[last] * self.v[last] * self.v[last];
+            return 0.5 * (interior + ends);
         }
         let lumped: f64 = self.mass.iter().zip(&self.v).map(|(m, v)| m * v * v).sum();
         let lateral: f64 = match &self.love {
