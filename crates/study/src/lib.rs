@@ -10,5 +10,6 @@ pub mod convergence;
 pub mod file;
 pub mod identity;
 pub mod sweep;
+pub mod uq;
 
 pub use shpb_input::{Error, Result};
