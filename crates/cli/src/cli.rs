@@ -56,7 +56,7 @@ pub struct Cli {
     /// No result table and no `wrote` lines (warnings and errors still go to stderr).
     #[arg(short, long, global = true)]
     pub quiet: bool,
-    /// Print the result of `run`, `reduce`, `incident` and `sweep` as one JSON object on stdout.
+    /// Print the result of `run`, `reduce`, `incident`, `sweep` and `study` as one JSON object on stdout.
     #[arg(long, global = true)]
     pub json: bool,
 }
@@ -237,6 +237,47 @@ pub enum Command {
         /// redoing finished runs.
         #[arg(long)]
         resume: bool,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Propagate the scene's uncertainties: draw its distributions (`{ mean = "12.5psi", sd =
+    /// "0.6psi" }`, `{ min, max }`, `{ median, gsd }`, `{ values = [..] }`) and the gun's
+    /// shot-to-shot scatter by a seeded Latin hypercube, run each sample, and print each summary
+    /// quantity's mean, sd, 5/50/95 % percentiles and first-order sensitivity indices.
+    Study {
+        /// The scene TOML file.
+        scene: PathBuf,
+        /// Samples (runs), 2 to 1000000.
+        #[arg(long, default_value_t = 32)]
+        samples: usize,
+        /// Seed of the Latin hypercube: the same seed gives the same samples and files.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads.
+        #[arg(
+            short = 'j',
+            long = "jobs",
+            default_value_t = 1,
+            allow_hyphen_values = true
+        )]
+        jobs: usize,
+        /// Do not draw the gun's shot-to-shot scatter (the set-up's `[gun] velocity_scatter`,
+        /// applied by default when the scene's pressure is one value).
+        #[arg(long)]
+        no_gun_scatter: bool,
+        /// HDF5 output: the runs (/summary table, /runs/<index>), the study in its `sweep` attribute.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// CSV of the runs: the inputs drawn (SI units) and the summary of each run.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// CSV of the statistics: quantity, unit, n, mean, sd, p5, p50, p95, S_<input>.
+        #[arg(long)]
+        summary: Option<PathBuf>,
+        /// PNG of the bands (5 / 50 / 95 %) of the reduced back force and the transmission gauge.
+        #[arg(long)]
+        plot: Option<PathBuf>,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -499,6 +540,31 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             shard.as_deref(),
             (output.as_deref(), csv.as_deref(), plot.as_deref()),
             resume,
+            force,
+        ),
+        Command::Study {
+            scene,
+            samples,
+            seed,
+            jobs,
+            no_gun_scatter,
+            output,
+            csv,
+            summary,
+            plot,
+            force,
+        } => cmd::study::study(
+            &scene,
+            samples,
+            seed,
+            jobs,
+            !no_gun_scatter,
+            cmd::study::StudyOutputs {
+                output: output.as_deref(),
+                csv: csv.as_deref(),
+                summary: summary.as_deref(),
+                plot: plot.as_deref(),
+            },
             force,
         ),
         Command::Merge {

@@ -11,5 +11,6 @@ pub mod merge;
 pub mod reduce;
 pub mod run;
 pub mod strain;
+pub mod study;
 pub mod sweep;
 pub mod validate;
