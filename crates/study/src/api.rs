@@ -604,3 +604,17 @@ pub fn sweep_rows(
     let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;
     Ok((axes, rows))
 }
+
+/// A whole uncertainty study of `scene` (`shpb study` without outputs): `samples` runs drawn by
+/// a Latin hypercube seeded with `seed` from the scene's distributions and, with `gun_scatter`,
+/// the set-up's gun scatter, run on `jobs` threads ([`crate::uq::study_rows`]);
+/// [`crate::uq::Study::statistics`] gives each quantity's mean, sd, percentiles and indices.
+pub fn study_rows(
+    scene: &Path,
+    samples: usize,
+    seed: u64,
+    jobs: usize,
+    gun_scatter: bool,
+) -> Result<crate::uq::Study> {
+    crate::uq::study_rows(scene, samples, seed, jobs, gun_scatter, false, |_| {})
+}

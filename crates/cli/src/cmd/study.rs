@@ -2,7 +2,7 @@
 //! scatter) drawn by a seeded Latin hypercube, each sample a normal run, and the statistics of
 //! every summary quantity (`shpb_study::uq`, docs/physics.md §10).
 
-use super::common::{finite, report, warn, wrote};
+use super::common::{finite, quiet_mode, report, warn, wrote};
 use shpb_input::{Error, Result};
 use shpb_output::io::check_output;
 use shpb_study::uq::{RunTraces, Study, Trace, bands};
@@ -61,8 +61,10 @@ pub fn study(
             "the scene has no distribution and no gun scatter applies: every sample is the same run",
         );
     }
-    for line in &spec {
-        eprintln!("shpb: {line}");
+    if !quiet_mode() {
+        for line in &spec {
+            eprintln!("shpb: {line}");
+        }
     }
     let stats = study.statistics_csv();
     report(&stats, || study_json(&study))?;
