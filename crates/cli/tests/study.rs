@@ -61,14 +61,28 @@ fn a_study_of_fixed_inputs_equals_one_run() {
     }
     let out = shpb(
         dir.path(),
-        &["study", "fixed.toml", "--samples", "2", "--no-gun-scatter"],
+        &[
+            "study",
+            "fixed.toml",
+            "--samples",
+            "2",
+            "--no-gun-scatter",
+            "--summary",
+            "fixed.csv",
+        ],
     );
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8(out.stdout).unwrap();
+    // The printed table names every quantity.
+    let printed = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        printed.contains("peak_force") && printed.contains("p95"),
+        "{printed}"
+    );
+    let text = std::fs::read_to_string(dir.path().join("fixed.csv")).unwrap();
     let row = stats_row(&text, "peak_force");
     assert_eq!(row["sd"].parse::<f64>().unwrap(), 0.0, "{text}");
     assert_eq!(row["mean"].parse::<f64>().unwrap(), one.peak_force_n);

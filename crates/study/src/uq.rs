@@ -600,6 +600,52 @@ impl Study {
         text
     }
 
+    /// The statistics as an aligned text table (what `shpb study` prints): quantity, unit, n,
+    /// mean, sd, p5, p50, p95 and `S_<key>`, numbers with four significant digits.
+    pub fn statistics_table(&self) -> String {
+        let csv = self.statistics_csv();
+        let rows: Vec<Vec<String>> = csv
+            .lines()
+            .enumerate()
+            .map(|(i, line)| {
+                line.split(',')
+                    .enumerate()
+                    .map(|(j, cell)| match cell.parse::<f64>() {
+                        Ok(v) if i > 0 && j > 2 => four_digits(v),
+                        _ => cell.to_string(),
+                    })
+                    .collect()
+            })
+            .collect();
+        let columns = rows.iter().map(Vec::len).max().unwrap_or(0);
+        let widths: Vec<usize> = (0..columns)
+            .map(|j| {
+                rows.iter()
+                    .map(|r| r.get(j).map_or(0, |c| c.chars().count()))
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let mut text = String::new();
+        for r in &rows {
+            let cells: Vec<String> = r
+                .iter()
+                .zip(&widths)
+                .enumerate()
+                .map(|(j, (c, &w))| {
+                    if j == 0 {
+                        format!("{c:<w$}")
+                    } else {
+                        format!("{c:>w$}")
+                    }
+                })
+                .collect();
+            text.push_str(cells.join("  ").trim_end());
+            text.push('\n');
+        }
+        text
+    }
+
     /// What the study was (for the study file's `sweep` attribute and the table's head): the
     /// sample count, the seed, the design and each input.
     pub fn specification(&self) -> Vec<String> {
@@ -610,6 +656,23 @@ impl Study {
         )];
         spec.extend(self.inputs.iter().map(StudyInput::describe));
         spec
+    }
+}
+
+/// A number with four significant digits, plainly between 0.01 and 99999, else in `e` notation.
+fn four_digits(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !v.is_finite() {
+        return format!("{v}");
+    }
+    let magnitude = v.abs().log10().floor() as i64;
+    if (-2..5).contains(&magnitude) {
+        let digits = (3 - magnitude).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.3e}")
     }
 }
 

@@ -67,7 +67,7 @@ pub fn study(
         }
     }
     let stats = study.statistics_csv();
-    report(&stats, || study_json(&study))?;
+    report(&study.statistics_table(), || study_json(&study))?;
     let keys = study.keys();
     if let Some(p) = outputs.csv {
         let table = shpb_study::sweep::summary_csv_keys(&keys, &study.rows);
