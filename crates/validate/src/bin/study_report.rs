@@ -34,6 +34,9 @@ const GAUGE_LENGTH_M: f64 = 2e-3;
 /// freedom is s √(5/11.0705) to s √(5/1.1455).
 const CHI2_5: (f64, f64) = (1.145_476, 11.070_498);
 
+/// One simulated shot: striker velocity (m/s), incident pulse energy (J) and peak (Pa).
+type Shot = (f64, f64, f64);
+
 /// Energy a bar stress pulse carries, A/(ρ c0) ∫σ² dt, J (as validation/pulse/REPORT.md).
 fn pulse_energy_j(a: &Apparatus, t: &[f64], y: &[f64]) -> f64 {
     let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
@@ -116,7 +119,7 @@ fn main() {
     assert_eq!(dof, 5, "8 records at 3 pressures");
 
     // The study: the shipped scatter drawn at each pressure, each sample's incident pulse.
-    let study: Vec<(f64, Vec<(f64, f64, f64)>)> = pressures
+    let study: Vec<(f64, Vec<Shot>)> = pressures
         .iter()
         .map(|&psi| {
             let input = StudyInput {
@@ -128,7 +131,7 @@ fn main() {
                 },
             };
             let samples = draw(std::slice::from_ref(&input), STUDY_SAMPLES, SEED).expect("draw");
-            let runs: Vec<(f64, f64, f64)> = samples
+            let runs: Vec<Shot> = samples
                 .labels
                 .par_iter()
                 .map(|l| {
