@@ -241,3 +241,18 @@ fn a_single_run_refuses_a_distribution() {
         "{e}"
     );
 }
+
+/// The shipped example study (README "Uncertainty studies") draws valid scenes.
+#[test]
+fn the_shipped_example_study_draws_valid_scenes() {
+    let path = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .join("examples/study/ss440c-12p5psi.toml");
+    let inputs = shpb::uq::study_inputs(&path, true).unwrap();
+    let keys: Vec<&str> = inputs.iter().map(|i| i.key.as_str()).collect();
+    assert_eq!(keys, ["pressure", "shaper.thickness_m"]);
+    let samples = shpb::uq::draw(&inputs, 8, 1).unwrap();
+    for o in &samples.overrides {
+        Params::from_file_overridden(&path, o).unwrap();
+    }
+    assert!(Params::from_file(&path).is_err(), "a single run refuses it");
+}
