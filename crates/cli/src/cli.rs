@@ -275,7 +275,8 @@ pub enum Command {
         /// CSV of the statistics: quantity, unit, n, mean, sd, p5, p50, p95, S_<input>.
         #[arg(long)]
         summary: Option<PathBuf>,
-        /// PNG of the bands (5 / 50 / 95 %) of the reduced back force and the transmission gauge.
+        /// PNG of the bands (5 / 50 / 95 %): contact force against approach on loading, reduced
+        /// back force and transmission gauge strain against time.
         #[arg(long)]
         plot: Option<PathBuf>,
         /// Overwrite existing output files.

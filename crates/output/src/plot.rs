@@ -511,7 +511,8 @@ pub fn sweep_figure(
     })
 }
 
-/// One panel of [`band_figure`]: a quantity's 5, 50 and 95 % percentiles against time.
+/// One panel of [`band_figure`]: a quantity's 5, 50 and 95 % percentiles against time (or
+/// another abscissa).
 pub struct BandPanel<'a> {
     /// Caption.
     pub title: &'a str,
@@ -519,14 +520,18 @@ pub struct BandPanel<'a> {
     pub y_label: &'a str,
     /// Factor applied to the values for display.
     pub y_scale: f64,
-    /// Time, s.
-    pub time_s: &'a [f64],
+    /// x-axis label with unit.
+    pub x_label: &'a str,
+    /// Factor applied to the abscissae for display.
+    pub x_scale: f64,
+    /// Abscissae (time in s, an approach in m).
+    pub x: &'a [f64],
     /// The 5, 50 and 95 % percentiles at each time.
     pub p5_p50_p95: [&'a [f64]; 3],
 }
 
 /// The bands of a study (`shpb study --plot`): one panel per quantity, its median as a line and
-/// its 5 % and 95 % percentiles dashed, against time in µs.
+/// its 5 % and 95 % percentiles dashed.
 pub fn band_figure(path: &Path, force: bool, panels: &[BandPanel]) -> Result<()> {
     write_atomically(path, force, |tmp| {
         let width = 800 * panels.len().max(1) as u32;
@@ -536,9 +541,9 @@ pub fn band_figure(path: &Path, force: bool, panels: &[BandPanel]) -> Result<()>
         for (area, p) in areas.iter().zip(panels) {
             let axes = Axes {
                 title: p.title,
-                x_label: "time (µs)",
+                x_label: p.x_label,
                 y_label: p.y_label,
-                x_scale: 1e6,
+                x_scale: p.x_scale,
                 y_scale: p.y_scale,
             };
             let curves: Vec<Curve> = ["5 %", "median", "95 %"]
@@ -546,7 +551,7 @@ pub fn band_figure(path: &Path, force: bool, panels: &[BandPanel]) -> Result<()>
                 .zip(p.p5_p50_p95)
                 .map(|(label, y)| Curve {
                     label: label.to_string(),
-                    x: p.time_s,
+                    x: p.x,
                     y,
                     measured: *label != "median",
                 })

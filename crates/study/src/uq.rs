@@ -425,6 +425,23 @@ pub struct RunTraces {
     pub back_force: Option<Trace>,
     /// Transmission gauge strain against run time.
     pub transmitted_strain: Option<Trace>,
+    /// True contact force (N) against approach (m) on loading: up to the peak force, the points
+    /// where the approach exceeds every earlier one.
+    pub force_approach: Option<Trace>,
+}
+
+/// The loading branch of a force–approach curve: up to the peak force, the points whose approach
+/// exceeds every earlier one (so the approach rises strictly and can be interpolated).
+pub fn loading_branch(approach_m: &[f64], force_n: &[f64], peak: usize) -> Trace {
+    let mut x = Vec::new();
+    let mut y = Vec::new();
+    for (&d, &f) in approach_m.iter().zip(force_n).take(peak + 1) {
+        if x.last().is_none_or(|&last| d > last) {
+            x.push(d);
+            y.push(f);
+        }
+    }
+    (x, y)
 }
 
 /// A finished study: its inputs, samples, one summary row per sample and, when asked, traces.
@@ -505,6 +522,10 @@ pub fn study_rows(
                                 .find(|g| g.name.contains("transmi"))
                                 .map(|g| (t.clone(), g.strain.clone()))
                         }),
+                        force_approach: out
+                            .contact
+                            .as_ref()
+                            .map(|c| loading_branch(&c.displacement_m, &c.force_n, c.peak_index())),
                     }
                 } else {
                     RunTraces::default()
@@ -677,10 +698,12 @@ fn four_digits(v: f64) -> String {
     }
 }
 
-/// The 5/50/95 % bands of `traces` on the first trace's time grid (each trace interpolated
+/// The 5/50/95 % bands of `traces` on the grid of the trace with the widest span (each trace interpolated
 /// linearly; outside its own span it does not count): (time, p5, p50, p95).
 pub fn bands(traces: &[&Trace]) -> Option<(Vec<f64>, [Vec<f64>; 3])> {
-    let grid = &traces.first()?.0;
+    let span =
+        |t: &&Trace| t.0.last().copied().unwrap_or(0.0) - t.0.first().copied().unwrap_or(0.0);
+    let grid = &traces.iter().max_by(|a, b| span(a).total_cmp(&span(b)))?.0;
     let mut out = [vec![], vec![], vec![]];
     let mut at = Vec::with_capacity(traces.len());
     for &t in grid {
@@ -813,6 +836,32 @@ mod tests {
         // An input without effect: ε² near 0 (the raw η² would be ≈ (B − 1)/(N − 1) = 0.03).
         let noise: Vec<f64> = (0..n).map(|i| ((i * 7919) % n) as f64).collect();
         assert!(first_order_index(&noise, &y) < 0.02);
+    }
+
+    /// Bands of y = c·x for c = 1…5 are c = 1.2 / 3 / 4.8 times x (type 7 at 5/50/95 %), each
+    /// trace counting only over its own span; the loading branch keeps a strictly rising approach.
+    #[test]
+    fn bands_are_percentiles_across_traces_at_each_abscissa() {
+        let traces: Vec<Trace> = (1..=5)
+            .map(|c| {
+                let x: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+                let y = x.iter().map(|v| c as f64 * v).collect();
+                (x, y)
+            })
+            .collect();
+        let refs: Vec<&Trace> = traces.iter().collect();
+        let (x, [p5, p50, p95]) = bands(&refs).unwrap();
+        for (i, &xi) in x.iter().enumerate() {
+            assert!((p5[i] - 1.2 * xi).abs() < 1e-12);
+            assert!((p50[i] - 3.0 * xi).abs() < 1e-12);
+            assert!((p95[i] - 4.8 * xi).abs() < 1e-12);
+        }
+        let (d, f) = loading_branch(
+            &[0.0, 1.0, 1.0, 0.5, 2.0, 3.0],
+            &[0.0, 1.0, 2.0, 3.0, 4.0, 9.0],
+            4,
+        );
+        assert_eq!((d, f), (vec![0.0, 1.0, 2.0], vec![0.0, 1.0, 4.0]));
     }
 
     #[test]

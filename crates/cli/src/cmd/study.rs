@@ -90,7 +90,8 @@ pub fn study(
     Ok(())
 }
 
-/// The band figure: the reduced back force and the transmission gauge's strain, 5–95 %.
+/// The band figure: the contact force on loading against approach, the reduced back force and
+/// the transmission gauge's strain against time, 5 / 50 / 95 %.
 fn band_plot(path: &Path, force: bool, traces: &[RunTraces]) -> Result<()> {
     let back: Vec<&Trace> = traces
         .iter()
@@ -100,24 +101,44 @@ fn band_plot(path: &Path, force: bool, traces: &[RunTraces]) -> Result<()> {
         .iter()
         .filter_map(|t| t.transmitted_strain.as_ref())
         .collect();
+    let curve: Vec<&Trace> = traces
+        .iter()
+        .filter_map(|t| t.force_approach.as_ref())
+        .collect();
     let back = bands(&back);
     let gauge = bands(&gauge);
+    let curve = bands(&curve);
     let mut panels = Vec::new();
+    if let Some((x, p)) = &curve {
+        panels.push(shpb_output::plot::BandPanel {
+            title: "contact force on loading, 5 / 50 / 95 % at each approach",
+            x_label: "approach (µm)",
+            x_scale: 1e6,
+            y_label: "force (kN)",
+            y_scale: 1e-3,
+            x,
+            p5_p50_p95: [&p[0], &p[1], &p[2]],
+        });
+    }
     if let Some((t, p)) = &back {
         panels.push(shpb_output::plot::BandPanel {
             title: "reduced back force, 5 / 50 / 95 %",
+            x_label: "time (µs)",
+            x_scale: 1e6,
             y_label: "force (kN)",
             y_scale: 1e-3,
-            time_s: t,
+            x: t,
             p5_p50_p95: [&p[0], &p[1], &p[2]],
         });
     }
     if let Some((t, p)) = &gauge {
         panels.push(shpb_output::plot::BandPanel {
             title: "transmission gauge strain, 5 / 50 / 95 %",
+            x_label: "time (µs)",
+            x_scale: 1e6,
             y_label: "strain (µε)",
             y_scale: 1e6,
-            time_s: t,
+            x: t,
             p5_p50_p95: [&p[0], &p[1], &p[2]],
         });
     }
@@ -125,8 +146,8 @@ fn band_plot(path: &Path, force: bool, traces: &[RunTraces]) -> Result<()> {
         return Err(Error::Input {
             file: "command line".into(),
             key: "--plot".into(),
-            problem: "the scene's runs have no gauge signals or reduction to draw".into(),
-            allowed: "a scene of kind shpb (bars and gauges)".into(),
+            problem: "the scene's runs have no contact, gauge signals or reduction to draw".into(),
+            allowed: "a scene with spheres or bars and gauges".into(),
         });
     }
     shpb_output::plot::band_figure(path, force, &panels)
