@@ -6,7 +6,8 @@
 //! the layers so that `shpb::bar`, `shpb::scene::Params` or `shpb::io::write_hdf5` name the same
 //! items as `shpb_core::bar`, … (see ARCHITECTURE.md for the map):
 //! `shpb-core` (physics and numerics) ← `shpb-input` (files → validated core objects) ←
-//! `shpb-output` (writers) ← `shpb-study` (sweeps, convergence, bench) ← `shpb-validate`.
+//! `shpb-output` (writers) ← `shpb-study` (sweeps, uncertainty studies, convergence, bench) ←
+//! `shpb-validate`.
 
 #![warn(missing_docs)]
 

@@ -1,6 +1,7 @@
-//! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`), the
-//! convergence of a scene under refinement (`shpb convergence`) and the speed/accuracy bench of
-//! the fidelity presets (`shpb bench`).
+//! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`),
+//! uncertainty studies (`shpb study`: Latin-hypercube samples of a scene's distributions, [`uq`]),
+//! the convergence of a scene under refinement (`shpb convergence`) and the speed/accuracy bench
+//! of the fidelity presets (`shpb bench`).
 
 #![warn(missing_docs)]
 
