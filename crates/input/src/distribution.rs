@@ -171,15 +171,32 @@ fn walk(
         } else {
             format!("{prefix}.{key}")
         };
-        if let toml::Value::Table(t) = value {
-            if is_distribution(t) {
+        match value {
+            toml::Value::Table(t) if is_distribution(t) => {
                 found.push(parse_distribution(&path, t, v)?);
-            } else {
-                walk(t, &path, v, found)?;
             }
+            toml::Value::Table(t) => walk(t, &path, v, found)?,
+            toml::Value::Array(items) if items.iter().any(holds_distribution) => {
+                return Err(v.error(
+                    &path,
+                    "a distribution inside a list: only keys reached by a dotted path can be drawn",
+                    "distributions on keys of tables (`pressure`, `shaper.thickness_m`), not inside \
+                     arrays such as [[specimen.sphere]]",
+                ));
+            }
+            _ => {}
         }
     }
     Ok(())
+}
+
+/// Whether `value` is or holds a distribution table (at any depth, through tables and arrays).
+fn holds_distribution(value: &toml::Value) -> bool {
+    match value {
+        toml::Value::Table(t) => is_distribution(t) || t.values().any(holds_distribution),
+        toml::Value::Array(items) => items.iter().any(holds_distribution),
+        _ => false,
+    }
 }
 
 /// Validates one distribution table of key `key`.
@@ -298,6 +315,7 @@ pub fn refuse_distributions(table: &toml::Table, file: &str) -> Result<()> {
             match value {
                 toml::Value::Table(t) if is_distribution(t) => Some(path),
                 toml::Value::Table(t) => first(t, &path),
+                toml::Value::Array(_) if holds_distribution(value) => Some(path),
                 _ => None,
             }
         })
@@ -406,6 +424,21 @@ diameter_m = { values = ["4mm", "3.9mm", "4.1mm"] }
             e.contains("`shaper.thickness_m`") && e.contains("shpb study"),
             "{e}"
         );
+        let listed: toml::Table = toml::from_str(
+            "kind = \"chain\"\n[[specimen.sphere]]\ndiameter_m = { min = 1, max = 2 }\n",
+        )
+        .unwrap();
+        let e = refuse_distributions(&listed, "s.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`specimen.sphere`"), "{e}");
+        let e = find_distributions(
+            "kind = \"chain\"\n[[specimen.sphere]]\ndiameter_m = { min = 1, max = 2 }\n",
+            "s.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("inside a list"), "{e}");
         let plain: toml::Table =
             toml::from_str("kind = \"shpb\"\n[specimen]\npair = \"x\"\n").unwrap();
         assert!(refuse_distributions(&plain, "s.toml").is_ok());

@@ -444,6 +444,10 @@ pub fn loading_branch(approach_m: &[f64], force_n: &[f64], peak: usize) -> Trace
     (x, y)
 }
 
+/// The samples whose traces a study keeps for its band plots (the first ones, a random sample of
+/// the same distribution: ≈ 150 kB each, so a large study does not hold them all).
+pub const MAX_TRACED_SAMPLES: usize = 1000;
+
 /// A finished study: its inputs, samples, one summary row per sample and, when asked, traces.
 #[derive(Debug, Clone)]
 pub struct Study {
@@ -462,7 +466,7 @@ pub struct Study {
 /// Runs a study of `scene`: `n` samples (≥ 2) drawn with `seed` from its inputs
 /// ([`study_inputs`]), each sample validated before the first run, then run on `jobs` threads
 /// (each a normal run of the scene with the sample's values), `done` called as each finishes;
-/// traces kept with `keep_traces`.
+/// traces kept with `keep_traces` (of the first [`MAX_TRACED_SAMPLES`]).
 pub fn study_rows(
     scene: &Path,
     n: usize,
@@ -510,7 +514,7 @@ pub fn study_rows(
                 let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
                 let out = params.run()?;
                 let row = summarise(i, samples.labels[i].clone(), &out);
-                let traces = if keep_traces {
+                let traces = if keep_traces && i < MAX_TRACED_SAMPLES {
                     RunTraces {
                         back_force: out
                             .reduction
@@ -540,7 +544,11 @@ pub fn study_rows(
         inputs,
         samples,
         rows,
-        traces: if keep_traces { traces } else { Vec::new() },
+        traces: if keep_traces {
+            traces.into_iter().take(MAX_TRACED_SAMPLES).collect()
+        } else {
+            Vec::new()
+        },
         seed,
     })
 }
