@@ -1,12 +1,14 @@
 //! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`), the
 //! convergence of a scene under refinement (`shpb convergence`) and the speed/accuracy bench of
-//! the fidelity presets (`shpb bench`).
+//! the fidelity presets (`shpb bench`), and the design search for inputs that meet a target
+//! (`shpb design`).
 
 #![warn(missing_docs)]
 
 pub mod api;
 pub mod bench;
 pub mod convergence;
+pub mod design;
 pub mod file;
 pub mod identity;
 pub mod sweep;
