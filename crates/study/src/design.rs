@@ -124,8 +124,37 @@ pub struct Target {
     pub quantity: usize,
     /// The target value, SI units.
     pub value_si: f64,
+    /// The unit the value was written in (empty: SI).
+    pub unit: String,
+    /// SI value of one `unit`.
+    pub unit_si: f64,
     /// As written.
     pub text: String,
+}
+
+impl Target {
+    /// The quantity's name ([`SUMMARY_COLUMNS`]).
+    pub fn name(&self) -> &'static str {
+        SUMMARY_COLUMNS[self.quantity].0
+    }
+
+    /// A value of the quantity (SI) in the target's unit, 6 significant digits (`10.0587kN`).
+    pub fn show(&self, v_si: f64) -> String {
+        let unit = if self.unit.is_empty() {
+            match SUMMARY_COLUMNS[self.quantity].1 {
+                "1" => "",
+                u => u,
+            }
+        } else {
+            &self.unit
+        };
+        let space = if unit.is_empty() || unit == "%" {
+            ""
+        } else {
+            " "
+        };
+        format!("{}{space}{unit}", significant(v_si / self.unit_si, 6))
+    }
 }
 
 /// Parses `--target QUANTITY=VALUE[unit]`; the value must be non-zero (the tolerance is relative
@@ -143,6 +172,11 @@ pub fn parse_target(spec: &str) -> Result<Target> {
     })?;
     let quantity = quantity_index(name, "--target", spec)?;
     let value_si = quantity_value(quantity, value, "--target", spec)?;
+    let unit = number_and_unit(value).map(|(_, u)| u).unwrap_or_default();
+    let unit_si = quantity_units(quantity)
+        .iter()
+        .find(|(u, _)| *u == unit)
+        .map_or(1.0, |(_, f)| *f);
     if value_si == 0.0 {
         return Err(cli_err(
             "--target",
@@ -153,6 +187,8 @@ pub fn parse_target(spec: &str) -> Result<Target> {
     Ok(Target {
         quantity,
         value_si,
+        unit,
+        unit_si,
         text: spec.trim().to_string(),
     })
 }
