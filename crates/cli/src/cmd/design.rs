@@ -185,6 +185,12 @@ fn status(
                 format!("violates {}", broken.join(", "))
             }
         }
+        Root::NotBracketed { at_lo, at_hi } if !(at_lo.is_finite() && at_hi.is_finite()) => {
+            format!(
+                "no solution: no {} from the runs at the bounds",
+                target.name()
+            )
+        }
         Root::NotBracketed { at_lo, at_hi } => format!(
             "no solution: {} spans {}–{} over {}",
             target.name(),
@@ -423,6 +429,21 @@ fn verdict(
                     _ => String::new(),
                 };
                 match s.root {
+                    Root::NotBracketed { at_lo, at_hi }
+                        if !(at_lo.is_finite() && at_hi.is_finite()) =>
+                    {
+                        format!(
+                            "the runs at the bounds of {}{at} give no {} ({} at {}, {} at {}): the \
+                         scene does not produce it (the equilibrium ratio, strain rate and time \
+                         to equilibrium need the reduction of a `shpb` scene)",
+                            first.key,
+                            target.name(),
+                            significant(at_lo, 6),
+                            first.short(first.lo),
+                            significant(at_hi, 6),
+                            first.short(first.hi),
+                        )
+                    }
                     Root::NotBracketed { at_lo, at_hi } => format!(
                         "no {} in [{}, {}]{at} reaches {} = {}: it spans {}–{} (fast runs at the \
                          bounds; the search assumes a response monotone between them)",
