@@ -188,8 +188,8 @@ class Table:
     :attr:`inputs` holds each swept key's
     values in SI units (or as written, for names), :attr:`labels` the values as written."""
 
-    def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
-        keys, labels, inputs, columns = raw
+    def __init__(self, raw: Tuple[Any, ...]) -> None:
+        keys, labels, inputs, columns = raw[:4]
         self.keys_swept: List[str] = list(keys)
         self.labels: Dict[str, List[str]] = {
             k: [row[i] for row in labels] for i, k in enumerate(keys)
@@ -349,13 +349,24 @@ def _label(v: Any) -> str:
 
 
 def sweep(
-    scene: PathLike, set: Mapping[str, Union[Sequence[Any], str]], jobs: int = 1
+    scene: PathLike,
+    set: Mapping[str, Union[Sequence[Any], str]],
+    jobs: int = 1,
+    client: Any = None,
+    shards: Optional[int] = None,
 ) -> Table:
     """Runs ``scene`` over the Cartesian product of the values in ``set`` (``shpb sweep``),
     on ``jobs`` threads (the GIL is released), and returns the summary :class:`Table`.
 
     ``set``: scene key → list of values (``{"pressure": ["8psi", "10psi"]}``), or the text of
     ``shpb sweep --set`` (``{"pressure": "5psi:20psi:16"}``).
+
+    ``client``: a ``dask.distributed.Client`` (a ``LocalCluster``, a SLURM cluster of
+    dask-jobqueue, Kubernetes, ...). The sweep is then cut into ``shards`` shards (default: one
+    per worker), exactly as ``shpb sweep --shard k/n`` cuts it, each shard runs on a worker
+    (``jobs`` threads there) and the rows are put back in sweep order: the table is the one
+    ``shpb sweep`` gives. Workers must see the scene and the files it names at the same path
+    (a shared file system).
     """
     specs = []
     for key, values in set.items():
@@ -363,4 +374,53 @@ def sweep(
             specs.append(f"{key}={values}")
         else:
             specs.append(f"{key}={','.join(_label(v) for v in values)}")
-    return Table(_shpb.sweep(os.fspath(scene), specs, int(jobs)))
+    path = os.path.abspath(os.fspath(scene))
+    if client is None:
+        return Table(_shpb.sweep(path, specs, int(jobs)))
+    parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+    return Table(_combine_shards(parts))
+
+
+def _sweep_shard(
+    scene: str, specs: List[str], jobs: int, k: int, n: int
+) -> Tuple[Any, ...]:
+    """Shard ``k`` of ``n`` of a sweep, run where a Dask worker calls it."""
+    return _shpb.sweep(scene, specs, jobs, (k, n))
+
+
+def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List[Any]:
+    """Runs ``fn(*args, k, n)`` for the shards k = 1..n on a Dask ``client`` and gathers the
+    results (in shard order); ``n`` is ``shards`` or the number of workers."""
+    if shards is None:
+        shards = max(1, len(client.scheduler_info().get("workers", {})))
+    n = int(shards)
+    if n < 1:
+        raise InputError(f"shards: {shards} (allowed: a whole number ≥ 1)")
+    futures = [client.submit(fn, *args, k, n, pure=False) for k in range(1, n + 1)]
+    return list(client.gather(futures))
+
+
+def _combine_shards(parts: Sequence[Tuple[Any, ...]]) -> Tuple[Any, ...]:
+    """The whole sweep's raw table from its shards' tables, rows in sweep order."""
+    keys = parts[0][0]
+    rows = []
+    for keys_k, labels, inputs, columns, indices in parts:
+        for j, index in enumerate(indices):
+            row_inputs = [None if c is None else (c[0], c[1][j]) for c in inputs]
+            row_columns = [(name, unit, values[j]) for name, unit, values in columns]
+            rows.append((index, labels[j], row_inputs, row_columns))
+    rows.sort(key=lambda r: r[0])
+    if [r[0] for r in rows] != list(range(len(rows))):
+        raise RuntimeError("the shards do not hold every run of the sweep exactly once")
+    inputs = []
+    for i in range(len(keys)):
+        cells = [r[2][i] for r in rows]
+        if any(c is None for c in cells) or len({c[0] for c in cells}) > 1:
+            inputs.append(None)
+        else:
+            inputs.append((cells[0][0], [c[1] for c in cells]))
+    columns = [
+        (name, unit, [r[3][m][2] for r in rows])
+        for m, (name, unit, _) in enumerate(parts[0][3])
+    ]
+    return (keys, [r[1] for r in rows], inputs, columns, [r[0] for r in rows])

@@ -53,12 +53,13 @@ def reduce(
     layout: Optional[str] = None,
 ) -> RunData: ...
 def sweep(
-    scene: str, set: Sequence[str], jobs: int = 1
+    scene: str, set: Sequence[str], jobs: int = 1, shard: Tuple[int, int] = (1, 1)
 ) -> Tuple[
     List[str],
     List[List[str]],
     List[Optional[Tuple[str, List[float]]]],
     List[Tuple[str, str, List[float]]],
+    List[int],
 ]: ...
 def version() -> str: ...
 def is_hdf5(path: str) -> bool: ...

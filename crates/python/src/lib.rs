@@ -593,20 +593,29 @@ fn reduce(
 }
 
 /// A sweep's table: the swept keys, each row's values as written, the SI value and units of each
-/// input column (None when not numeric), and the summary columns (name, units, values).
+/// input column (None when not numeric), the summary columns (name, units, values) and each
+/// row's index in the whole sweep.
 type SweepTable = (
     Vec<String>,
     Vec<Vec<String>>,
     Vec<Option<(String, Vec<f64>)>>,
     Vec<(String, String, Vec<f64>)>,
+    Vec<usize>,
 );
 
 /// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
-/// (`shpb sweep`, without checkpoint or files).
+/// (`shpb sweep`, without checkpoint or files); `shard = (k, n)` runs only shard k of n
+/// (`shpb sweep --shard k/n`).
 #[pyfunction]
-#[pyo3(signature = (scene, set, jobs = 1))]
-fn sweep(py: Python<'_>, scene: PathBuf, set: Vec<String>, jobs: usize) -> PyResult<SweepTable> {
-    let (axes, rows) = detached(py, || api::sweep_rows(&scene, &set, jobs))?;
+#[pyo3(signature = (scene, set, jobs = 1, shard = (1, 1)))]
+fn sweep(
+    py: Python<'_>,
+    scene: PathBuf,
+    set: Vec<String>,
+    jobs: usize,
+    shard: (usize, usize),
+) -> PyResult<SweepTable> {
+    let (axes, rows) = detached(py, || api::sweep_shard_rows(&scene, &set, shard, jobs))?;
     let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
     let labels: Vec<Vec<String>> = rows.iter().map(|r| r.inputs.clone()).collect();
     let inputs = keys
@@ -636,7 +645,8 @@ fn sweep(py: Python<'_>, scene: PathBuf, set: Vec<String>, jobs: usize) -> PyRes
             )
         })
         .collect();
-    Ok((keys, labels, inputs, columns))
+    let indices = rows.iter().map(|r| r.index).collect();
+    Ok((keys, labels, inputs, columns, indices))
 }
 
 /// The version of shpb this module was built from.

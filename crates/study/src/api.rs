@@ -588,6 +588,18 @@ pub fn sweep_rows(
     set: &[String],
     jobs: usize,
 ) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
+    sweep_shard_rows(scene, set, (1, 1), jobs)
+}
+
+/// Runs shard `k` of `n` of the sweep (`shpb sweep --shard k/n`, without checkpoint or files):
+/// every n-th run of the product from k − 1, each row carrying its index in the whole sweep, so
+/// shards run anywhere (a Dask worker, a job array) combine into [`sweep_rows`]' table.
+pub fn sweep_shard_rows(
+    scene: &Path,
+    set: &[String],
+    (k, n): (usize, usize),
+    jobs: usize,
+) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
     if !scene.is_file() {
         return Err(input_err(
             "SCENE",
@@ -595,11 +607,12 @@ pub fn sweep_rows(
             "a scene .toml file",
         ));
     }
+    let (k, n) = crate::sweep::parse_shard(&format!("{k}/{n}"))?;
     let axes = crate::sweep::parse_axes(set)?;
     // Before anything is allocated: can the sweep finish on this machine? (as `shpb sweep`)
-    crate::sweep::estimate(&axes, (1, 1), crate::sweep::Outputs::default())
+    crate::sweep::estimate(&axes, (k, n), crate::sweep::Outputs::default())
         .check(&crate::sweep::Limits::of_machine(&[]))?;
-    let points = crate::sweep::product(&axes);
+    let points = crate::sweep::shard_points(&axes, k, n);
     crate::sweep::check_points(scene, &axes, &points)?;
     let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;
     Ok((axes, rows))

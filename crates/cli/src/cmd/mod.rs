@@ -4,6 +4,7 @@ pub mod bench;
 pub mod common;
 pub mod convergence;
 pub mod curve;
+pub mod design;
 pub mod gun;
 pub mod incident;
 pub mod list;
