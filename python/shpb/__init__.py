@@ -37,6 +37,8 @@ __all__ = [
     "curve",
     "reduce",
     "sweep",
+    "study",
+    "Study",
     "__version__",
 ]
 
@@ -379,6 +381,75 @@ def sweep(
         return Table(_shpb.sweep(path, specs, int(jobs)))
     parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
     return Table(_combine_shards(parts))
+
+
+class Study:
+    """An uncertainty study (:func:`study`, ``shpb study``): :attr:`runs` is the :class:`Table` of
+    its runs (one row per sample: the inputs drawn and the summary), :attr:`stats` the statistics
+    of each input and summary quantity, as ``shpb study --summary`` writes them::
+
+        s.stats["peak_force"]["mean"], s.stats["peak_force"]["p95"], s.stats["peak_force"]["S"]["pressure"]
+    """
+
+    def __init__(self, raw: Tuple[Any, Any, Any]) -> None:
+        table, stats, spec = raw
+        self.runs: Table = Table(table)
+        """One row per sample: ``runs["peak_force"]``, ``runs.inputs["pressure"]`` (SI units)."""
+        keys = self.runs.keys_swept
+        self.stats: Dict[str, Dict[str, Any]] = {}
+        """Quantity (a summary column, or ``"input KEY"``) → ``unit``, ``n``, ``mean``, ``sd``,
+        ``p5``, ``p50``, ``p95`` and ``S`` (first-order sensitivity index to each input; empty for
+        an input's own row)."""
+        for name, unit, n, mean, sd, (p5, p50, p95), first in stats:
+            self.stats[name] = {
+                "unit": unit,
+                "n": n,
+                "mean": mean,
+                "sd": sd,
+                "p5": p5,
+                "p50": p50,
+                "p95": p95,
+                "S": dict(zip(keys, first)),
+            }
+        self.inputs: List[str] = list(spec)
+        """The study's description: each input's distribution, the seed and the samples."""
+
+    def __repr__(self) -> str:
+        return f"<shpb.Study: {len(self.runs)} samples of {', '.join(self.runs.keys_swept) or 'no input'}>"
+
+
+def study(
+    scene: PathLike,
+    samples: int = 32,
+    seed: int = 1,
+    jobs: int = 1,
+    gun_scatter: bool = True,
+    client: Any = None,
+    shards: Optional[int] = None,
+) -> Study:
+    """Propagates the scene's uncertainties (``shpb study SCENE --samples N --seed S``): its
+    distributions (``pressure = { mean = "12.5psi", sd = "0.6psi" }``) and, with ``gun_scatter``,
+    the set-up's shot-to-shot gun scatter are drawn by a seeded Latin hypercube, each sample is
+    run, and the :class:`Study` holds the runs and their statistics.
+
+    ``client``: a ``dask.distributed.Client``; the samples are then run in ``shards`` shards
+    (default one per worker, every n-th sample as ``--shard k/n`` cuts a sweep), and the study is
+    the one ``shpb study`` gives, bit for bit. Workers must see the scene at the same path.
+    """
+    path = os.path.abspath(os.fspath(scene))
+    args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter))
+    if client is None:
+        rows = _study_shard(*args, 1, 1)
+    else:
+        rows = [r for part in _on_cluster(client, _study_shard, shards, *args) for r in part]
+    return Study(_shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows))
+
+
+def _study_shard(
+    scene: str, samples: int, seed: int, jobs: int, gun_scatter: bool, k: int, n: int
+) -> List[Any]:
+    """Shard ``k`` of ``n`` of a study, run where a Dask worker calls it."""
+    return _shpb.study_runs(scene, samples, seed, jobs, gun_scatter, (k, n))
 
 
 def _sweep_shard(

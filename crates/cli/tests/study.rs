@@ -256,3 +256,29 @@ fn the_shipped_example_study_draws_valid_scenes() {
     }
     assert!(Params::from_file(&path).is_err(), "a single run refuses it");
 }
+
+/// Shards of a study (as Dask workers or a job array run them) join into the whole study: the
+/// same rows bit for bit and the same statistics; a shard's rows alone are refused.
+#[test]
+fn shards_of_a_study_join_into_the_whole_study() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let path = scene(
+        dir.path(),
+        "uncertain.toml",
+        "{ mean = \"10psi\", sd = \"0.5psi\" }",
+    );
+    let whole = study_rows(&path, 5, 11, 1, false, false, |_| {}).unwrap();
+    let mut rows = Vec::new();
+    for k in [2, 1] {
+        let part =
+            shpb::uq::study_shard_rows(&path, 5, 11, 1, false, false, (k, 2), |_| {}).unwrap();
+        assert!(part.rows.iter().all(|r| r.index % 2 == k - 1));
+        rows.extend(part.rows);
+    }
+    let first = rows[..2].to_vec();
+    let joined = shpb::uq::Study::from_rows(&path, 5, 11, false, rows).unwrap();
+    assert_eq!(joined.rows, whole.rows);
+    assert_eq!(joined.statistics_csv(), whole.statistics_csv());
+    let e = shpb::uq::Study::from_rows(&path, 5, 11, false, first).unwrap_err();
+    assert!(e.to_string().contains("exactly once"), "{e}");
+}

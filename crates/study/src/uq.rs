@@ -476,6 +476,17 @@ pub fn study_rows(
     keep_traces: bool,
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Study> {
+    study_shard_rows(scene, n, seed, jobs, gun_scatter, keep_traces, (1, 1), done)
+}
+
+/// The inputs and samples of a study of `scene` (`n` samples drawn with `seed`), every sample
+/// validated: what each shard of the study recomputes identically before running its part.
+fn study_samples(
+    scene: &Path,
+    n: usize,
+    seed: u64,
+    gun_scatter: bool,
+) -> Result<(Vec<StudyInput>, Samples)> {
     if !scene.is_file() {
         return Err(Error::Input {
             file: "command line".into(),
@@ -498,6 +509,26 @@ pub fn study_rows(
     for o in &samples.overrides {
         Params::from_file_overridden(scene, o)?;
     }
+    Ok((inputs, samples))
+}
+
+/// Shard `k` of `m` of a study ([`study_rows`]): the same `n` samples drawn with `seed`, of which
+/// only those with index ≡ k − 1 (mod m) are run (as `shpb sweep --shard k/m` cuts a sweep), so
+/// shards run anywhere (a Dask worker, a job array) and [`Study::from_rows`] joins their rows into
+/// the study [`study_rows`] gives.
+#[allow(clippy::too_many_arguments)]
+pub fn study_shard_rows(
+    scene: &Path,
+    n: usize,
+    seed: u64,
+    jobs: usize,
+    gun_scatter: bool,
+    keep_traces: bool,
+    (k, m): (usize, usize),
+    done: impl Fn(&RunSummary) + Sync,
+) -> Result<Study> {
+    let (k, m) = crate::sweep::parse_shard(&format!("{k}/{m}"))?;
+    let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.max(1))
         .build()
@@ -507,8 +538,9 @@ pub fn study_rows(
             problem: e.to_string(),
             allowed: "a thread count from 1 up".into(),
         })?;
+    let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
     let results: Vec<(RunSummary, RunTraces)> = pool.install(|| {
-        (0..n)
+        indices
             .into_par_iter()
             .map(|i| {
                 let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
@@ -554,6 +586,42 @@ pub fn study_rows(
 }
 
 impl Study {
+    /// The study of `scene` (`n` samples drawn with `seed`) from the rows of its shards
+    /// ([`study_shard_rows`]), in any order: each sample's row exactly once, or an error.
+    pub fn from_rows(
+        scene: &Path,
+        n: usize,
+        seed: u64,
+        gun_scatter: bool,
+        mut rows: Vec<RunSummary>,
+    ) -> Result<Study> {
+        let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
+        rows.sort_by_key(|r| r.index);
+        let complete = rows.len() == n
+            && rows
+                .iter()
+                .enumerate()
+                .all(|(i, r)| r.index == i && r.inputs == samples.labels[i]);
+        if !complete {
+            return Err(Error::Input {
+                file: scene.display().to_string(),
+                key: "rows".into(),
+                problem: format!(
+                    "{} rows do not hold each of the {n} samples of seed {seed} exactly once",
+                    rows.len()
+                ),
+                allowed: "the rows of every shard k/m of the same study, k = 1..m".into(),
+            });
+        }
+        Ok(Study {
+            inputs,
+            samples,
+            rows,
+            traces: Vec::new(),
+            seed,
+        })
+    }
+
     /// The scene keys of the inputs, in order.
     pub fn keys(&self) -> Vec<String> {
         self.inputs.iter().map(|i| i.key.clone()).collect()
