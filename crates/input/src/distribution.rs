@@ -123,24 +123,6 @@ impl Uncertain {
     }
 }
 
-/// Splits `12.5psi` into (12.5, "psi"); `None` when it does not start with a number.
-fn number_and_unit(text: &str) -> Option<(f64, String)> {
-    let t = text.trim();
-    let split = t
-        .char_indices()
-        .find(|(_, c)| !(c.is_ascii_digit() || "+-.eE".contains(*c)))
-        .map(|(i, _)| i)
-        .unwrap_or(t.len());
-    let (mut num, mut unit) = t.split_at(split);
-    while num.ends_with(['e', 'E', '+', '-']) {
-        let k = num.len() - 1;
-        unit = &t[k..];
-        num = &t[..k];
-    }
-    let value: f64 = num.parse().ok()?;
-    Some((value, unit.trim().to_string()))
-}
-
 /// Whether `table` is meant as a distribution: it is not empty and has only distribution keys.
 fn is_distribution(table: &toml::Table) -> bool {
     !table.is_empty()
@@ -206,7 +188,7 @@ fn parse_distribution(key: &str, t: &toml::Table, v: &Validator) -> Result<Uncer
         let (x, unit) = match value {
             toml::Value::Float(x) => (*x, String::new()),
             toml::Value::Integer(i) => (*i as f64, String::new()),
-            toml::Value::String(s) => number_and_unit(s)
+            toml::Value::String(s) => crate::units::number_and_unit(s)
                 .ok_or_else(|| err(format!("{name} = `{s}` is not a number with a unit")))?,
             other => return Err(err(format!("{name} = {other} is not a number"))),
         };

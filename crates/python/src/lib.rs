@@ -709,15 +709,7 @@ fn study_table(
 ) -> PyResult<(SweepTable, Vec<StudyStat>, Vec<String>)> {
     let rows = rows
         .into_iter()
-        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary {
-            index,
-            inputs,
-            peak_force_n: v[0],
-            displacement_at_peak_m: v[1],
-            peak_strain_rate_per_s: v[2],
-            equilibrium_ratio_at_peak: v[3],
-            time_to_equilibrium_s: v[4],
-        })
+        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary::from_values(index, inputs, v))
         .collect();
     let study = detached(py, || {
         shpb_study::uq::Study::from_rows(&scene, samples, seed, gun_scatter, rows)

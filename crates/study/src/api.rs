@@ -22,7 +22,8 @@ use std::path::Path;
 /// The built-in set-up `--bars` names when not given.
 pub const DEFAULT_BARS: &str = "authors";
 
-fn input_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
+/// An input error of the command line (`file = "command line"`) naming the flag or argument `key`.
+pub fn input_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
     Error::Input {
         file: "command line".to_string(),
         key: key.to_string(),
@@ -600,13 +601,7 @@ pub fn sweep_shard_rows(
     (k, n): (usize, usize),
     jobs: usize,
 ) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
-    if !scene.is_file() {
-        return Err(input_err(
-            "SCENE",
-            format!("cannot read {}: no such file", scene.display()),
-            "a scene .toml file",
-        ));
-    }
+    crate::sweep::require_scene(scene)?;
     let (k, n) = crate::sweep::parse_shard(&format!("{k}/{n}"))?;
     let axes = crate::sweep::parse_axes(set)?;
     // Before anything is allocated: can the sweep finish on this machine? (as `shpb sweep`)

@@ -14,15 +14,6 @@ use crate::sweep::{RunSummary, SUMMARY_COLUMNS, number_and_unit};
 use shpb_core::fidelity::Fidelity;
 use shpb_input::{Error, Result};
 
-fn cli_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
-    Error::Input {
-        file: "command line".into(),
-        key: key.into(),
-        problem: problem.into(),
-        allowed: allowed.into(),
-    }
-}
-
 /// Names a summary quantity may be written with besides [`SUMMARY_COLUMNS`]' own (the issue's
 /// `equilibrium_ratio`).
 const QUANTITY_ALIASES: &[(&str, &str)] = &[("equilibrium_ratio", "equilibrium_ratio_at_peak")];
@@ -71,7 +62,7 @@ fn quantity_index(name: &str, flag: &str, spec: &str) -> Result<usize> {
         .iter()
         .position(|(n, _)| *n == name)
         .ok_or_else(|| {
-            cli_err(
+            crate::api::input_err(
                 flag,
                 format!("`{spec}`: unknown quantity `{name}`"),
                 format!("a summary quantity of `shpb sweep`: {}", quantity_names()),
@@ -94,7 +85,7 @@ fn quantity_value(quantity: usize, text: &str, flag: &str, spec: &str) -> Result
         )
     };
     let (v, unit) = number_and_unit(text).ok_or_else(|| {
-        cli_err(
+        crate::api::input_err(
             flag,
             format!("`{spec}`: `{text}` is not a number"),
             allowed(),
@@ -104,10 +95,16 @@ fn quantity_value(quantity: usize, text: &str, flag: &str, spec: &str) -> Result
         .iter()
         .find(|(u, _)| *u == unit)
         .map(|(_, f)| *f)
-        .ok_or_else(|| cli_err(flag, format!("`{spec}`: unknown unit `{unit}`"), allowed()))?;
+        .ok_or_else(|| {
+            crate::api::input_err(flag, format!("`{spec}`: unknown unit `{unit}`"), allowed())
+        })?;
     let si = v * factor;
     if !si.is_finite() {
-        return Err(cli_err(flag, format!("`{spec}`: not finite"), allowed()));
+        return Err(crate::api::input_err(
+            flag,
+            format!("`{spec}`: not finite"),
+            allowed(),
+        ));
     }
     Ok(si)
 }
@@ -161,7 +158,7 @@ impl Target {
 /// to it).
 pub fn parse_target(spec: &str) -> Result<Target> {
     let (name, value) = spec.split_once('=').ok_or_else(|| {
-        cli_err(
+        crate::api::input_err(
             "--target",
             format!("`{spec}`: no `=`"),
             format!(
@@ -178,7 +175,7 @@ pub fn parse_target(spec: &str) -> Result<Target> {
         .find(|(u, _)| *u == unit)
         .map_or(1.0, |(_, f)| *f);
     if value_si == 0.0 {
-        return Err(cli_err(
+        return Err(crate::api::input_err(
             "--target",
             format!("`{spec}`: a target of zero"),
             "a non-zero value (the tolerance is relative to it)",
@@ -237,7 +234,7 @@ pub fn parse_requirement(spec: &str) -> Result<Requirement> {
         .into_iter()
         .find_map(|(s, op)| spec.find(s).map(|i| (i, s.len(), op)));
     let Some((i, len, op)) = found else {
-        return Err(cli_err(
+        return Err(crate::api::input_err(
             "--require",
             format!("`{spec}`: no comparison"),
             format!(
@@ -300,7 +297,8 @@ pub fn significant(v: f64, digits: usize) -> String {
 pub fn parse_vary(spec: &str) -> Result<Vary> {
     let allowed = "KEY=LO:HI with LO < HI in one unit, e.g. pressure=7psi:20psi or \
                    shaper.thickness=0.3mm:0.6mm";
-    let bad = |problem: String| cli_err("--vary", format!("`{spec}`: {problem}"), allowed);
+    let bad =
+        |problem: String| crate::api::input_err("--vary", format!("`{spec}`: {problem}"), allowed);
     let (key, range) = spec.split_once('=').ok_or_else(|| bad("no `=`".into()))?;
     let (lo, hi) = range
         .split_once(':')
@@ -559,7 +557,7 @@ pub fn design(
             })
             .collect(),
         _ => {
-            return Err(cli_err(
+            return Err(crate::api::input_err(
                 "--vary",
                 format!("{} varied inputs", varies.len()),
                 "one (1-D search) or two (a family of solutions over a grid of the second)",

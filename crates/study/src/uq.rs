@@ -487,14 +487,7 @@ fn study_samples(
     seed: u64,
     gun_scatter: bool,
 ) -> Result<(Vec<StudyInput>, Samples)> {
-    if !scene.is_file() {
-        return Err(Error::Input {
-            file: "command line".into(),
-            key: "SCENE".into(),
-            problem: format!("cannot read {}: no such file", scene.display()),
-            allowed: "a scene .toml file".into(),
-        });
-    }
+    crate::sweep::require_scene(scene)?;
     if !(2..=1_000_000).contains(&n) {
         return Err(Error::Input {
             file: "command line".into(),
@@ -529,15 +522,7 @@ pub fn study_shard_rows(
 ) -> Result<Study> {
     let (k, m) = crate::sweep::parse_shard(&format!("{k}/{m}"))?;
     let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
-        .build()
-        .map_err(|e| Error::Input {
-            file: "command line".into(),
-            key: "-j".into(),
-            problem: e.to_string(),
-            allowed: "a thread count from 1 up".into(),
-        })?;
+    let pool = crate::sweep::thread_pool(jobs)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
     let results: Vec<(RunSummary, RunTraces)> = pool.install(|| {
         indices

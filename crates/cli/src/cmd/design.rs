@@ -27,15 +27,6 @@ pub struct DesignOptions<'a> {
     pub max_runs: usize,
 }
 
-fn cli_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
-    Error::Input {
-        file: "command line".into(),
-        key: key.into(),
-        problem: problem.into(),
-        allowed: allowed.into(),
-    }
-}
-
 /// Parses `--tol`: a fraction (`0.002`) or a percentage (`0.2%`) of the target, in (0, 50 %].
 pub fn parse_tol(text: &str) -> Result<f64> {
     let t = text.trim();
@@ -46,7 +37,7 @@ pub fn parse_tol(text: &str) -> Result<f64> {
     let v = number.trim().parse::<f64>().ok().map(|v| v * scale);
     match v {
         Some(v) if v > 0.0 && v <= 0.5 => Ok(v),
-        _ => Err(cli_err(
+        _ => Err(shpb_study::api::input_err(
             "--tol",
             format!("`{text}`"),
             "a fraction of the target in (0, 0.5], or a percentage in (0 %, 50 %], e.g. 0.2% or \
@@ -60,13 +51,7 @@ pub fn parse_tol(text: &str) -> Result<f64> {
 /// when no input within the bounds meets the target and 5 when the solutions violate a
 /// `--require` (README "Design search").
 pub fn design(scene: &Path, o: &DesignOptions) -> Result<()> {
-    if !scene.is_file() {
-        return Err(cli_err(
-            "SCENE",
-            format!("cannot read {}: no such file", scene.display()),
-            "a scene .toml file",
-        ));
-    }
+    shpb_study::sweep::require_scene(scene)?;
     let target = parse_target(o.target)?;
     let varies = o
         .vary
@@ -74,14 +59,14 @@ pub fn design(scene: &Path, o: &DesignOptions) -> Result<()> {
         .map(|v| parse_vary(v))
         .collect::<Result<Vec<_>>>()?;
     if varies.len() > 2 {
-        return Err(cli_err(
+        return Err(shpb_study::api::input_err(
             "--vary",
             format!("{} varied inputs", varies.len()),
             "one (1-D search) or two (the first solved on a grid of the second)",
         ));
     }
     if varies.len() == 2 && varies[0].key == varies[1].key {
-        return Err(cli_err(
+        return Err(shpb_study::api::input_err(
             "--vary",
             format!("`{}` is varied twice", varies[0].key),
             "two different keys",
@@ -94,14 +79,14 @@ pub fn design(scene: &Path, o: &DesignOptions) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     let tol = parse_tol(o.tol)?;
     if !(2..=50).contains(&o.grid) {
-        return Err(cli_err(
+        return Err(shpb_study::api::input_err(
             "--grid",
             format!("{}", o.grid),
             "2 to 50 values of the second --vary",
         ));
     }
     if !(3..=1000).contains(&o.max_runs) {
-        return Err(cli_err(
+        return Err(shpb_study::api::input_err(
             "--max-runs",
             format!("{}", o.max_runs),
             "3 to 1000 runs per 1-D search (two bound runs and a confirmation at least)",
