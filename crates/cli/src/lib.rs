@@ -6,7 +6,8 @@
 //! the layers so that `shpb::bar`, `shpb::scene::Params` or `shpb::io::write_hdf5` name the same
 //! items as `shpb_core::bar`, … (see ARCHITECTURE.md for the map):
 //! `shpb-core` (physics and numerics) ← `shpb-input` (files → validated core objects) ←
-//! `shpb-output` (writers) ← `shpb-study` (sweeps, convergence, bench) ← `shpb-validate`.
+//! `shpb-output` (writers) ← `shpb-study` (sweeps, uncertainty studies, convergence, bench) ←
+//! `shpb-validate`.
 
 #![warn(missing_docs)]
 
@@ -19,11 +20,11 @@ pub use shpb_core::{
     solver, specimen, striker,
 };
 pub use shpb_input::{
-    Error, Result, Validator, csv, error, gauges, kinds, provenance, resources, units,
+    Error, Result, Validator, csv, distribution, error, gauges, kinds, provenance, resources, units,
 };
 pub use shpb_output::{batch, io, plot, study as study_table, writer};
 pub use shpb_study::{
-    api, bench, convergence, file as study_file, identity as study_identity, sweep,
+    api, bench, convergence, file as study_file, identity as study_identity, sweep, uq,
 };
 pub use shpb_validate as validate;
 

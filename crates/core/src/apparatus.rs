@@ -101,6 +101,9 @@ pub struct Apparatus {
     /// The gauge pressures (lowest, highest) the gun (and shaper) were calibrated at, Pa; a run
     /// outside them is warned about (the striker velocity is extrapolated). None: not stated.
     pub gun_calibrated_pa: Option<(f64, f64)>,
+    /// The gun's shot-to-shot scatter: relative standard deviation of the striker velocity at one
+    /// pressure (docs/physics.md §10.4); `shpb study` draws it by default. None: not stated.
+    pub gun_velocity_scatter: Option<f64>,
     /// Default pulse shaper (None: no shaper).
     pub shaper: Option<PulseShaper>,
     /// Gauge channels.

@@ -83,6 +83,14 @@ pub enum Error {
         /// The keys that make the run smaller.
         hint: String,
     },
+    /// A design search (`shpb design`) found no input within the bounds that meets its target
+    /// (exit code 4): the message names the target, the bounds and what the runs gave.
+    #[error("{0}")]
+    NoSolution(String),
+    /// A design search met its target, but no solution satisfies every `--require` constraint
+    /// (exit code 5): the message names the constraints and the values at the solutions.
+    #[error("{0}")]
+    RequirementUnmet(String),
     /// A physical quantity outside its model's range, reported by the core without a file
     /// (a caller of the library passed it directly).
     #[error("{quantity}: {problem}; allowed: {allowed}")]
@@ -142,7 +150,8 @@ pub type Result<T> = std::result::Result<T, Error>;
 impl Error {
     /// Process exit code for this error: 2 for bad input (a missing input file included,
     /// wherever it is read, and a run too large for the machine), 3 for an unstable run, 130 for
-    /// a run interrupted by its caller (as SIGINT), 1 otherwise.
+    /// a run interrupted by its caller (as SIGINT), 4 for a design search without a solution, 5
+    /// for a design whose solutions violate a `--require` constraint, 1 otherwise.
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Input { .. }
@@ -152,6 +161,8 @@ impl Error {
             | Error::Invalid { .. } => 2,
             Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => 2,
             Error::Unstable { .. } => 3,
+            Error::NoSolution(_) => 4,
+            Error::RequirementUnmet(_) => 5,
             Error::Interrupted { .. } => 130,
             Error::Io { .. } | Error::Hdf5 { .. } => 1,
         }

@@ -9,6 +9,7 @@
 
 pub mod builtin;
 pub mod csv;
+pub mod distribution;
 pub mod error;
 pub mod files;
 pub mod gauges;

@@ -37,6 +37,8 @@ impl SceneFile for Params {
     fn from_toml(text: &str, file: &str, base_dir: &Path) -> Result<Params> {
         let v = Validator::new(file);
         let table: toml::Table = parse_as(text, file)?;
+        // A distribution (`shpb study`) is not one value: a single run refuses it.
+        crate::distribution::refuse_distributions(&table, file)?;
         let kind = match table.get("kind") {
             Some(toml::Value::String(k)) => k.clone(),
             Some(_) => return Err(v.error("kind", "not a string", kinds::allowed())),

@@ -45,6 +45,7 @@ struct GunToml {
     max_pressure_pa: f64,
     calibrated_min_pressure_pa: Option<f64>,
     calibrated_max_pressure_pa: Option<f64>,
+    velocity_scatter: Option<f64>,
 }
 
 #[derive(Deserialize, Clone)]
@@ -317,6 +318,10 @@ impl ApparatusFile for Apparatus {
                 ));
             }
         };
+        let gun_velocity_scatter = g
+            .velocity_scatter
+            .map(|s| gv.in_range("velocity_scatter", s, 0.0, 0.5, "1"))
+            .transpose()?;
         let need = |key: &str, x: Option<f64>| {
             x.ok_or_else(|| {
                 gv.error(
@@ -432,6 +437,7 @@ impl ApparatusFile for Apparatus {
             striker,
             gun,
             gun_calibrated_pa,
+            gun_velocity_scatter,
             shaper,
             gauges,
         })

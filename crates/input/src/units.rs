@@ -53,3 +53,22 @@ pub fn cli_pressure(text: &str) -> Result<f64> {
         allowed: PRESSURE_SYNTAX.into(),
     })
 }
+
+/// Splits `12.5psi` into (12.5, "psi"); `None` when it does not start with a number. A trailing
+/// `e`/`E` belongs to the unit when no exponent digits follow (`5e` is 5 and the unit `e`).
+pub fn number_and_unit(text: &str) -> Option<(f64, String)> {
+    let t = text.trim();
+    let split = t
+        .char_indices()
+        .find(|(_, c)| !(c.is_ascii_digit() || "+-.eE".contains(*c)))
+        .map(|(i, _)| i)
+        .unwrap_or(t.len());
+    let (mut num, mut unit) = t.split_at(split);
+    while num.ends_with(['e', 'E', '+', '-']) {
+        let k = num.len() - 1;
+        unit = &t[k..];
+        num = &t[..k];
+    }
+    let value: f64 = num.parse().ok()?;
+    Some((value, unit.trim().to_string()))
+}

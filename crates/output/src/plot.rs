@@ -511,6 +511,57 @@ pub fn sweep_figure(
     })
 }
 
+/// One panel of [`band_figure`]: a quantity's 5, 50 and 95 % percentiles against time (or
+/// another abscissa).
+pub struct BandPanel<'a> {
+    /// Caption.
+    pub title: &'a str,
+    /// y-axis label with unit.
+    pub y_label: &'a str,
+    /// Factor applied to the values for display.
+    pub y_scale: f64,
+    /// x-axis label with unit.
+    pub x_label: &'a str,
+    /// Factor applied to the abscissae for display.
+    pub x_scale: f64,
+    /// Abscissae (time in s, an approach in m).
+    pub x: &'a [f64],
+    /// The 5, 50 and 95 % percentiles at each time.
+    pub p5_p50_p95: [&'a [f64]; 3],
+}
+
+/// The bands of a study (`shpb study --plot`): one panel per quantity, its median as a line and
+/// its 5 % and 95 % percentiles dashed.
+pub fn band_figure(path: &Path, force: bool, panels: &[BandPanel]) -> Result<()> {
+    write_atomically(path, force, |tmp| {
+        let width = 800 * panels.len().max(1) as u32;
+        let root = BitMapBackend::new(tmp, (width, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let areas = root.split_evenly((1, panels.len().max(1)));
+        for (area, p) in areas.iter().zip(panels) {
+            let axes = Axes {
+                title: p.title,
+                x_label: p.x_label,
+                y_label: p.y_label,
+                x_scale: p.x_scale,
+                y_scale: p.y_scale,
+            };
+            let curves: Vec<Curve> = ["5 %", "median", "95 %"]
+                .iter()
+                .zip(p.p5_p50_p95)
+                .map(|(label, y)| Curve {
+                    label: label.to_string(),
+                    x: p.x,
+                    y,
+                    measured: *label != "median",
+                })
+                .collect();
+            draw_xy(area, path, &axes, &curves)?;
+        }
+        root.present().map_err(perr(path))
+    })
+}
+
 /// Draws a run: force against displacement for sphere scenes (with the measured curve for
 /// force-driven ones), gauge signals as bar stress against time for bar scenes.
 pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> Result<()> {

@@ -593,21 +593,20 @@ fn reduce(
 }
 
 /// A sweep's table: the swept keys, each row's values as written, the SI value and units of each
-/// input column (None when not numeric), and the summary columns (name, units, values).
+/// input column (None when not numeric), the summary columns (name, units, values) and each
+/// row's index in the whole sweep.
 type SweepTable = (
     Vec<String>,
     Vec<Vec<String>>,
     Vec<Option<(String, Vec<f64>)>>,
     Vec<(String, String, Vec<f64>)>,
+    Vec<usize>,
 );
 
-/// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
-/// (`shpb sweep`, without checkpoint or files).
-#[pyfunction]
-#[pyo3(signature = (scene, set, jobs = 1))]
-fn sweep(py: Python<'_>, scene: PathBuf, set: Vec<String>, jobs: usize) -> PyResult<SweepTable> {
-    let (axes, rows) = detached(py, || api::sweep_rows(&scene, &set, jobs))?;
-    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+/// The rows of a table as Python takes them: each row's inputs as written, the SI value and units
+/// of each input column (None when not numeric), the summary columns (name, units, values) and
+/// each row's index in the whole sweep or study.
+fn table_columns(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> SweepTable {
     let labels: Vec<Vec<String>> = rows.iter().map(|r| r.inputs.clone()).collect();
     let inputs = keys
         .iter()
@@ -636,7 +635,105 @@ fn sweep(py: Python<'_>, scene: PathBuf, set: Vec<String>, jobs: usize) -> PyRes
             )
         })
         .collect();
-    Ok((keys, labels, inputs, columns))
+    let indices = rows.iter().map(|r| r.index).collect();
+    (keys.to_vec(), labels, inputs, columns, indices)
+}
+
+/// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
+/// (`shpb sweep`, without checkpoint or files); `shard = (k, n)` runs only shard k of n
+/// (`shpb sweep --shard k/n`).
+#[pyfunction]
+#[pyo3(signature = (scene, set, jobs = 1, shard = (1, 1)))]
+fn sweep(
+    py: Python<'_>,
+    scene: PathBuf,
+    set: Vec<String>,
+    jobs: usize,
+    shard: (usize, usize),
+) -> PyResult<SweepTable> {
+    let (axes, rows) = detached(py, || api::sweep_shard_rows(&scene, &set, shard, jobs))?;
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    Ok(table_columns(&keys, &rows))
+}
+
+/// A study's runs as they travel between processes: (sample index, inputs as written, the
+/// summary values in the order of `SUMMARY_COLUMNS`).
+type StudyRows = Vec<(usize, Vec<String>, [f64; 5])>;
+
+/// Runs shard `k` of `n` (`shard`) of the study of `scene` (`shpb study`: `samples` Latin-
+/// hypercube samples drawn with `seed`, the gun scatter with `gun_scatter`) on `jobs` threads.
+#[pyfunction]
+#[pyo3(signature = (scene, samples, seed = 1, jobs = 1, gun_scatter = true, shard = (1, 1)))]
+fn study_runs(
+    py: Python<'_>,
+    scene: PathBuf,
+    samples: usize,
+    seed: u64,
+    jobs: usize,
+    gun_scatter: bool,
+    shard: (usize, usize),
+) -> PyResult<StudyRows> {
+    let study = detached(py, || {
+        shpb_study::uq::study_shard_rows(
+            &scene,
+            samples,
+            seed,
+            jobs,
+            gun_scatter,
+            false,
+            shard,
+            |_| {},
+        )
+    })?;
+    Ok(study
+        .rows
+        .iter()
+        .map(|r| (r.index, r.inputs.clone(), r.values()))
+        .collect())
+}
+
+/// One statistic row of a study: quantity, units, finite values counted, mean, sd, the 5/50/95 %
+/// percentiles and the first-order index to each input (empty for an input's own row).
+type StudyStat = (String, String, usize, f64, f64, [f64; 3], Vec<f64>);
+
+/// The study of `scene` from the rows of all its shards (`study_runs`): its table (as `sweep`
+/// returns one), its statistics (`shpb study --summary`) and the description of its inputs.
+#[pyfunction]
+fn study_table(
+    py: Python<'_>,
+    scene: PathBuf,
+    samples: usize,
+    seed: u64,
+    gun_scatter: bool,
+    rows: StudyRows,
+) -> PyResult<(SweepTable, Vec<StudyStat>, Vec<String>)> {
+    let rows = rows
+        .into_iter()
+        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary::from_values(index, inputs, v))
+        .collect();
+    let study = detached(py, || {
+        shpb_study::uq::Study::from_rows(&scene, samples, seed, gun_scatter, rows)
+    })?;
+    let stats = study
+        .statistics()
+        .into_iter()
+        .map(|s| {
+            (
+                s.name,
+                s.unit,
+                s.count,
+                s.mean,
+                s.sd,
+                s.p5_p50_p95,
+                s.first_order,
+            )
+        })
+        .collect();
+    Ok((
+        table_columns(&study.keys(), &study.rows),
+        stats,
+        study.specification(),
+    ))
 }
 
 /// The version of shpb this module was built from.
@@ -658,6 +755,8 @@ fn _shpb(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<RunData>()?;
     for f in [
         wrap_pyfunction!(run, m)?,
+        wrap_pyfunction!(study_runs, m)?,
+        wrap_pyfunction!(study_table, m)?,
         wrap_pyfunction!(load, m)?,
         wrap_pyfunction!(gun, m)?,
         wrap_pyfunction!(curve, m)?,

@@ -22,7 +22,8 @@ use std::path::Path;
 /// The built-in set-up `--bars` names when not given.
 pub const DEFAULT_BARS: &str = "authors";
 
-fn input_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
+/// An input error of the command line (`file = "command line"`) naming the flag or argument `key`.
+pub fn input_err(key: &str, problem: impl Into<String>, allowed: impl Into<String>) -> Error {
     Error::Input {
         file: "command line".to_string(),
         key: key.to_string(),
@@ -588,19 +589,40 @@ pub fn sweep_rows(
     set: &[String],
     jobs: usize,
 ) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
-    if !scene.is_file() {
-        return Err(input_err(
-            "SCENE",
-            format!("cannot read {}: no such file", scene.display()),
-            "a scene .toml file",
-        ));
-    }
+    sweep_shard_rows(scene, set, (1, 1), jobs)
+}
+
+/// Runs shard `k` of `n` of the sweep (`shpb sweep --shard k/n`, without checkpoint or files):
+/// every n-th run of the product from k − 1, each row carrying its index in the whole sweep, so
+/// shards run anywhere (a Dask worker, a job array) combine into [`sweep_rows`]' table.
+pub fn sweep_shard_rows(
+    scene: &Path,
+    set: &[String],
+    (k, n): (usize, usize),
+    jobs: usize,
+) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
+    crate::sweep::require_scene(scene)?;
+    let (k, n) = crate::sweep::parse_shard(&format!("{k}/{n}"))?;
     let axes = crate::sweep::parse_axes(set)?;
     // Before anything is allocated: can the sweep finish on this machine? (as `shpb sweep`)
-    crate::sweep::estimate(&axes, (1, 1), crate::sweep::Outputs::default())
+    crate::sweep::estimate(&axes, (k, n), crate::sweep::Outputs::default())
         .check(&crate::sweep::Limits::of_machine(&[]))?;
-    let points = crate::sweep::product(&axes);
+    let points = crate::sweep::shard_points(&axes, k, n);
     crate::sweep::check_points(scene, &axes, &points)?;
     let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;
     Ok((axes, rows))
+}
+
+/// A whole uncertainty study of `scene` (`shpb study` without outputs): `samples` runs drawn by
+/// a Latin hypercube seeded with `seed` from the scene's distributions and, with `gun_scatter`,
+/// the set-up's gun scatter, run on `jobs` threads ([`crate::uq::study_rows`]);
+/// [`crate::uq::Study::statistics`] gives each quantity's mean, sd, percentiles and indices.
+pub fn study_rows(
+    scene: &Path,
+    samples: usize,
+    seed: u64,
+    jobs: usize,
+    gun_scatter: bool,
+) -> Result<crate::uq::Study> {
+    crate::uq::study_rows(scene, samples, seed, jobs, gun_scatter, false, |_| {})
 }

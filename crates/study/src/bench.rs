@@ -27,6 +27,19 @@ pub struct Row {
     pub displacement_error: f64,
     /// RMS difference of the transmission-gauge strain from the reference, relative to its peak.
     pub signal_rms_error: f64,
+    /// Node updates of the run, steps × bar nodes and bodies ([`shpb_core::estimate::RunEstimate::updates`]).
+    pub node_steps: f64,
+}
+
+/// Cost per step of the whole run against a minimal loop of the same size (issue 20): what a
+/// regression in the hot loops shows in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepCost {
+    /// Wall-clock time of the whole run (all its work: bars, joints, recording, reduction)
+    /// divided by its node updates, s.
+    pub run_s: f64,
+    /// The same for the minimal loop ([`minimal_leapfrog_s`] or [`minimal_dem_s`]), s.
+    pub minimal_s: f64,
 }
 
 /// Memory use at one bar-length scale.
@@ -50,6 +63,72 @@ pub struct Bench {
     /// Memory against bar length (standard preset, fixed run duration, no snapshots), measured
     /// first and in ascending size so the process's high-water mark tracks each run.
     pub memory: Vec<MemoryRow>,
+    /// Per node-step cost of the `standard` full test against a minimal leapfrog of its size.
+    pub node_step: StepCost,
+    /// Per step cost of the force-driven Fig. 4 DEM (`scenes/force-driven-ss440c-10psi.toml`
+    /// beside the scene, when present) against a minimal velocity-Verlet Hertz step.
+    pub dem_step: Option<StepCost>,
+}
+
+/// Time per node update of the minimal lumped-mass leapfrog (unit masses and springs, Courant 1,
+/// free ends): `nodes` nodes advanced `steps` steps, median of `repeats`, s. The floor the bar
+/// solver is measured against (the loop a compiler makes of u += v; v += (u₋ − 2u + u₊)).
+pub fn minimal_leapfrog_s(nodes: usize, steps: usize, repeats: usize) -> f64 {
+    let nodes = nodes.max(3);
+    let mut times = Vec::new();
+    for _ in 0..repeats.max(1) {
+        let mut u = vec![0.0f64; nodes];
+        let mut v = vec![0.0f64; nodes];
+        v[0] = 1.0;
+        let start = Instant::now();
+        for _ in 0..steps {
+            for (ui, vi) in u.iter_mut().zip(&v) {
+                *ui += vi;
+            }
+            v[0] += u[1] - u[0];
+            for i in 1..nodes - 1 {
+                v[i] += u[i - 1] - 2.0 * u[i] + u[i + 1];
+            }
+            v[nodes - 1] += u[nodes - 2] - u[nodes - 1];
+            std::hint::black_box(&mut v);
+        }
+        times.push(start.elapsed().as_secs_f64() / (nodes * steps.max(1)) as f64);
+        std::hint::black_box(&u);
+    }
+    median(times)
+}
+
+/// Time per step of a minimal two-sphere DEM: velocity Verlet with the Hertz force (one square
+/// root a step, no rate, no memory, no checks), `steps` steps, median of `repeats`, s (per
+/// degree of freedom, as [`RunEstimate::updates`](shpb_core::estimate::RunEstimate::updates)
+/// counts the DEM's two spheres).
+pub fn minimal_dem_s(steps: usize, repeats: usize) -> f64 {
+    let (k, m, dt) = (1.0e10f64, 1.0e-3f64, 1.0e-9f64);
+    let mut times = Vec::new();
+    for _ in 0..repeats.max(1) {
+        let (mut x1, mut x2, mut v1, mut v2, mut f) = (0.0f64, 0.0f64, 1.0f64, 0.0f64, 0.0f64);
+        let start = Instant::now();
+        for _ in 0..steps {
+            let h1 = v1 - 0.5 * dt * f / m;
+            let h2 = v2 + 0.5 * dt * f / m;
+            x1 += dt * h1;
+            x2 += dt * h2;
+            let d = (x1 - x2).max(0.0);
+            f = k * d * d.sqrt();
+            v1 = h1 - 0.5 * dt * f / m;
+            v2 = h2 + 0.5 * dt * f / m;
+            std::hint::black_box(&mut v1);
+        }
+        times.push(start.elapsed().as_secs_f64() / (2 * steps.max(1)) as f64);
+        std::hint::black_box((x1, x2, v2));
+    }
+    median(times)
+}
+
+/// The median of a non-empty list.
+fn median(mut times: Vec<f64>) -> f64 {
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
 }
 
 /// Peak resident set size of this process so far (Linux `/proc/self/status` VmHWM), bytes.
@@ -70,12 +149,17 @@ fn timed(params: &Params, repeats: usize) -> Result<(f64, RunOutput)> {
         times.push(start.elapsed().as_secs_f64());
         last = Some(out);
     }
-    times.sort_by(f64::total_cmp);
-    Ok((times[times.len() / 2], last.expect("at least one run")))
+    Ok((median(times), last.expect("at least one run")))
 }
 
 /// A row comparing `out` with `reference` (both full tests: the scene was checked to have spheres).
-fn row(label: &str, runtime_s: f64, out: &RunOutput, reference: &RunOutput) -> Row {
+fn row(
+    label: &str,
+    runtime_s: f64,
+    node_steps: f64,
+    out: &RunOutput,
+    reference: &RunOutput,
+) -> Row {
     let (m, r) = (metrics(out), metrics(reference));
     let ((t, y), (tr, yr)) = (signal(out), signal(reference));
     Row {
@@ -87,6 +171,7 @@ fn row(label: &str, runtime_s: f64, out: &RunOutput, reference: &RunOutput) -> R
         displacement_error: (m.displacement_at_peak_m - r.displacement_at_peak_m).abs()
             / r.displacement_at_peak_m,
         signal_rms_error: rms_difference(&t, &y, &tr, &yr),
+        node_steps,
     }
 }
 
@@ -140,18 +225,22 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
         });
     }
     progress("reference preset");
-    let (t_ref, reference) = timed(&load(Fidelity::Reference, &[])?, 1)?;
+    let reference_params = load(Fidelity::Reference, &[])?;
+    let (t_ref, reference) = timed(&reference_params, 1)?;
     let mut presets = Vec::new();
     for f in [Fidelity::Fast, Fidelity::Standard] {
         progress(&format!("{} preset", f.name()));
-        let (t, out) = timed(&load(f, &[])?, repeats)?;
-        presets.push(row(f.name(), t, &out, &reference));
+        let p = load(f, &[])?;
+        let (t, out) = timed(&p, repeats)?;
+        presets.push(row(f.name(), t, p.estimate().updates(), &out, &reference));
     }
-    presets.push(row("reference", t_ref, &reference, &reference));
+    let n_ref = reference_params.estimate().updates();
+    presets.push(row("reference", t_ref, n_ref, &reference, &reference));
 
     progress("physics knobs");
     let (t_std, standard) = timed(&base, repeats)?;
-    let mut knobs = vec![row("standard", t_std, &standard, &standard)];
+    let n_std = base.estimate().updates();
+    let mut knobs = vec![row("standard", t_std, n_std, &standard, &standard)];
     let s = |x: &str| shpb_input::scene::Value::String(x.into());
     for (label, extra) in [
         ("dispersion = love-rod", vec![("dispersion", s("love-rod"))]),
@@ -166,21 +255,44 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
         ),
     ] {
         progress(label);
-        let (t, out) = timed(&load(Fidelity::Standard, &extra)?, repeats)?;
-        knobs.push(row(label, t, &out, &standard));
+        let p = load(Fidelity::Standard, &extra)?;
+        let (t, out) = timed(&p, repeats)?;
+        knobs.push(row(label, t, p.estimate().updates(), &out, &standard));
     }
+
+    progress("minimal loops");
+    let est = base.estimate();
+    let node_step = StepCost {
+        run_s: t_std / n_std,
+        minimal_s: minimal_leapfrog_s(est.degrees_of_freedom as usize, est.steps as usize, repeats),
+    };
+    let dem = path.with_file_name("force-driven-ss440c-10psi.toml");
+    let dem_step = if dem.is_file() {
+        progress("force-driven DEM");
+        let p = Params::from_file_overridden(&dem, &[])?;
+        let (t, _) = timed(&p, repeats)?;
+        let e = p.estimate();
+        Some(StepCost {
+            run_s: t / e.updates(),
+            minimal_s: minimal_dem_s(e.steps as usize, repeats),
+        })
+    } else {
+        None
+    };
 
     Ok(Bench {
         presets,
         knobs,
         memory,
+        node_step,
+        dem_step,
     })
 }
 
 /// The bench as markdown tables.
 pub fn markdown(b: &Bench) -> String {
     let mut t = String::from(
-        "| preset | run time (ms) | ratio to standard | peak force (kN) | error vs reference | δ at peak (µm) | error vs reference | gauge signal RMS vs reference |\n|---|---|---|---|---|---|---|---|\n",
+        "| preset | run time (ms) | ratio to standard | ns per node-step | peak force (kN) | error vs reference | δ at peak (µm) | error vs reference | gauge signal RMS vs reference |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     let t_std = b
         .presets
@@ -190,10 +302,11 @@ pub fn markdown(b: &Bench) -> String {
         .unwrap_or(1.0);
     for r in &b.presets {
         t.push_str(&format!(
-            "| {} | {:.1} | {:.2} | {:.4} | {:.1e} | {:.3} | {:.1e} | {:.1e} |\n",
+            "| {} | {:.1} | {:.2} | {:.2} | {:.4} | {:.1e} | {:.3} | {:.1e} | {:.1e} |\n",
             r.label,
             r.runtime_s * 1e3,
             r.runtime_s / t_std,
+            1e9 * r.runtime_s / r.node_steps,
             r.peak_force_n * 1e-3,
             r.peak_error,
             r.displacement_at_peak_m * 1e6,
@@ -201,19 +314,41 @@ pub fn markdown(b: &Bench) -> String {
             r.signal_rms_error
         ));
     }
-    t.push_str("\n| physics knob (on `standard`) | run time (ms) | ratio | peak force (kN) | change | δ at peak (µm) | change | gauge signal RMS change |\n|---|---|---|---|---|---|---|---|\n");
+    t.push_str("\n| physics knob (on `standard`) | run time (ms) | ratio | ns per node-step | peak force (kN) | change | δ at peak (µm) | change | gauge signal RMS change |\n|---|---|---|---|---|---|---|---|---|\n");
     for r in &b.knobs {
         t.push_str(&format!(
-            "| {} | {:.1} | {:.2} | {:.4} | {:.1} % | {:.3} | {:.1} % | {:.1} % |\n",
+            "| {} | {:.1} | {:.2} | {:.2} | {:.4} | {:.1} % | {:.3} | {:.1} % | {:.1} % |\n",
             r.label,
             r.runtime_s * 1e3,
             r.runtime_s / t_std,
+            1e9 * r.runtime_s / r.node_steps,
             r.peak_force_n * 1e-3,
             100.0 * r.peak_error,
             r.displacement_at_peak_m * 1e6,
             100.0 * r.displacement_error,
             100.0 * r.signal_rms_error
         ));
+    }
+    t.push_str(
+        "\n| per step (median) | whole run (ns) | minimal loop (ns) | ratio |\n|---|---|---|---|\n",
+    );
+    let mut cost = |label: &str, c: &StepCost| {
+        t.push_str(&format!(
+            "| {label} | {:.2} | {:.2} | {:.1} |\n",
+            1e9 * c.run_s,
+            1e9 * c.minimal_s,
+            c.run_s / c.minimal_s
+        ))
+    };
+    cost(
+        "`standard` full test, per node-step (minimal: lumped-mass leapfrog of the same nodes and steps)",
+        &b.node_step,
+    );
+    if let Some(d) = &b.dem_step {
+        cost(
+            "force-driven Fig. 4 DEM, per sphere-step (minimal: velocity Verlet with Hertz)",
+            d,
+        );
     }
     t.push_str("\n| bars (incident + transmission, m) | nodes | peak resident memory (MiB) |\n|---|---|---|\n");
     for m in &b.memory {
@@ -227,4 +362,18 @@ pub fn markdown(b: &Bench) -> String {
         ));
     }
     t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn minimal_loops_take_time_per_update_below_a_microsecond() {
+        // A few nanoseconds a node-step on any machine this runs on; a microsecond would mean
+        // the loop is not the minimal one (or the count of updates is wrong).
+        for t in [minimal_leapfrog_s(1000, 200, 3), minimal_dem_s(20_000, 3)] {
+            assert!(t > 0.0 && t < 1e-6, "{t}");
+        }
+    }
 }

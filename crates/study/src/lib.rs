@@ -1,14 +1,18 @@
-//! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`), the
-//! convergence of a scene under refinement (`shpb convergence`) and the speed/accuracy bench of
-//! the fidelity presets (`shpb bench`).
+//! shpb-study: many runs of one scene. Parameter sweeps (`shpb sweep`, `merge`, `--resume`),
+//! uncertainty studies (`shpb study`: Latin-hypercube samples of a scene's distributions, [`uq`]),
+//! the convergence of a scene under refinement (`shpb convergence`), the speed/accuracy bench
+//! of the fidelity presets (`shpb bench`), and the design search for inputs that meet a target
+//! (`shpb design`).
 
 #![warn(missing_docs)]
 
 pub mod api;
 pub mod bench;
 pub mod convergence;
+pub mod design;
 pub mod file;
 pub mod identity;
 pub mod sweep;
+pub mod uq;
 
 pub use shpb_input::{Error, Result};

@@ -44,24 +44,7 @@ fn bad_set(spec: &str, problem: impl Into<String>) -> Error {
     }
 }
 
-/// Splits `12.5psi` into (12.5, "psi"); None when it does not start with a number.
-pub fn number_and_unit(text: &str) -> Option<(f64, String)> {
-    let t = text.trim();
-    let split = t
-        .char_indices()
-        .find(|(_, c)| !(c.is_ascii_digit() || "+-.eE".contains(*c)))
-        .map(|(i, _)| i)
-        .unwrap_or(t.len());
-    // A trailing `e`/`E` belongs to the unit when no exponent digits follow.
-    let (mut num, mut unit) = t.split_at(split);
-    while num.ends_with(['e', 'E', '+', '-']) {
-        let k = num.len() - 1;
-        unit = &t[k..];
-        num = &t[..k];
-    }
-    let value: f64 = num.parse().ok()?;
-    Some((value, unit.trim().to_string()))
-}
+pub use shpb_input::units::number_and_unit;
 
 /// The TOML value of one text value of `key`: lengths in m for `_m` keys, numbers as floats,
 /// anything else (a pressure with unit, a law name) as a string the scene validates.
@@ -276,7 +259,47 @@ pub const SUMMARY_COLUMNS: [(&str, &str); 5] = [
     ("time_to_equilibrium", "s"),
 ];
 
+/// A pool of `jobs` worker threads (`-j`; 0 counts as 1) for the runs of a sweep or a study.
+pub fn thread_pool(jobs: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .map_err(|e| Error::Input {
+            file: "command line".into(),
+            key: "-j".into(),
+            problem: e.to_string(),
+            allowed: "a thread count from 1 up".into(),
+        })
+}
+
+/// An input error unless `scene` names a readable file (before any run is planned).
+pub fn require_scene(scene: &Path) -> Result<()> {
+    if scene.is_file() {
+        return Ok(());
+    }
+    Err(Error::Input {
+        file: "command line".into(),
+        key: "SCENE".into(),
+        problem: format!("cannot read {}: no such file", scene.display()),
+        allowed: "a scene .toml file".into(),
+    })
+}
+
 impl RunSummary {
+    /// A row from its index, inputs as written and numeric columns in the order of
+    /// [`SUMMARY_COLUMNS`] (the inverse of [`RunSummary::values`]).
+    pub fn from_values(index: usize, inputs: Vec<String>, v: [f64; 5]) -> RunSummary {
+        RunSummary {
+            index,
+            inputs,
+            peak_force_n: v[0],
+            displacement_at_peak_m: v[1],
+            peak_strain_rate_per_s: v[2],
+            equilibrium_ratio_at_peak: v[3],
+            time_to_equilibrium_s: v[4],
+        }
+    }
+
     /// The numeric columns in the order of [`SUMMARY_COLUMNS`].
     pub fn values(&self) -> [f64; 5] {
         [
@@ -360,15 +383,7 @@ pub fn run_points(
     threads: usize,
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Vec<RunSummary>> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.max(1))
-        .build()
-        .map_err(|e| Error::Input {
-            file: "command line".into(),
-            key: "-j".into(),
-            problem: e.to_string(),
-            allowed: "a thread count from 1 up".into(),
-        })?;
+    let pool = thread_pool(threads)?;
     pool.install(|| {
         points
             .par_iter()
@@ -773,15 +788,11 @@ fn parse_row(line: &str, n_inputs: usize) -> Option<RunSummary> {
         .iter()
         .map(|c| c.parse().ok())
         .collect::<Option<_>>()?;
-    Some(RunSummary {
+    Some(RunSummary::from_values(
         index,
         inputs,
-        peak_force_n: v[0],
-        displacement_at_peak_m: v[1],
-        peak_strain_rate_per_s: v[2],
-        equilibrium_ratio_at_peak: v[3],
-        time_to_equilibrium_s: v[4],
-    })
+        [v[0], v[1], v[2], v[3], v[4]],
+    ))
 }
 
 /// Whether run `index` belongs to the shard of `stamp`.

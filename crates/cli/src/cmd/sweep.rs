@@ -32,14 +32,7 @@ pub fn sweep(
             check_output(p, force)?;
         }
     }
-    if !scene.is_file() {
-        return Err(Error::Input {
-            file: "command line".into(),
-            key: "SCENE".into(),
-            problem: format!("cannot read {}: no such file", scene.display()),
-            allowed: "a scene .toml file".into(),
-        });
-    }
+    shpb_study::sweep::require_scene(scene)?;
     let axes = parse_axes(set)?;
     if plot.is_some() && axes.len() > 2 {
         return Err(Error::Input {

@@ -1,0 +1,182 @@
+//! `shpb study`: uncertainty propagation. The scene's distributions (and the gun's shot-to-shot
+//! scatter) drawn by a seeded Latin hypercube, each sample a normal run, and the statistics of
+//! every summary quantity (`shpb_study::uq`, docs/physics.md §10).
+
+use super::common::{finite, quiet_mode, report, warn, wrote};
+use shpb_input::{Error, Result};
+use shpb_output::io::check_output;
+use shpb_study::uq::{RunTraces, Study, Trace, bands};
+use std::path::Path;
+
+/// The outputs of `shpb study`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StudyOutputs<'a> {
+    /// HDF5 study file (`-o`): the runs as a sweep's file, with the study in its `sweep` attribute.
+    pub output: Option<&'a Path>,
+    /// CSV of the runs (`--csv`).
+    pub csv: Option<&'a Path>,
+    /// CSV of the statistics (`--summary`).
+    pub summary: Option<&'a Path>,
+    /// PNG of the bands (`--plot`).
+    pub plot: Option<&'a Path>,
+}
+
+/// `shpb study`: checks the outputs, draws `samples` samples with `seed`, runs them on `jobs`
+/// threads with a progress bar, prints the statistics (mean, sd, 5/50/95 %, first-order
+/// indices) and writes the outputs atomically (an existing file only with `force`).
+pub fn study(
+    scene: &Path,
+    samples: usize,
+    seed: u64,
+    jobs: usize,
+    gun_scatter: bool,
+    outputs: StudyOutputs,
+    force: bool,
+) -> Result<()> {
+    let paths = [outputs.output, outputs.csv, outputs.summary, outputs.plot];
+    for p in paths.into_iter().flatten() {
+        check_output(p, force)?;
+    }
+    let bar = indicatif::ProgressBar::new(samples as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} samples, ETA {eta}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let study = shpb_study::uq::study_rows(
+        scene,
+        samples,
+        seed,
+        jobs,
+        gun_scatter,
+        outputs.plot.is_some(),
+        |_| bar.inc(1),
+    )?;
+    bar.finish_and_clear();
+    let spec = study.specification();
+    if study.inputs.is_empty() {
+        warn(
+            "the scene has no distribution and no gun scatter applies: every sample is the same run",
+        );
+    }
+    if !quiet_mode() {
+        for line in &spec {
+            eprintln!("shpb: {line}");
+        }
+    }
+    let stats = study.statistics_csv();
+    report(&study.statistics_table(), || study_json(&study))?;
+    let keys = study.keys();
+    if let Some(p) = outputs.csv {
+        let table = shpb_study::sweep::summary_csv_keys(&keys, &study.rows);
+        shpb_output::io::write_text_atomically(p, force, &table)?;
+        wrote(p);
+    }
+    if let Some(p) = outputs.summary {
+        shpb_output::io::write_text_atomically(p, force, &stats)?;
+        wrote(p);
+    }
+    if let Some(p) = outputs.output {
+        let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
+        shpb_study::file::write_sweep_hdf5(p, force, &scene_text, &spec, None, &keys, &study.rows)?;
+        wrote(p);
+    }
+    if let Some(p) = outputs.plot {
+        band_plot(p, force, &study.traces)?;
+        wrote(p);
+    }
+    Ok(())
+}
+
+/// The band figure: the contact force on loading against approach, the reduced back force and
+/// the transmission gauge's strain against time, 5 / 50 / 95 %.
+fn band_plot(path: &Path, force: bool, traces: &[RunTraces]) -> Result<()> {
+    let back: Vec<&Trace> = traces
+        .iter()
+        .filter_map(|t| t.back_force.as_ref())
+        .collect();
+    let gauge: Vec<&Trace> = traces
+        .iter()
+        .filter_map(|t| t.transmitted_strain.as_ref())
+        .collect();
+    let curve: Vec<&Trace> = traces
+        .iter()
+        .filter_map(|t| t.force_approach.as_ref())
+        .collect();
+    let back = bands(&back);
+    let gauge = bands(&gauge);
+    let curve = bands(&curve);
+    let mut panels = Vec::new();
+    if let Some((x, p)) = &curve {
+        panels.push(shpb_output::plot::BandPanel {
+            title: "contact force on loading, 5 / 50 / 95 % at each approach",
+            x_label: "approach (µm)",
+            x_scale: 1e6,
+            y_label: "force (kN)",
+            y_scale: 1e-3,
+            x,
+            p5_p50_p95: [&p[0], &p[1], &p[2]],
+        });
+    }
+    if let Some((t, p)) = &back {
+        panels.push(shpb_output::plot::BandPanel {
+            title: "reduced back force, 5 / 50 / 95 %",
+            x_label: "time (µs)",
+            x_scale: 1e6,
+            y_label: "force (kN)",
+            y_scale: 1e-3,
+            x: t,
+            p5_p50_p95: [&p[0], &p[1], &p[2]],
+        });
+    }
+    if let Some((t, p)) = &gauge {
+        panels.push(shpb_output::plot::BandPanel {
+            title: "transmission gauge strain, 5 / 50 / 95 %",
+            x_label: "time (µs)",
+            x_scale: 1e6,
+            y_label: "strain (µε)",
+            y_scale: 1e6,
+            x: t,
+            p5_p50_p95: [&p[0], &p[1], &p[2]],
+        });
+    }
+    if panels.is_empty() {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "--plot".into(),
+            problem: "the scene's runs have no contact, gauge signals or reduction to draw".into(),
+            allowed: "a scene with spheres or bars and gauges".into(),
+        });
+    }
+    shpb_output::plot::band_figure(path, force, &panels)
+}
+
+/// The study as JSON: its specification and each quantity's statistics.
+fn study_json(study: &Study) -> serde_json::Value {
+    let keys = study.keys();
+    let quantities: Vec<serde_json::Value> = study
+        .statistics()
+        .iter()
+        .map(|s| {
+            let indices: serde_json::Map<String, serde_json::Value> = keys
+                .iter()
+                .zip(&s.first_order)
+                .map(|(k, v)| (k.clone(), finite(*v)))
+                .collect();
+            serde_json::json!({
+                "quantity": s.name,
+                "unit": s.unit,
+                "n": s.count,
+                "mean": finite(s.mean),
+                "sd": finite(s.sd),
+                "p5": finite(s.p5_p50_p95[0]),
+                "p50": finite(s.p5_p50_p95[1]),
+                "p95": finite(s.p5_p50_p95[2]),
+                "first_order": indices,
+            })
+        })
+        .collect();
+    serde_json::json!({"study": study.specification(), "quantities": quantities})
+}
