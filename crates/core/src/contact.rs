@@ -131,6 +131,12 @@ impl LoadingCurve {
         yield_stress_pa: f64,
         form: Region2Form,
     ) -> LoadingCurve {
+        LoadingCurve::with_form_parts(e_star_pa, radius_m, yield_stress_pa).with_region2(form)
+    }
+
+    /// The parts of Eq. 1 every approach needs (δy, Fy, the fits, p0, Fp), region II not yet set
+    /// up ([`LoadingCurve::with_region2`]).
+    fn with_form_parts(e_star_pa: f64, radius_m: f64, yield_stress_pa: f64) -> LoadingCurve {
         let k = YIELD_ONSET_FACTOR * PI * yield_stress_pa;
         let delta_y_m = 0.25 * radius_m / (e_star_pa * e_star_pa) * k * k;
         let force_y_n = (1.0 / 6.0) * (radius_m / e_star_pa).powi(2) * k * k * k;
@@ -138,7 +144,7 @@ impl LoadingCurve {
         let fit = FittedParameters::at(q, radius_m);
         let p0_pa = fit.c1 * yield_stress_pa;
         let force_p_n = p0_pa * PI * (2.0 * radius_m * fit.delta_p_m + fit.c2_m2);
-        let mut curve = LoadingCurve {
+        LoadingCurve {
             e_star_pa,
             radius_m,
             yield_stress_pa,
@@ -151,20 +157,58 @@ impl LoadingCurve {
             beta: 0.0,
             gamma: 0.0,
             degenerate: Degenerate::No,
-        };
-        let (dy, dp) = (delta_y_m, fit.delta_p_m);
-        if dp > dy && force_p_n > 0.0 {
+        }
+    }
+
+    /// Whether region II exists (δy < δp with Fp > 0), so the curve is the normal three-region law.
+    fn has_region2(&self) -> bool {
+        self.fit.delta_p_m > self.delta_y_m && self.force_p_n > 0.0
+    }
+
+    /// Completes a curve whose δy, Fy, fit, p0 and Fp are set: region II's α, β (and γ for the
+    /// smooth form), or how region I joins region III when there is no region II.
+    fn with_region2(mut self, form: Region2Form) -> LoadingCurve {
+        let (dy, dp) = (self.delta_y_m, self.fit.delta_p_m);
+        let (force_y_n, force_p_n) = (self.force_y_n, self.force_p_n);
+        if self.has_region2() {
             let beta = (dy * force_p_n - dp * force_y_n) / (dy * dp * (dp / dy).ln());
-            curve.beta = beta;
-            curve.alpha = force_y_n / dy - beta * dy.ln();
+            self.beta = beta;
+            self.alpha = force_y_n / dy - beta * dy.ln();
             if form == Region2Form::Smooth {
-                let jump = curve.alpha + beta * (dy.ln() + 1.0) - 1.5 * force_y_n / dy;
-                curve.gamma = -jump / (dp - dy);
+                let jump = self.alpha + beta * (dy.ln() + 1.0) - 1.5 * force_y_n / dy;
+                self.gamma = -jump / (dp - dy);
             }
         } else {
-            curve.degenerate = curve.hertz_plastic_crossing();
+            self.degenerate = self.hertz_plastic_crossing();
         }
-        curve
+        self
+    }
+
+    /// [`LoadingCurve::with_form`]`(…).force(delta_m)`, the same number, without computing what
+    /// `delta_m` does not need: in region I or III of a three-region curve, region II's
+    /// coefficients (two logarithms) are left out. What the implicit contact solves call at every
+    /// trial rate (issue 20: the DEM rebuilt the whole curve at each call).
+    pub fn force_for(
+        e_star_pa: f64,
+        radius_m: f64,
+        yield_stress_pa: f64,
+        form: Region2Form,
+        delta_m: f64,
+    ) -> f64 {
+        if delta_m <= 0.0 {
+            return 0.0;
+        }
+        // Region II only if needed: start from the curve with no region II set up yet.
+        let head = LoadingCurve::with_form_parts(e_star_pa, radius_m, yield_stress_pa);
+        if head.has_region2() {
+            if delta_m <= head.delta_y_m {
+                return hertz_force(e_star_pa, radius_m, delta_m);
+            }
+            if delta_m > head.fit.delta_p_m {
+                return head.plastic_line(delta_m);
+            }
+        }
+        head.with_region2(form).force(delta_m)
     }
 
     /// The crossing where Hertz overtakes the region-III line, used when δp ≤ δy (docs/physics.md §1).
@@ -348,6 +392,11 @@ pub trait ContactLaw: Send + Sync + Clone + 'static {
     /// The virgin loading force at `delta_m` under a constant strain rate (no history).
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
 
+    /// The force [`ContactLaw::evaluate`] returns at `delta_m` and δ̇ = `approach_speed_m_s` while
+    /// [`ContactLaw::is_loading`] holds, the same number without a state to update (the trial
+    /// evaluations of the implicit contact solves).
+    fn virgin_force(&self, delta_m: f64, approach_speed_m_s: f64) -> f64;
+
     /// Whether `delta_m` loads the contact on its virgin curve (beyond any approach reached before).
     fn is_loading(&self, state: &Self::State, delta_m: f64) -> bool;
 
@@ -376,6 +425,11 @@ pub trait Contact: Send + Sync {
 
     /// Evaluates without committing (for the implicit solves of a step), memory untouched.
     fn trial(&self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval;
+
+    /// `trial(delta_m, approach_speed_m_s).force_n`, the same number, cheaper while loading
+    /// ([`ContactLaw::virgin_force`]: no copy of the memory, no bookkeeping, only the parts of the
+    /// loading curve the approach needs).
+    fn trial_force(&self, delta_m: f64, approach_speed_m_s: f64) -> f64;
 
     /// The virgin loading force at `delta_m` under a constant strain rate ([`ContactLaw::loading_force`]).
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64;
@@ -430,6 +484,14 @@ impl<L: ContactLaw> Contact for Stateful<L> {
             .evaluate(&mut self.state.clone(), delta_m, approach_speed_m_s)
     }
 
+    fn trial_force(&self, delta_m: f64, approach_speed_m_s: f64) -> f64 {
+        if self.law.is_loading(&self.state, delta_m) {
+            self.law.virgin_force(delta_m, approach_speed_m_s)
+        } else {
+            self.trial(delta_m, approach_speed_m_s).force_n
+        }
+    }
+
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64 {
         self.law.loading_force(delta_m, strain_rate_per_s)
     }
@@ -482,6 +544,10 @@ impl ContactLaw for Hertz {
     }
 
     fn loading_force(&self, delta_m: f64, _strain_rate_per_s: f64) -> f64 {
+        hertz_force(self.e_star_pa, self.radius_m, delta_m)
+    }
+
+    fn virgin_force(&self, delta_m: f64, _approach_speed_m_s: f64) -> f64 {
         hertz_force(self.e_star_pa, self.radius_m, delta_m)
     }
 
@@ -791,7 +857,22 @@ impl ContactLaw for BurgoyneDaraio {
     }
 
     fn loading_force(&self, delta_m: f64, strain_rate_per_s: f64) -> f64 {
-        self.curve_at(strain_rate_per_s).force(delta_m)
+        let s = self.yield_stress(strain_rate_per_s);
+        if s == self.props.yield_stress_pa {
+            self.static_curve.force(delta_m)
+        } else {
+            LoadingCurve::force_for(
+                self.props.e_star_pa,
+                self.props.radius_m,
+                s,
+                self.region2,
+                delta_m,
+            )
+        }
+    }
+
+    fn virgin_force(&self, delta_m: f64, approach_speed_m_s: f64) -> f64 {
+        self.loading_force(delta_m, self.strain_rate(approach_speed_m_s))
     }
 
     fn is_loading(&self, h: &ContactHistory, delta_m: f64) -> bool {
@@ -881,6 +962,48 @@ mod tests {
                 reference_rate_per_s: 1e-3,
             },
             wave_speed_m_s: (204e9f64 / 7800.0).sqrt(),
+        }
+    }
+
+    /// The lazy evaluations the implicit solves use are the full ones, bit for bit: the loading
+    /// curve's force in every region, in both forms and when region II is missing (a yield stress
+    /// so high that δp ≤ δy), and a contact's trial force while loading, unloading and reloading.
+    #[test]
+    fn lazy_forces_are_the_full_evaluations_bit_for_bit() {
+        let p = ss440c();
+        let (e, r) = (p.e_star_pa, p.radius_m);
+        for sigma in [0.5e9, p.yield_stress_pa, 3.0e9, 2.0e10, 1.0e11] {
+            for form in [Region2Form::Smooth, Region2Form::Published] {
+                let curve = LoadingCurve::with_form(e, r, sigma, form);
+                for i in 0..400 {
+                    let d = 1e-9 * 1.05f64.powi(i) - 2e-9;
+                    let lazy = LoadingCurve::force_for(e, r, sigma, form, d);
+                    assert_eq!(
+                        lazy.to_bits(),
+                        curve.force(d).to_bits(),
+                        "{sigma} {form:?} {d}"
+                    );
+                }
+            }
+        }
+        for law in [
+            LawKind::BurgoyneDaraio,
+            LawKind::RateIndependent,
+            LawKind::Hertz,
+        ] {
+            let mut c = law.build(p);
+            // Load, unload part way, reload past the maximum.
+            let path = (0..60)
+                .map(|i| 4e-6 * i as f64)
+                .chain((0..20).map(|i| 236e-6 - 3e-6 * i as f64))
+                .chain((0..40).map(|i| 180e-6 + 4e-6 * i as f64));
+            for d in path {
+                for u in [0.0, 0.5, 3.0, 20.0] {
+                    let (a, b) = (c.trial_force(d, u), c.trial(d, u).force_n);
+                    assert_eq!(a.to_bits(), b.to_bits(), "{law:?} δ {d} δ̇ {u}");
+                }
+                c.evaluate(d, 3.0);
+            }
         }
     }
 

@@ -112,8 +112,7 @@ impl JointState {
             Joint::Spheres { .. } => {
                 let law = self.law.as_ref().expect("sphere joints carry their law");
                 solve_force(|f| {
-                    law.trial(p.average_closure_m(f, dt_s), p.closure_rate_m_s(f, dt_s))
-                        .force_n
+                    law.trial_force(p.average_closure_m(f, dt_s), p.closure_rate_m_s(f, dt_s))
                 })
             }
         }

@@ -298,7 +298,7 @@ impl PairStepper {
 /// module docs), by bracketed Illinois iteration to 1e-13 relative. Shared by the pair and the
 /// chain steppers, so both take exactly the same arithmetic.
 pub fn solve_approach_speed(law: &dyn Contact, delta: f64, a: f64, b: f64) -> f64 {
-    let force = |u: f64| law.trial(delta, u).force_n;
+    let force = |u: f64| law.trial_force(delta, u);
     // g(u) = u − A + B F(u) is increasing in u (F does not fall with the rate): bracket its root.
     let g = |u: f64| u - a + b * force(u);
     let u_hi = a - b * force(0.0);

@@ -323,7 +323,7 @@ impl Stepper {
             self.forces[k] = if implicit[k] {
                 f_now[k]
             } else {
-                self.laws[k].trial(delta_next[k], self.speeds[k]).force_n
+                self.laws[k].trial_force(delta_next[k], self.speeds[k])
             };
         }
         if implicit.iter().any(|&i| i) {
@@ -337,7 +337,7 @@ impl Stepper {
                         (vh[k] + 0.5 * dt * f_left / m_l) - (vh[k + 1] - 0.5 * dt * f_right / m_r);
                     let b = 0.5 * dt / m_l + 0.5 * dt / m_r;
                     let u = solve_approach_speed(self.laws[k].as_ref(), delta_next[k], a, b);
-                    let f = self.laws[k].trial(delta_next[k], u).force_n;
+                    let f = self.laws[k].trial_force(delta_next[k], u);
                     change = change.max((f - self.forces[k]).abs());
                     self.speeds[k] = u;
                     self.forces[k] = f;
