@@ -117,3 +117,43 @@ fn a_run_shows_its_progress_with_an_eta() {
     assert!(e.contains("ETA") && e.contains("100 % done"), "{e}");
     assert!(!out(&o).contains("ETA"), "progress belongs on stderr");
 }
+
+/// `study` and `design` follow the same convention: one JSON object on stdout with `--json`,
+/// progress and messages on stderr.
+#[test]
+fn study_and_design_json_results_parse() {
+    let dir = TempDir::new().unwrap();
+    let scene = dir.path().join("uncertain.toml");
+    std::fs::write(
+        &scene,
+        "kind = \"collision\"\nvelocity1_m_s = { min = 1.0, max = 2.0 }\n[specimen]\npair = \"ss440c\"\n",
+    )
+    .unwrap();
+    let o = shpb(
+        dir.path(),
+        &["study", scene.to_str().unwrap(), "--samples", "4", "--json"],
+    );
+    assert!(o.status.success(), "{}", err(&o));
+    let v: serde_json::Value = serde_json::from_str(&out(&o)).expect("one JSON object");
+    let q = v["quantities"].as_array().unwrap();
+    assert!(
+        q.iter()
+            .any(|x| x["quantity"] == "peak_force" && x["unit"] == "N")
+    );
+
+    let o = shpb(
+        dir.path(),
+        &[
+            "design",
+            &path("scenes/collision-ss440c-5ms.toml"),
+            "--target",
+            "peak_force=0.5kN",
+            "--vary",
+            "velocity1_m_s=0.5:10",
+            "--json",
+        ],
+    );
+    assert!(o.status.success(), "{}", err(&o));
+    serde_json::from_str::<serde_json::Value>(&out(&o)).expect("one JSON object");
+    assert!(!out(&o).contains("shpb:"), "messages belong on stderr");
+}
