@@ -31,7 +31,7 @@ DEMO_SCENE := validation/fig4-virtual-shpb/ss440c-10psi-20cm-striker.toml
 DEMO_H5 := demo.h5
 DEMO_PNG := demo.png
 
-.PHONY: all deps build demo test pytest wheel venv clean perf-report
+.PHONY: all deps build static demo test pytest wheel venv clean perf-report
 
 # The Python package's virtual environment (created once, reused; `make clean` removes it).
 VENV := $(or $(CARGO_TARGET_DIR),target)/venv
@@ -67,6 +67,15 @@ deps:
 
 build: deps
 	$(CARGO) build --release -p shpb
+
+# The binary with HDF5 built from source and linked statically (feature `static-hdf5`): the
+# process loads 12 shared libraries instead of 42 (no libcurl, GnuTLS, Kerberos, LDAP) and starts
+# in about 3 ms instead of 10 (validation/perf/REPORT.md). Builds HDF5 once (about 2 min); needs
+# CMake >= 3.26, newer than Debian bookworm's, so CMake comes from PyPI into target/tools.
+TOOLS := $(or $(CARGO_TARGET_DIR),target)/tools
+static: deps
+	@test -x $(TOOLS)/bin/cmake || ($(PYTHON) -m venv $(TOOLS) && $(TOOLS)/bin/pip install --quiet --disable-pip-version-check cmake)
+	CMAKE=$(abspath $(TOOLS))/bin/cmake $(CARGO) build --release -p shpb --features static-hdf5
 
 # The paper's Fig. 4 SS440c test at 10 psi, end to end: gas gun, copper shaper, bars, two
 # 6.35 mm spheres, gauges and the data reduction of the simulated records.
