@@ -24,53 +24,9 @@ REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 CSV = os.path.join(REPO, "validation/fig4-force-driven/data/ss440c_10psi_force10.csv")
 DT = 4.648965e-8
 
-RHO, E, NU, SY = 7800.0, 204e9, 0.28, 1900e6
-JC_C, JC_RATE0 = 0.035, 1e-3
-R_SPHERE = 6.35e-3 / 2.0
-M1 = M2 = RHO * 4.0 / 3.0 * math.pi * R_SPHERE**3
-E_STAR = 1.0 / (2.0 * (1.0 - NU**2) / E)
-R_EFF = R_SPHERE / 2.0
-SUM_R = 2.0 * R_SPHERE
-Z = 8110.0 * 4865.5 * math.pi * 9.525e-3 * 9.525e-3
-KH = 4.0 / 3.0 * E_STAR * math.sqrt(R_EFF)
-
-
-def curve(sy):
-    k = 1.6 * math.pi * sy
-    dy = 0.25 * R_EFF / (E_STAR * E_STAR) * k * k
-    fy = (1.0 / 6.0) * (R_EFF / E_STAR) ** 2 * k**3
-    q = E_STAR / sy
-    s = R_EFF / 0.00159
-    dp = (0.00428 / q + 1.47e-5) * s
-    c1 = -6.76 * q**-0.137 + 6.304
-    c2 = (-3.99e-6 / q + 1.01e-9) * s * s
-    p0 = c1 * sy
-    fp = p0 * math.pi * (2.0 * R_EFF * dp + c2)
-    beta = (dy * fp - dp * fy) / (dy * dp * math.log(dp / dy))
-    alpha = fy / dy - beta * math.log(dy)
-    gamma = -(alpha + beta * (math.log(dy) + 1.0) - 1.5 * fy / dy) / (dp - dy)
-    return dy, dp, alpha, beta, gamma, p0 * math.pi * 2.0 * R_EFF, p0 * math.pi * c2
-
-
-def curve_force(c, d):
-    dy, dp, alpha, beta, gamma, a3, b3 = c
-    if d <= 0.0:
-        return 0.0
-    if d <= dy:
-        return KH * d * math.sqrt(d)
-    if d <= dp:
-        return d * (alpha + beta * math.log(d)) + gamma * (d - dy) * (dp - d)
-    return a3 * d + b3
-
-
-STATIC = curve(SY)
-
-
-def loading_force(d, u):
-    rate = u / SUM_R if u > 0.0 else 0.0
-    if rate > JC_RATE0:
-        return curve_force(curve(SY * (1.0 + JC_C * math.log(rate / JC_RATE0))), d)
-    return curve_force(STATIC, d)
+from dem_law import (  # noqa: E402  (the model shared with scipy_force_driven.py)
+    E_STAR, M1, M2, R_EFF, STATIC, SUM_R, SY, Z, curve_force, loading_force,
+)
 
 
 def approach_speed(d, a, b):
@@ -116,7 +72,6 @@ def main():
     k2 = 1.0 + 0.5 * DT * Z / M2
     for n in range(steps):
         fe, fe_next = drive[n], drive[n + 1]
-        d_now = SUM_R - (x2 - x1)
         v1h = v1 + 0.5 * DT * (fe - f) / M1
         v2h = v2 + 0.5 * DT * (f - Z * v2) / M2
         x1 += DT * v1h

@@ -4,7 +4,7 @@
 //! solution, 5 a design whose solutions violate a `--require`, 1 other failures).
 
 use crate::cmd;
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::reduce::DispersionCorrection;
@@ -149,6 +149,19 @@ impl From<LawArg> for LawKind {
     }
 }
 
+/// `-j/--jobs`: worker threads of `sweep` and `study` (one definition for both).
+#[derive(Args, Debug, Clone, Copy)]
+pub struct Jobs {
+    /// Worker threads.
+    #[arg(
+        short = 'j',
+        long = "jobs",
+        default_value_t = 1,
+        allow_hyphen_values = true
+    )]
+    pub jobs: usize,
+}
+
 /// Subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
@@ -215,14 +228,9 @@ pub enum Command {
         /// `_m` keys in mm/um/m), e.g. pressure=5psi:20psi:16. Repeat for a product.
         #[arg(long = "set", required = true)]
         set: Vec<String>,
-        /// Worker threads.
-        #[arg(
-            short = 'j',
-            long = "jobs",
-            default_value_t = 1,
-            allow_hyphen_values = true
-        )]
-        jobs: usize,
+        /// Worker threads (`-j`).
+        #[command(flatten)]
+        jobs: Jobs,
         /// Run only shard k of n (k/n): every n-th run from the k-th, deterministic.
         #[arg(long)]
         shard: Option<String>,
@@ -257,14 +265,9 @@ pub enum Command {
         /// Seed of the Latin hypercube: the same seed gives the same samples and files.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Worker threads.
-        #[arg(
-            short = 'j',
-            long = "jobs",
-            default_value_t = 1,
-            allow_hyphen_values = true
-        )]
-        jobs: usize,
+        /// Worker threads (`-j`).
+        #[command(flatten)]
+        jobs: Jobs,
         /// Do not draw the gun's shot-to-shot scatter (the set-up's `[gun] velocity_scatter`,
         /// applied by default when the scene's pressure is one value).
         #[arg(long)]
@@ -571,7 +574,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
         } => cmd::sweep::sweep(
             &scene,
             &set,
-            jobs,
+            jobs.jobs,
             shard.as_deref(),
             (output.as_deref(), csv.as_deref(), plot.as_deref()),
             resume,
@@ -592,7 +595,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             &scene,
             samples,
             seed,
-            jobs,
+            jobs.jobs,
             !no_gun_scatter,
             cmd::study::StudyOutputs {
                 output: output.as_deref(),
