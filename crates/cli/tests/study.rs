@@ -282,3 +282,19 @@ fn shards_of_a_study_join_into_the_whole_study() {
     let e = shpb::uq::Study::from_rows(&path, 5, 11, false, first).unwrap_err();
     assert!(e.to_string().contains("exactly once"), "{e}");
 }
+
+/// A distribution whose draws the key does not take (a plain number where `pressure` needs its
+/// unit) is refused before any run, naming the key, the sample and the form to write.
+#[test]
+fn a_unitless_pressure_distribution_is_refused_naming_the_key() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let path = scene(dir.path(), "unitless.toml", "{ mean = 12.5, sd = 1.0 }");
+    let out = shpb(
+        dir.path(),
+        &["study", path.to_str().unwrap(), "--samples", "4"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("`pressure`: sample 0"), "{e}");
+    assert!(e.contains("\"12.5psi\""), "{e}");
+}

@@ -499,8 +499,27 @@ fn study_samples(
     let inputs = study_inputs(scene, gun_scatter)?;
     let samples = draw(&inputs, n, seed)?;
     // Every sample validated before the first run (a bad draw fails fast, naming its value).
-    for o in &samples.overrides {
-        Params::from_file_overridden(scene, o)?;
+    for (i, o) in samples.overrides.iter().enumerate() {
+        Params::from_file_overridden(scene, o).map_err(|e| match e {
+            // A drawn value of the wrong type (a number where the key takes a quantity with its
+            // unit): name the inputs and the sample, not the line of a scene text nobody wrote.
+            Error::Parse { message, .. } => Error::Input {
+                file: scene.display().to_string(),
+                key: inputs
+                    .iter()
+                    .map(|input| input.key.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                problem: format!(
+                    "sample {i} ({}) is not a value the scene takes: {message}",
+                    samples.labels[i].join(", ")
+                ),
+                allowed: "a distribution in the key's own form: with its unit where the key \
+                          takes one (pressure = { mean = \"12.5psi\", sd = \"0.6psi\" })"
+                    .into(),
+            },
+            other => other,
+        })?;
     }
     Ok((inputs, samples))
 }
