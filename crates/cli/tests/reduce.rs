@@ -1004,6 +1004,19 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
 fn bad_inputs_name_file_and_key() {
     let dir = tempfile::tempdir().unwrap();
     let bars = root().join("bars/authors.toml");
+    // The error of `shpb reduce RECORD --bars BARS` with the default options.
+    let fails = |record: &Path, bars: &Path| {
+        reduce_command(
+            record,
+            Some(bars),
+            None,
+            None,
+            false,
+            DispersionCorrection::Bancroft,
+            false,
+        )
+        .unwrap_err()
+    };
     // A record too short for the windows.
     let mut text = String::from("time_s,incident_V,transmission_V\n");
     for k in 0..3000 {
@@ -1016,55 +1029,19 @@ fn bad_inputs_name_file_and_key() {
     }
     let short = dir.path().join("short.csv");
     std::fs::write(&short, text).unwrap();
-    let err = reduce_command(
-        &short,
-        Some(&bars),
-        None,
-        None,
-        false,
-        DispersionCorrection::Bancroft,
-        false,
-    )
-    .unwrap_err();
+    let err = fails(&short, &bars);
     let msg = err.to_string();
     assert_eq!(err.exit_code(), 2, "{msg}");
     assert!(msg.contains("short.csv") && msg.contains("time_s"), "{msg}");
     // Missing files.
-    let err = reduce_command(
-        &dir.path().join("nope.csv"),
-        Some(&bars),
-        None,
-        None,
-        false,
-        DispersionCorrection::Bancroft,
-        false,
-    )
-    .unwrap_err();
+    let err = fails(&dir.path().join("nope.csv"), &bars);
     assert!(err.to_string().contains("RECORD"), "{err}");
-    let err = reduce_command(
-        &short,
-        Some(&dir.path().join("nope.toml")),
-        None,
-        None,
-        false,
-        DispersionCorrection::Bancroft,
-        false,
-    )
-    .unwrap_err();
+    let err = fails(&short, &dir.path().join("nope.toml"));
     assert!(err.to_string().contains("--bars"), "{err}");
     // An HDF5 file without gauges names the dataset.
     let h5 = dir.path().join("empty.h5");
     hdf5::File::create(&h5).unwrap();
-    let err = reduce_command(
-        &h5,
-        Some(&bars),
-        None,
-        None,
-        false,
-        DispersionCorrection::Bancroft,
-        false,
-    )
-    .unwrap_err();
+    let err = fails(&h5, &bars);
     assert!(err.to_string().contains("time"), "{err}");
     // Options out of range.
     let s = setup(5000.0, 0.65, 0.35);

@@ -720,6 +720,18 @@ pub fn dispersion_shift(
     distance_m: f64,
     bar: &BarProperties,
 ) -> Vec<f64> {
+    shift_whole(signal, dt_s, distance_m, bar, None)
+}
+
+/// The whole of `signal` moved `distance_m` along `bar` by the Bancroft fit (`exact` = None) or
+/// the exact first mode: what [`dispersion_shift`] and [`dispersion_shift_exact`] share.
+fn shift_whole(
+    signal: &[f64],
+    dt_s: f64,
+    distance_m: f64,
+    bar: &BarProperties,
+    exact: Option<&PochhammerChree>,
+) -> Vec<f64> {
     cut(
         signal,
         dt_s,
@@ -729,7 +741,7 @@ pub fn dispersion_shift(
             distance_m,
             radius_m: bar.radius_m,
             c0_m_s: bar.wave_speed_m_s,
-            exact: None,
+            exact,
             tyas_pope: None,
         }),
     )
@@ -745,19 +757,7 @@ pub fn dispersion_shift_exact(
     bar: &BarProperties,
 ) -> Result<Vec<f64>> {
     let pc = PochhammerChree::new(bar.poisson_ratio, bar.radius_m, bar.wave_speed_m_s)?;
-    Ok(cut(
-        signal,
-        dt_s,
-        0.0,
-        signal.len(),
-        Some(&WaveCorrection {
-            distance_m,
-            radius_m: bar.radius_m,
-            c0_m_s: bar.wave_speed_m_s,
-            exact: Some(&pc),
-            tyas_pope: None,
-        }),
-    ))
+    Ok(shift_whole(signal, dt_s, distance_m, bar, Some(&pc)))
 }
 
 /// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
@@ -1434,6 +1434,20 @@ pub fn record_strains(
     })
 }
 
+/// The authors' bars as the reduction sees them (192 GPa, c0 4865.5 m/s, 19.05 mm, ν 0.31), for
+/// the unit tests of the reduction and of its cylinder analysis.
+#[cfg(test)]
+pub(crate) fn authors_bar() -> BarProperties {
+    BarProperties {
+        youngs_modulus_pa: 192e9,
+        wave_speed_m_s: 4865.5,
+        area_m2: std::f64::consts::PI * 9.525e-3 * 9.525e-3,
+        radius_m: 9.525e-3,
+        poisson_ratio: 0.31,
+        length_m: None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1442,14 +1456,7 @@ mod tests {
     /// foot passes the incident gauge at 100 µs, its reflection (tensile, 60 % of it) 2 d_I/c0
     /// later, and a compressive transmitted pulse, sampled at 10 MHz with a little noise.
     fn record() -> (ReductionInput, ReductionSetup) {
-        let bar = BarProperties {
-            youngs_modulus_pa: 192e9,
-            wave_speed_m_s: 4865.5,
-            area_m2: std::f64::consts::PI * 9.525e-3 * 9.525e-3,
-            radius_m: 9.525e-3,
-            poisson_ratio: 0.31,
-            length_m: None,
-        };
+        let bar = authors_bar();
         let setup = ReductionSetup {
             incident_bar: bar,
             transmission_bar: bar,

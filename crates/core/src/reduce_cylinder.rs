@@ -251,17 +251,10 @@ pub fn loading_modulus(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reduce::{BarProperties, Windows};
+    use crate::reduce::Windows;
 
     fn bars() -> ReductionSetup {
-        let bar = BarProperties {
-            youngs_modulus_pa: 192e9,
-            wave_speed_m_s: 4865.5,
-            area_m2: std::f64::consts::PI * 9.525e-3 * 9.525e-3,
-            radius_m: 9.525e-3,
-            poisson_ratio: 0.31,
-            length_m: None,
-        };
+        let bar = crate::reduce::authors_bar();
         ReductionSetup {
             incident_bar: bar,
             transmission_bar: bar,

@@ -121,6 +121,27 @@ impl CrushedDisc {
 }
 
 impl PulseShaper {
+    /// A crushed-disc shaper (§6.5) of diameter `diameter_m`, thickness `thickness_m` and disc
+    /// modulus `youngs_modulus_pa`, flowing by `disc`; the Frew constants unused (NaN), no
+    /// calibrated pressures.
+    pub fn crushed_disc(
+        diameter_m: f64,
+        thickness_m: f64,
+        youngs_modulus_pa: f64,
+        disc: CrushedDisc,
+    ) -> PulseShaper {
+        PulseShaper {
+            diameter_m,
+            thickness_m,
+            sigma0_pa: f64::NAN,
+            n: f64::NAN,
+            m: f64::NAN,
+            youngs_modulus_pa,
+            model: ShaperModel::CrushedDisc(disc),
+            calibrated_pressure_pa: None,
+        }
+    }
+
     /// Initial area A0, m².
     pub fn area_m2(&self) -> f64 {
         std::f64::consts::PI * 0.25 * self.diameter_m * self.diameter_m
@@ -283,17 +304,7 @@ mod tests {
     fn disc(friction: f64) -> (PulseShaper, CrushedDisc) {
         let mut d = CrushedDisc::ofhc_copper(192e9, 0.31);
         d.friction = friction;
-        let s = PulseShaper {
-            diameter_m: 4e-3,
-            thickness_m: 0.5e-3,
-            sigma0_pa: f64::NAN,
-            n: f64::NAN,
-            m: f64::NAN,
-            youngs_modulus_pa: 117e9,
-            model: ShaperModel::CrushedDisc(d),
-            calibrated_pressure_pa: None,
-        };
-        (s, d)
+        (PulseShaper::crushed_disc(4e-3, 0.5e-3, 117e9, d), d)
     }
 
     #[test]

@@ -93,55 +93,52 @@ pub fn study(
 /// The band figure: the contact force on loading against approach, the reduced back force and
 /// the transmission gauge's strain against time, 5 / 50 / 95 %.
 fn band_plot(path: &Path, force: bool, traces: &[RunTraces]) -> Result<()> {
-    let back: Vec<&Trace> = traces
-        .iter()
-        .filter_map(|t| t.back_force.as_ref())
-        .collect();
-    let gauge: Vec<&Trace> = traces
-        .iter()
-        .filter_map(|t| t.transmitted_strain.as_ref())
-        .collect();
-    let curve: Vec<&Trace> = traces
-        .iter()
-        .filter_map(|t| t.force_approach.as_ref())
-        .collect();
-    let back = bands(&back);
-    let gauge = bands(&gauge);
-    let curve = bands(&curve);
-    let mut panels = Vec::new();
-    if let Some((x, p)) = &curve {
-        panels.push(shpb_output::plot::BandPanel {
+    /// One panel: which trace of a run it draws, its caption, and its axes (label, scale).
+    struct Spec {
+        pick: fn(&RunTraces) -> Option<&Trace>,
+        title: &'static str,
+        x: (&'static str, f64),
+        y: (&'static str, f64),
+    }
+    let specs = [
+        Spec {
+            pick: |t| t.force_approach.as_ref(),
             title: "contact force on loading, 5 / 50 / 95 % at each approach",
-            x_label: "approach (µm)",
-            x_scale: 1e6,
-            y_label: "force (kN)",
-            y_scale: 1e-3,
+            x: ("approach (µm)", 1e6),
+            y: ("force (kN)", 1e-3),
+        },
+        Spec {
+            pick: |t| t.back_force.as_ref(),
+            title: "reduced back force, 5 / 50 / 95 %",
+            x: ("time (µs)", 1e6),
+            y: ("force (kN)", 1e-3),
+        },
+        Spec {
+            pick: |t| t.transmitted_strain.as_ref(),
+            title: "transmission gauge strain, 5 / 50 / 95 %",
+            x: ("time (µs)", 1e6),
+            y: ("strain (µε)", 1e6),
+        },
+    ];
+    let drawn: Vec<_> = specs
+        .iter()
+        .filter_map(|spec| {
+            let runs: Vec<&Trace> = traces.iter().filter_map(spec.pick).collect();
+            bands(&runs).map(|b| (spec, b))
+        })
+        .collect();
+    let panels: Vec<shpb_output::plot::BandPanel> = drawn
+        .iter()
+        .map(|(spec, (x, p))| shpb_output::plot::BandPanel {
+            title: spec.title,
+            x_label: spec.x.0,
+            x_scale: spec.x.1,
+            y_label: spec.y.0,
+            y_scale: spec.y.1,
             x,
             p5_p50_p95: [&p[0], &p[1], &p[2]],
-        });
-    }
-    if let Some((t, p)) = &back {
-        panels.push(shpb_output::plot::BandPanel {
-            title: "reduced back force, 5 / 50 / 95 %",
-            x_label: "time (µs)",
-            x_scale: 1e6,
-            y_label: "force (kN)",
-            y_scale: 1e-3,
-            x: t,
-            p5_p50_p95: [&p[0], &p[1], &p[2]],
-        });
-    }
-    if let Some((t, p)) = &gauge {
-        panels.push(shpb_output::plot::BandPanel {
-            title: "transmission gauge strain, 5 / 50 / 95 %",
-            x_label: "time (µs)",
-            x_scale: 1e6,
-            y_label: "strain (µε)",
-            y_scale: 1e6,
-            x: t,
-            p5_p50_p95: [&p[0], &p[1], &p[2]],
-        });
-    }
+        })
+        .collect();
     if panels.is_empty() {
         return Err(Error::Input {
             file: "command line".into(),

@@ -181,16 +181,7 @@ impl Family {
                 } else {
                     d.friction = p[2];
                 }
-                PulseShaper {
-                    diameter_m: p[0],
-                    thickness_m: p[1],
-                    sigma0_pa: f64::NAN,
-                    n: f64::NAN,
-                    m: f64::NAN,
-                    youngs_modulus_pa: COPPER_MODULUS_PA,
-                    model: ShaperModel::CrushedDisc(d),
-                    calibrated_pressure_pa: None,
-                }
+                PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
             }
         }
     }
@@ -562,16 +553,7 @@ fn probe(a: &Apparatus, records: &[Record], args: &[String]) {
     let mut d = CrushedDisc::ofhc_copper(a.material.youngs_modulus_pa, a.material.poisson_ratio);
     d.face_compliance_factor = x[2];
     d.friction = x[3];
-    let sh = PulseShaper {
-        diameter_m: x[0] * 1e-3,
-        thickness_m: x[1] * 1e-3,
-        sigma0_pa: f64::NAN,
-        n: f64::NAN,
-        m: f64::NAN,
-        youngs_modulus_pa: COPPER_MODULUS_PA,
-        model: ShaperModel::CrushedDisc(d),
-        calibrated_pressure_pa: None,
-    };
+    let sh = PulseShaper::crushed_disc(x[0] * 1e-3, x[1] * 1e-3, COPPER_MODULUS_PA, d);
     for (i, &psi) in PRESSURES_PSI.iter().enumerate() {
         let Some(s) = simulate(a, x[4 + i], sh) else {
             println!("{psi} psi: no pulse");
