@@ -190,8 +190,8 @@ class Table:
     :attr:`inputs` holds each swept key's
     values in SI units (or as written, for names), :attr:`labels` the values as written."""
 
-    def __init__(self, raw: Tuple[Any, ...]) -> None:
-        keys, labels, inputs, columns = raw[:4]
+    def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
+        keys, labels, inputs, columns = raw
         self.keys_swept: List[str] = list(keys)
         self.labels: Dict[str, List[str]] = {
             k: [row[i] for row in labels] for i, k in enumerate(keys)
@@ -378,9 +378,12 @@ def sweep(
             specs.append(f"{key}={','.join(_label(v) for v in values)}")
     path = os.path.abspath(os.fspath(scene))
     if client is None:
-        return Table(_shpb.sweep(path, specs, int(jobs)))
-    parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
-    return Table(_combine_shards(parts))
+        keys, rows = _sweep_shard(path, specs, int(jobs), 1, 1)
+    else:
+        parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+        keys = parts[0][0]
+        rows = [r for _, part in parts for r in part]
+    return Table(_shpb.sweep_table(keys, rows))
 
 
 class Study:
@@ -456,7 +459,7 @@ def _sweep_shard(
     scene: str, specs: List[str], jobs: int, k: int, n: int
 ) -> Tuple[Any, ...]:
     """Shard ``k`` of ``n`` of a sweep, run where a Dask worker calls it."""
-    return _shpb.sweep(scene, specs, jobs, (k, n))
+    return _shpb.sweep_runs(scene, specs, jobs, (k, n))
 
 
 def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List[Any]:
@@ -469,29 +472,3 @@ def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List
         raise InputError(f"shards: {shards} (allowed: a whole number ≥ 1)")
     futures = [client.submit(fn, *args, k, n, pure=False) for k in range(1, n + 1)]
     return list(client.gather(futures))
-
-
-def _combine_shards(parts: Sequence[Tuple[Any, ...]]) -> Tuple[Any, ...]:
-    """The whole sweep's raw table from its shards' tables, rows in sweep order."""
-    keys = parts[0][0]
-    rows = []
-    for keys_k, labels, inputs, columns, indices in parts:
-        for j, index in enumerate(indices):
-            row_inputs = [None if c is None else (c[0], c[1][j]) for c in inputs]
-            row_columns = [(name, unit, values[j]) for name, unit, values in columns]
-            rows.append((index, labels[j], row_inputs, row_columns))
-    rows.sort(key=lambda r: r[0])
-    if [r[0] for r in rows] != list(range(len(rows))):
-        raise RuntimeError("the shards do not hold every run of the sweep exactly once")
-    inputs = []
-    for i in range(len(keys)):
-        cells = [r[2][i] for r in rows]
-        if any(c is None for c in cells) or len({c[0] for c in cells}) > 1:
-            inputs.append(None)
-        else:
-            inputs.append((cells[0][0], [c[1] for c in cells]))
-    columns = [
-        (name, unit, [r[3][m][2] for r in rows])
-        for m, (name, unit, _) in enumerate(parts[0][3])
-    ]
-    return (keys, [r[1] for r in rows], inputs, columns, [r[0] for r in rows])

@@ -52,14 +52,18 @@ def reduce(
     specimen_diameter_m: Optional[float] = None,
     layout: Optional[str] = None,
 ) -> RunData: ...
-def sweep(
+Rows = List[Tuple[int, List[str], Tuple[float, float, float, float, float]]]
+
+def sweep_runs(
     scene: str, set: Sequence[str], jobs: int = 1, shard: Tuple[int, int] = (1, 1)
+) -> Tuple[List[str], Rows]: ...
+def sweep_table(
+    keys: List[str], rows: Rows
 ) -> Tuple[
     List[str],
     List[List[str]],
     List[Optional[Tuple[str, List[float]]]],
     List[Tuple[str, str, List[float]]],
-    List[int],
 ]: ...
 def study_runs(
     scene: str,
@@ -68,13 +72,13 @@ def study_runs(
     jobs: int = 1,
     gun_scatter: bool = True,
     shard: Tuple[int, int] = (1, 1),
-) -> List[Tuple[int, List[str], Tuple[float, float, float, float, float]]]: ...
+) -> Rows: ...
 def study_table(
     scene: str,
     samples: int,
     seed: int,
     gun_scatter: bool,
-    rows: List[Tuple[int, List[str], Tuple[float, float, float, float, float]]],
+    rows: Rows,
 ) -> Tuple[Any, List[Tuple[str, str, int, float, float, Tuple[float, float, float], List[float]]], List[str]]: ...
 def version() -> str: ...
 def is_hdf5(path: str) -> bool: ...

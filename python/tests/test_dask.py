@@ -55,3 +55,9 @@ def test_any_number_of_shards_gives_the_local_table(client, shards):
 def test_bad_shard_count_is_an_input_error(client):
     with pytest.raises(shpb.InputError, match="shards"):
         shpb.sweep(SCENE, SET, client=client, shards=0)
+
+
+def test_rows_of_one_shard_alone_are_refused():
+    keys, rows = shpb._shpb.sweep_runs(SCENE, CLI_SET[1::2], 1, (1, 2))
+    with pytest.raises(shpb.InputError, match="exactly once"):
+        shpb._shpb.sweep_table(keys, rows)

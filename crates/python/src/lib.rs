@@ -593,19 +593,15 @@ fn reduce(
 }
 
 /// A sweep's table: the swept keys, each row's values as written, the SI value and units of each
-/// input column (None when not numeric), the summary columns (name, units, values) and each
-/// row's index in the whole sweep.
+/// input column (None when not numeric) and the summary columns (name, units, values).
 type SweepTable = (
     Vec<String>,
     Vec<Vec<String>>,
     Vec<Option<(String, Vec<f64>)>>,
     Vec<(String, String, Vec<f64>)>,
-    Vec<usize>,
 );
 
-/// The rows of a table as Python takes them: each row's inputs as written, the SI value and units
-/// of each input column (None when not numeric), the summary columns (name, units, values) and
-/// each row's index in the whole sweep or study.
+/// The rows of a table as Python takes them ([`SweepTable`]).
 fn table_columns(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> SweepTable {
     let labels: Vec<Vec<String>> = rows.iter().map(|r| r.inputs.clone()).collect();
     let inputs = keys
@@ -635,28 +631,62 @@ fn table_columns(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> Swe
             )
         })
         .collect();
-    let indices = rows.iter().map(|r| r.index).collect();
-    (keys.to_vec(), labels, inputs, columns, indices)
+    (keys.to_vec(), labels, inputs, columns)
 }
 
 /// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
 /// (`shpb sweep`, without checkpoint or files); `shard = (k, n)` runs only shard k of n
-/// (`shpb sweep --shard k/n`).
+/// (`shpb sweep --shard k/n`). Returns the swept keys and the rows, for [`sweep_table`].
 #[pyfunction]
 #[pyo3(signature = (scene, set, jobs = 1, shard = (1, 1)))]
-fn sweep(
+fn sweep_runs(
     py: Python<'_>,
     scene: PathBuf,
     set: Vec<String>,
     jobs: usize,
     shard: (usize, usize),
-) -> PyResult<SweepTable> {
+) -> PyResult<(Vec<String>, StudyRows)> {
     let (axes, rows) = detached(py, || api::sweep_shard_rows(&scene, &set, shard, jobs))?;
-    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    Ok((
+        axes.iter().map(|a| a.key.clone()).collect(),
+        travelling(&rows),
+    ))
+}
+
+/// The table of a sweep over `keys` from the rows of all its shards (`sweep_runs`), in sweep
+/// order; an input error unless they hold every run exactly once.
+#[pyfunction]
+fn sweep_table(keys: Vec<String>, rows: StudyRows) -> PyResult<SweepTable> {
+    let mut rows = arrived(rows);
+    rows.sort_by_key(|r| r.index);
+    if rows.iter().enumerate().any(|(i, r)| r.index != i) {
+        return Err(input_error(
+            "shards",
+            format!(
+                "{} rows do not hold each run of the sweep exactly once",
+                rows.len()
+            ),
+            "the rows of every shard k/n of one sweep, k = 1..n",
+        ));
+    }
     Ok(table_columns(&keys, &rows))
 }
 
-/// A study's runs as they travel between processes: (sample index, inputs as written, the
+/// Rows as they travel between processes ([`StudyRows`]).
+fn travelling(rows: &[shpb_study::sweep::RunSummary]) -> StudyRows {
+    rows.iter()
+        .map(|r| (r.index, r.inputs.clone(), r.values()))
+        .collect()
+}
+
+/// Rows back from their travelling form.
+fn arrived(rows: StudyRows) -> Vec<shpb_study::sweep::RunSummary> {
+    rows.into_iter()
+        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary::from_values(index, inputs, v))
+        .collect()
+}
+
+/// Runs of a sweep or a study as they travel between processes: (index, inputs as written, the
 /// summary values in the order of `SUMMARY_COLUMNS`).
 type StudyRows = Vec<(usize, Vec<String>, [f64; 5])>;
 
@@ -685,11 +715,7 @@ fn study_runs(
             |_| {},
         )
     })?;
-    Ok(study
-        .rows
-        .iter()
-        .map(|r| (r.index, r.inputs.clone(), r.values()))
-        .collect())
+    Ok(travelling(&study.rows))
 }
 
 /// One statistic row of a study: quantity, units, finite values counted, mean, sd, the 5/50/95 %
@@ -707,10 +733,7 @@ fn study_table(
     gun_scatter: bool,
     rows: StudyRows,
 ) -> PyResult<(SweepTable, Vec<StudyStat>, Vec<String>)> {
-    let rows = rows
-        .into_iter()
-        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary::from_values(index, inputs, v))
-        .collect();
+    let rows = arrived(rows);
     let study = detached(py, || {
         shpb_study::uq::Study::from_rows(&scene, samples, seed, gun_scatter, rows)
     })?;
@@ -761,7 +784,8 @@ fn _shpb(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(gun, m)?,
         wrap_pyfunction!(curve, m)?,
         wrap_pyfunction!(reduce, m)?,
-        wrap_pyfunction!(sweep, m)?,
+        wrap_pyfunction!(sweep_runs, m)?,
+        wrap_pyfunction!(sweep_table, m)?,
         wrap_pyfunction!(version, m)?,
         wrap_pyfunction!(is_hdf5, m)?,
     ] {
