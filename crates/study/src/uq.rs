@@ -479,9 +479,9 @@ pub fn study_rows(
     study_shard_rows(scene, n, seed, jobs, gun_scatter, keep_traces, (1, 1), done)
 }
 
-/// The inputs and samples of a study of `scene` (`n` samples drawn with `seed`), every sample
-/// validated: what each shard of the study recomputes identically before running its part.
-fn study_samples(
+/// The inputs and samples of a study of `scene` (`n` samples drawn with `seed`): what each shard
+/// of the study, and the join of their rows, recompute identically.
+fn study_draw(
     scene: &Path,
     n: usize,
     seed: u64,
@@ -498,7 +498,18 @@ fn study_samples(
     }
     let inputs = study_inputs(scene, gun_scatter)?;
     let samples = draw(&inputs, n, seed)?;
-    // Every sample validated before the first run (a bad draw fails fast, naming its value).
+    Ok((inputs, samples))
+}
+
+/// [`study_draw`] with every sample validated before the first run (a bad draw fails fast,
+/// naming its value).
+fn study_samples(
+    scene: &Path,
+    n: usize,
+    seed: u64,
+    gun_scatter: bool,
+) -> Result<(Vec<StudyInput>, Samples)> {
+    let (inputs, samples) = study_draw(scene, n, seed, gun_scatter)?;
     for (i, o) in samples.overrides.iter().enumerate() {
         Params::from_file_overridden(scene, o).map_err(|e| match e {
             // A drawn value of the wrong type (a number where the key takes a quantity with its
@@ -599,7 +610,8 @@ impl Study {
         gun_scatter: bool,
         mut rows: Vec<RunSummary>,
     ) -> Result<Study> {
-        let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
+        // The shards validated and ran the samples; the join only needs them drawn again.
+        let (inputs, samples) = study_draw(scene, n, seed, gun_scatter)?;
         rows.sort_by_key(|r| r.index);
         let complete = rows.len() == n
             && rows
