@@ -85,6 +85,7 @@
 //! run (`solver::chain::CHECK_INTERVAL_STEPS`).
 
 use crate::error::{Error, Named, Result};
+use crate::transit::{StretchPoint, TransitDesign, TransitFilter, TransitModel};
 use std::f64::consts::PI;
 
 /// Largest number of nodes a bar may have (a memory guard: ~100 bytes per node).
@@ -187,8 +188,49 @@ pub enum Dispersion {
     /// Elementary bar theory, `ρA ü = (EA u')'`: non-dispersive.
     #[default]
     None,
-    /// Love rod with lateral inertia, `ρA ü = EA u'' + ρν²J ü''` (Rayleigh–Love dispersion).
+    /// Love rod with lateral inertia, `ρA ü = EA u'' + ρν²J ü''` (Rayleigh–Love dispersion),
+    /// integrated by finite differences on every node.
     LoveRod,
+    /// The Rayleigh–Love relation applied to the travelling waves of a delay line (module docs,
+    /// "Dispersive delay line"; [`crate::transit`]).
+    RayleighLove,
+    /// The exact first Pochhammer–Chree mode applied to the travelling waves of a delay line
+    /// (module docs, "Dispersive delay line"; [`crate::transit`]).
+    PochhammerChree,
+}
+
+impl Dispersion {
+    /// Every bar theory, in the order the documentation lists them.
+    pub const ALL: [Dispersion; 4] = [
+        Dispersion::None,
+        Dispersion::LoveRod,
+        Dispersion::RayleighLove,
+        Dispersion::PochhammerChree,
+    ];
+
+    /// The name scene files use (`dispersion = "…"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Dispersion::None => "none",
+            Dispersion::LoveRod => "love-rod",
+            Dispersion::RayleighLove => "rayleigh-love",
+            Dispersion::PochhammerChree => "pochhammer-chree",
+        }
+    }
+
+    /// Parses a name of [`Dispersion::name`] (`None` for an unknown one).
+    pub fn parse(name: &str) -> Option<Dispersion> {
+        Dispersion::ALL.into_iter().find(|d| d.name() == name)
+    }
+
+    /// The relation a dispersive delay line applies, for the two transit variants.
+    pub fn transit_model(self) -> Option<TransitModel> {
+        match self {
+            Dispersion::RayleighLove => Some(TransitModel::RayleighLove),
+            Dispersion::PochhammerChree => Some(TransitModel::PochhammerChree),
+            Dispersion::None | Dispersion::LoveRod => None,
+        }
+    }
 }
 
 /// A bar: uniform segments from left to right, its end conditions and theory (docs/physics.md §6).
@@ -567,6 +609,154 @@ struct Waves {
     left: Vec<f64>,
     /// n mod N.
     shift: usize,
+    /// The dispersion the travelling waves carry, if any (module docs, "Dispersive delay line").
+    transit: Option<Box<Transit>>,
+}
+
+/// What a dispersive delay line keeps beyond the ring buffers (module docs, "Dispersive delay
+/// line"): every increment injected, and the transit filters that read them.
+#[derive(Debug, Clone)]
+struct Transit {
+    design: TransitDesign,
+    /// The end-to-end filter (N − 1 cells), taps oldest first.
+    ends: ReversedFilter,
+    /// Right-going increments A[m] injected at the left end at step m, at index m + offset
+    /// (m ≥ −N: the initial field, older: its last value repeated), m.
+    injected_right: Vec<f64>,
+    /// Left-going increments B[m] injected at the right end, likewise, m.
+    injected_left: Vec<f64>,
+    offset: usize,
+    /// Steps taken n.
+    step: usize,
+    /// [D at element N − 1, E at element 0] at the current level: the waves arriving at the ends.
+    arrival: [f64; 2],
+    /// Filters over fewer cells, for reads inside the bar, by cells.
+    interior: std::cell::RefCell<std::collections::HashMap<usize, std::sync::Arc<ReversedFilter>>>,
+    /// Σ of the squared increments injected (the initial field included) and delivered at the
+    /// ends: k times each is the wave energy into and out of the transit, m².
+    injected_sq: f64,
+    delivered_sq: f64,
+    /// max |H|² − 1 (≥ 0) of the end-to-end filter as truncated: the most energy it can add.
+    ends_gain_excess: f64,
+}
+
+/// A transit filter with its taps oldest first (for a dot product with a history slice).
+#[derive(Debug, Clone)]
+struct ReversedFilter {
+    lead: usize,
+    taps: Vec<f64>,
+}
+
+impl ReversedFilter {
+    fn new(f: TransitFilter) -> ReversedFilter {
+        let mut taps = f.taps;
+        taps.reverse();
+        ReversedFilter { lead: f.lead, taps }
+    }
+
+    /// Σ_j h_j s[newest − j + lead] over the history `s` (index of the pure-delay sample
+    /// `newest`; the lead never reaches past the last sample injected).
+    #[inline]
+    fn apply(&self, s: &[f64], newest: usize) -> f64 {
+        let lo = newest + self.lead + 1 - self.taps.len();
+        crate::transit::dot(&self.taps, &s[lo..=newest + self.lead])
+    }
+}
+
+impl Transit {
+    /// The transit of a delay line of `n` elements holding the field of `waves`.
+    fn new(design: TransitDesign, n: usize) -> Transit {
+        let filter = design.filter(n - 1);
+        let ends_gain_excess = (crate::transit::max_power_gain(&filter.taps) - 1.0).max(0.0);
+        let ends = ReversedFilter::new(filter);
+        // Room for the longest filter behind the oldest pure-delay read (interior filters,
+        // over fewer cells, are shorter; the slack covers their rounding).
+        let offset = n + 2 * ends.taps.len() + 16;
+        let mut t = Transit {
+            design,
+            ends,
+            injected_right: Vec::new(),
+            injected_left: Vec::new(),
+            offset,
+            step: 0,
+            arrival: [0.0; 2],
+            interior: Default::default(),
+            injected_sq: 0.0,
+            delivered_sq: 0.0,
+            ends_gain_excess,
+        };
+        t.injected_right = vec![0.0; offset];
+        t.injected_left = vec![0.0; offset];
+        t
+    }
+
+    /// Restarts the histories from the field of ring buffers at step 0 (A[m] = D_{−m−1},
+    /// B[m] = E_{N+m} for −N ≤ m < 0) and computes the arrivals.
+    fn restart(&mut self, right: &[f64], left: &[f64]) {
+        let n = right.len();
+        let pad = self.offset - n;
+        self.injected_right.truncate(self.offset);
+        self.injected_left.truncate(self.offset);
+        for i in 0..self.offset {
+            // m = i − offset; A[m] = right[−m−1] = right[offset − 1 − i] while that is < N.
+            let back = self.offset - 1 - i;
+            self.injected_right[i] = right[back.min(n - 1)];
+            self.injected_left[i] = left[(i.max(pad)) - pad];
+        }
+        self.step = 0;
+        self.injected_sq = right.iter().chain(left).map(|x| x * x).sum();
+        self.delivered_sq = 0.0;
+        self.update_arrivals();
+    }
+
+    /// Arrivals at the current step n: D̃ = Σ h_j A[n − N − j + lead], Ẽ likewise from B.
+    fn update_arrivals(&mut self) {
+        let idx = self.step + self.offset - self.elements(); // A[n − N]
+        self.arrival = [
+            self.ends.apply(&self.injected_right, idx),
+            self.ends.apply(&self.injected_left, idx),
+        ];
+    }
+
+    /// N, from the histories' layout.
+    fn elements(&self) -> usize {
+        self.offset - 2 * self.ends.taps.len() - 16
+    }
+
+    /// Records the increments injected at step n and moves to n + 1.
+    fn inject(&mut self, a: f64, b: f64, delivered: [f64; 2]) {
+        self.delivered_sq += delivered[0] * delivered[0] + delivered[1] * delivered[1];
+        self.injected_sq += a * a + b * b;
+        self.injected_right.push(a);
+        self.injected_left.push(b);
+        self.step += 1;
+        self.update_arrivals();
+    }
+
+    /// The filter over `cells` cells (built once).
+    fn interior(&self, cells: usize) -> std::sync::Arc<ReversedFilter> {
+        if let Some(f) = self.interior.borrow().get(&cells) {
+            return std::sync::Arc::clone(f);
+        }
+        let f = std::sync::Arc::new(ReversedFilter::new(self.design.filter(cells)));
+        self.interior
+            .borrow_mut()
+            .insert(cells, std::sync::Arc::clone(&f));
+        f
+    }
+
+    /// Right-going increment at element e (0 < e < N − 1): A[n − e − 1] carried over e cells.
+    fn right_at(&self, e: usize) -> f64 {
+        let f = self.interior(e);
+        f.apply(&self.injected_right, self.step + self.offset - e - 1)
+    }
+
+    /// Left-going increment at element e (0 < e < N − 1): B[n − (N − e)] carried over N − 1 − e cells.
+    fn left_at(&self, e: usize) -> f64 {
+        let n = self.elements();
+        let f = self.interior(n - 1 - e);
+        f.apply(&self.injected_left, self.step + self.offset - (n - e))
+    }
 }
 
 impl Waves {
@@ -576,6 +766,7 @@ impl Waves {
             right: vec![0.0; elements],
             left: vec![0.0; elements],
             shift: 0,
+            transit: None,
         }
     }
 
@@ -595,32 +786,69 @@ impl Waves {
         if s >= n { s - n } else { s }
     }
 
+    /// Right-going increment at element e at the current level: D_{e−n}, or with dispersion the
+    /// wave injected e + 1 steps ago carried over e cells, m.
+    #[inline]
+    fn d(&self, e: usize) -> f64 {
+        match &self.transit {
+            Some(t) if e > 0 && t.step > 0 => {
+                if e + 1 == self.right.len() {
+                    t.arrival[0]
+                } else {
+                    t.right_at(e)
+                }
+            }
+            _ => self.right[self.right_slot(e)],
+        }
+    }
+
+    /// Left-going increment at element e at the current level: E_{e+n}, or with dispersion the
+    /// wave injected N − e steps ago carried over N − 1 − e cells, m.
+    #[inline]
+    fn e(&self, e: usize) -> f64 {
+        match &self.transit {
+            Some(t) if e + 1 < self.left.len() && t.step > 0 => {
+                if e == 0 {
+                    t.arrival[1]
+                } else {
+                    t.left_at(e)
+                }
+            }
+            _ => self.left[self.left_slot(e)],
+        }
+    }
+
     /// Stretch u_{e+1}^n − u_e^n = D_{e−n} + E_{e+n} of element e, m.
     #[inline]
     fn stretch(&self, e: usize) -> f64 {
-        self.right[self.right_slot(e)] + self.left[self.left_slot(e)]
+        self.d(e) + self.e(e)
     }
 
     /// Δt v_i^{n−1/2} = E_{i−1+n} − D_{i−n} of interior node i (1 ≤ i ≤ N − 1), m.
     #[inline]
     fn last_move(&self, i: usize) -> f64 {
-        self.left[self.left_slot(i - 1)] - self.right[self.right_slot(i)]
+        self.e(i - 1) - self.d(i)
     }
 
     /// Δt v_i^{n+1/2} = E_{i+n} − D_{i−1−n} of interior node i (1 ≤ i ≤ N − 1), m.
     #[inline]
     fn next_move(&self, i: usize) -> f64 {
-        self.left[self.left_slot(i)] - self.right[self.right_slot(i - 1)]
+        self.e(i) - self.d(i - 1)
     }
 
     /// One step: the end nodes move by `left_move` = Δt v_0^{n+1/2} and `right_move` = Δt v_N^{n+1/2};
-    /// injects D_{−n−1} = E_n − left_move and E_{N+n} = D_{N−n−1} + right_move, m.
+    /// injects D_{−n−1} = E_n − left_move and E_{N+n} = D_{N−n−1} + right_move, m (with
+    /// dispersion, E_n and D_{N−n−1} are the arrivals).
     #[inline]
     fn advance(&mut self, left_move: f64, right_move: f64) {
         let n = self.right.len();
         let d_slot = n - 1 - self.shift;
-        let entering_left = self.left[self.shift] - left_move;
-        let entering_right = self.right[d_slot] + right_move;
+        let (arriving_left, arriving_right) = match &self.transit {
+            Some(_) => (self.e(0), self.d(n - 1)),
+            None => (self.left[self.shift], self.right[d_slot]),
+        };
+        let entering_left = arriving_left - left_move;
+        let entering_right = arriving_right + right_move;
         self.right[d_slot] = entering_left;
         self.left[self.shift] = entering_right;
         self.shift = if self.shift + 1 == n {
@@ -628,6 +856,20 @@ impl Waves {
         } else {
             self.shift + 1
         };
+        if let Some(t) = &mut self.transit {
+            t.inject(
+                entering_left,
+                entering_right,
+                [arriving_right, arriving_left],
+            );
+        }
+    }
+
+    /// Restarts the dispersive histories from the ring buffers (at step 0).
+    fn restart_transit(&mut self) {
+        if let Some(t) = &mut self.transit {
+            t.restart(&self.right, &self.left);
+        }
     }
 }
 
@@ -769,12 +1011,49 @@ impl Bar {
             ledger_j: 0.0,
             ledger_turnover_j: 0.0,
         };
+        let uniform_courant_1 = bar.segments.len() == 1
+            && (bar.courant_number(0) - 1.0).abs() <= DELAY_LINE_COURANT_SLACK;
         if scheme == BarScheme::Auto
-            && spec.dispersion == Dispersion::None
-            && bar.segments.len() == 1
-            && (bar.courant_number(0) - 1.0).abs() <= DELAY_LINE_COURANT_SLACK
+            && (spec.dispersion == Dispersion::None || spec.dispersion.transit_model().is_some())
+            && uniform_courant_1
         {
             bar.waves = Some(Waves::new(bar.k.len()));
+        }
+        if let Some(model) = spec.dispersion.transit_model() {
+            let Some(waves) = bar.waves.as_mut() else {
+                return Err(val.error(
+                    "dispersion",
+                    format!(
+                        "{:?} rides on the travelling waves of a delay line, but this bar is {}",
+                        spec.dispersion,
+                        if scheme == BarScheme::FiniteDifference {
+                            "forced onto finite differences".to_string()
+                        } else if bar.segments.len() > 1 {
+                            format!("{} segments", bar.segments.len())
+                        } else {
+                            format!(
+                                "at Courant number {:.6} ({} m is not a whole number of cells c0·Δt = {:e} m)",
+                                bar.courant_number(0),
+                                first.length_m,
+                                first.material.wave_speed_m_s() * dt_s
+                            )
+                        }
+                    ),
+                    "one uniform segment whose length is a whole number of cells c0·Δt (choose the \
+                     cell size so, e.g. 1 mm for the authors' bars), or dispersion = \"love-rod\" \
+                     (finite differences on any bar)",
+                ));
+            };
+            let seg = &spec.segments[0];
+            let design = TransitDesign::new(
+                model,
+                seg.material.poisson_ratio,
+                0.5 * seg.diameter_m,
+                bar.segments[0].dx_m,
+                bar.k.len(),
+            );
+            waves.transit = Some(Box::new(Transit::new(design, bar.k.len())));
+            waves.restart_transit();
         }
         if spec.dispersion == Dispersion::LoveRod {
             bar.love = Some(LoveOperator {
@@ -1128,6 +1407,12 @@ impl Bar {
             let half = 0.5 * self.dt_s * v_m_s;
             w.right.fill(-half);
             w.left.fill(half);
+            assert!(
+                w.transit.is_none() || self.step_index == 0,
+                "bar {}: a dispersive delay line is set moving only before its first step",
+                self.name
+            );
+            w.restart_transit();
         }
         let n = self.v.len();
         if self.ends[0] == EndCondition::Fixed {
@@ -1222,24 +1507,68 @@ impl Bar {
             .unwrap_or(self.segments.len() - 1)
     }
 
-    /// Axial strain at x (tension positive): linear between element centres of the segment holding x,
-    /// constant from the outermost centre to the segment's ends.
-    pub fn strain_at(&self, x_m: f64) -> f64 {
-        let s = &self.segments[self.segment_at(x_m)];
-        let e0 = s.first_element;
-        // [`Bar::element_strain`] of an element of segment s.
-        let strain = |e: usize| match &self.waves {
-            Some(w) => w.stretch(e) / s.dx_m,
-            None => (self.u[e + 1] - self.u[e]) / s.dx_m,
-        };
+    /// Where [`Bar::strain_at`] reads x: the segment, the element e and the weight t of element
+    /// e + 1 (strain = (1 − t) ε_e + t ε_{e+1}; t = 0 in a one-cell segment).
+    fn strain_point(&self, x_m: f64) -> (usize, usize, f64) {
+        let k = self.segment_at(x_m);
+        let s = &self.segments[k];
         if s.cells == 1 {
-            return strain(e0);
+            return (k, s.first_element, 0.0);
         }
         let xi = ((x_m - s.x0_m) / s.dx_m - 0.5).clamp(0.0, (s.cells - 1) as f64);
         // xi ≥ 0 (NaN → 0): truncation is the floor, without a libm call.
         let j = (xi as usize).min(s.cells - 2);
-        let t = xi - j as f64;
-        (1.0 - t) * strain(e0 + j) + t * strain(e0 + j + 1)
+        (k, s.first_element + j, xi - j as f64)
+    }
+
+    /// Axial strain at x (tension positive): linear between element centres of the segment holding x,
+    /// constant from the outermost centre to the segment's ends.
+    pub fn strain_at(&self, x_m: f64) -> f64 {
+        let (k, e, t) = self.strain_point(x_m);
+        let dx = self.segments[k].dx_m;
+        // [`Bar::element_strain`] of an element of segment k.
+        let strain = |e: usize| match &self.waves {
+            Some(w) => w.stretch(e) / dx,
+            None => (self.u[e + 1] - self.u[e]) / dx,
+        };
+        if t == 0.0 {
+            return strain(e);
+        }
+        (1.0 - t) * strain(e) + t * strain(e + 1)
+    }
+
+    /// Axial stress at each of `x_m` at each of the past `steps` (≤ the current step) of a
+    /// dispersive delay line, one row per step, from its whole histories by FFT (module docs,
+    /// "Dispersive delay line"; what [`Bar::stress_at`] read then, to the filters' truncation),
+    /// Pa; `None` for any other bar.
+    pub fn stress_history(&self, x_m: &[f64], steps: &[usize]) -> Option<Vec<Vec<f64>>> {
+        let t = self.transit()?;
+        let seg = &self.segments[0];
+        let scale = seg.youngs_modulus_pa / seg.dx_m;
+        let points: Vec<StretchPoint> = x_m
+            .iter()
+            .map(|&x| {
+                let (_, e, w) = self.strain_point(x);
+                StretchPoint {
+                    element: e,
+                    w0: (1.0 - w) * scale,
+                    w1: w * scale,
+                }
+            })
+            .collect();
+        let times: Vec<usize> = steps.iter().map(|&n| n + t.offset).collect();
+        let columns = t.design.stretch_history(
+            &t.injected_right,
+            &t.injected_left,
+            self.k.len(),
+            &points,
+            &times,
+        );
+        Some(
+            (0..steps.len())
+                .map(|i| columns.iter().map(|c| c[i]).collect())
+                .collect(),
+        )
     }
 
     /// Axial stress E·ε at x with E of the segment there, Pa (tension positive).
@@ -1333,6 +1662,9 @@ impl Bar {
     /// around the bar, J: a bar reached only by a tiny precursor has a turnover of 1e-315 J, whose
     /// rounding is judged against the energy of the test), or if the ledger is not finite.
     pub fn check_energy_ledger(&self, scale_j: f64) -> Result<()> {
+        if let Some(t) = self.transit().filter(|t| t.step > 0) {
+            return self.check_transit_passivity(t, scale_j);
+        }
         let full = self.recomputed_energy_j();
         let difference = self.ledger_j - full;
         let scale = self.ledger_turnover_j.max(scale_j);
@@ -1348,6 +1680,55 @@ impl Bar {
             ),
             value: difference,
         })
+    }
+
+    /// The dispersive delay line's energy check (module docs, "Dispersive delay line"): the
+    /// transit delivers no more wave energy than was injected into it (k Σ D̃² ≤ k Σ D², the
+    /// filters being passive), and the ledger is finite and not below zero, each within
+    /// [`ENERGY_LEDGER_TOLERANCE`] of the energy in play.
+    fn check_transit_passivity(&self, t: &Transit, scale_j: f64) -> Result<()> {
+        let k = self.k[0];
+        let scale = self.ledger_turnover_j.max(scale_j);
+        // A truncated filter's gain may exceed one by its truncation error: allow that share
+        // of the wave energy delivered, on top of the rounding of the energy in play.
+        let excess = k * (t.delivered_sq - t.injected_sq);
+        let allowed = ENERGY_LEDGER_TOLERANCE * scale + k * t.delivered_sq * t.ends_gain_excess;
+        let (quantity, value) = if excess.is_nan() || excess > allowed {
+            (
+                format!(
+                    "bar {}: the dispersive transit delivered {excess:e} J more wave energy than it was given \
+                     (allowed: {allowed:e} J)",
+                    self.name
+                ),
+                excess,
+            )
+        } else if self.ledger_j.is_nan() || self.ledger_j < -allowed {
+            (
+                format!(
+                    "bar {}: energy ledger {:e} J (allowed: ≥ {:e} J)",
+                    self.name, self.ledger_j, -allowed
+                ),
+                self.ledger_j,
+            )
+        } else {
+            return Ok(());
+        };
+        Err(Error::Unstable {
+            step: self.step_index,
+            time_s: self.time_s(),
+            quantity,
+            value,
+        })
+    }
+
+    /// The dispersive transit of a delay line, if the bar has one.
+    fn transit(&self) -> Option<&Transit> {
+        self.waves.as_ref().and_then(|w| w.transit.as_deref())
+    }
+
+    /// The dispersion relation the bar's travelling waves carry, if it is a dispersive delay line.
+    pub fn transit_model(&self) -> Option<TransitModel> {
+        self.transit().map(|t| t.design.model())
     }
 
     /// O(1) check of one step: the energy ledger is finite (it takes the end velocities every
@@ -1403,6 +1784,16 @@ impl Bar {
                 return Err(self.unstable_node(what, i, value));
             }
         }
+        if let Some(t) = self.transit() {
+            for (what, value, node) in [
+                ("right-going wave arriving", t.arrival[0], self.u.len() - 1),
+                ("left-going wave arriving", t.arrival[1], 0),
+            ] {
+                if !value.is_finite() {
+                    return Err(self.unstable_node(what, node, value));
+                }
+            }
+        }
         if let Some(w) = &self.waves {
             // D_{e−n} enters v_e, E_{e+n} enters v_{e+1} (module docs, "Delay line").
             for e in 0..w.right.len() {
@@ -1434,6 +1825,11 @@ impl Bar {
 
     /// Turns a delay line into the leapfrog on every node (before an interior node mass).
     fn materialise(&mut self) {
+        assert!(
+            self.transit().is_none(),
+            "bar {}: a dispersive delay line takes added masses only at its end nodes",
+            self.name
+        );
         let Some(w) = self.waves.take() else {
             return;
         };
@@ -1481,10 +1877,11 @@ pub fn rayleigh_love_velocity_ratio(poisson_ratio: f64, radius_over_wavelength: 
     1.0 / (1.0 + 0.5 * poisson_ratio * poisson_ratio * ka * ka).sqrt()
 }
 
-/// γ = ν²a²/(2Δx²) of the discrete Love relation (0 without the Love term).
+/// γ = ν²a²/(2Δx²) of the discrete Love relation (0 without the Love term: the grid of a
+/// dispersive delay line is elementary, its dispersion is in the transit filters).
 fn love_gamma(material: &BarMaterial, diameter_m: f64, dispersion: Dispersion, cell_m: f64) -> f64 {
     match dispersion {
-        Dispersion::None => 0.0,
+        Dispersion::None | Dispersion::RayleighLove | Dispersion::PochhammerChree => 0.0,
         Dispersion::LoveRod => {
             let a = diameter_m / 2.0;
             material.poisson_ratio.powi(2) * a * a / (2.0 * cell_m * cell_m)
@@ -1493,7 +1890,9 @@ fn love_gamma(material: &BarMaterial, diameter_m: f64, dispersion: Dispersion, c
 }
 
 /// Angular frequency of wavenumber κ on a uniform grid of this scheme, from
-/// sin²(ωΔt/2)(1 + 4γS²) = r²S², S = sin(κΔx/2), r = c0Δt/Δx, γ = ν²a²/(2Δx²) (module docs), rad/s.
+/// sin²(ωΔt/2)(1 + 4γS²) = r²S², S = sin(κΔx/2), r = c0Δt/Δx, γ = ν²a²/(2Δx²) (module docs), rad/s;
+/// for a dispersive delay line, its model's relation (the grid itself being exact), with the
+/// Pochhammer–Chree root solved rather than tabulated.
 pub fn scheme_angular_frequency_rad_s(
     material: &BarMaterial,
     diameter_m: f64,
@@ -1502,6 +1901,24 @@ pub fn scheme_angular_frequency_rad_s(
     dt_s: f64,
     wavenumber_rad_m: f64,
 ) -> f64 {
+    let (c0, k, a) = (
+        material.wave_speed_m_s(),
+        wavenumber_rad_m,
+        0.5 * diameter_m,
+    );
+    match dispersion.transit_model() {
+        Some(TransitModel::RayleighLove) => {
+            return c0 * k / (1.0 + 0.5 * (material.poisson_ratio * a * k).powi(2)).sqrt();
+        }
+        Some(TransitModel::PochhammerChree) => {
+            let ratio = crate::dispersion::velocity_ratio_at_radius_over_wavelength(
+                material.poisson_ratio,
+                k * a / (2.0 * PI),
+            );
+            return c0 * k * ratio;
+        }
+        None => {}
+    }
     let gamma = love_gamma(material, diameter_m, dispersion, cell_m);
     let r = material.wave_speed_m_s() * dt_s / cell_m;
     let s = (0.5 * wavenumber_rad_m * cell_m).sin();
@@ -1518,6 +1935,12 @@ pub fn scheme_wavenumber_rad_m(
     dt_s: f64,
     angular_frequency_rad_s: f64,
 ) -> f64 {
+    if let Some(model) = dispersion.transit_model() {
+        // The grid at Courant 1 carries Ω = ωΔt exactly; the transit adds φ(Ω) a cell.
+        let design = TransitDesign::new(model, material.poisson_ratio, 0.5 * diameter_m, cell_m, 1);
+        let w = angular_frequency_rad_s * dt_s;
+        return (w + design.phase_and_gain(w).0) / cell_m;
+    }
     let gamma = love_gamma(material, diameter_m, dispersion, cell_m);
     let r = material.wave_speed_m_s() * dt_s / cell_m;
     let p = (0.5 * angular_frequency_rad_s * dt_s).sin().powi(2);
@@ -1663,9 +2086,12 @@ pub fn measure_phase_velocity(
     let n_start = (t_start / dt).ceil() as usize;
     let n_end = (t_end / dt).ceil() as usize;
     let mut fits = [HarmonicFit::default(); 2];
+    // A dispersive delay line's stations are read after the run, with each wave's whole
+    // response (module docs, "Dispersive delay line").
+    let after = bar.transit_model().is_some();
     for n in 0..n_end {
         let t = n as f64 * dt;
-        if n >= n_start {
+        if n >= n_start && !after {
             fits[0].add(omega * t, bar.element_strain(first));
             fits[1].add(omega * t, bar.element_strain(second));
         }
@@ -1677,6 +2103,15 @@ pub fn measure_phase_velocity(
         bar.step(1e3 * envelope * (omega * t).sin(), 0.0);
     }
     bar.check_finite()?;
+    let centres = [bar.element_centre_m(first), bar.element_centre_m(second)];
+    let steps: Vec<usize> = (n_start..n_end).collect();
+    if let Some(rows) = bar.stress_history(&centres, &steps) {
+        for (&n, row) in steps.iter().zip(&rows) {
+            for (fit, stress) in fits.iter_mut().zip(row) {
+                fit.add(omega * n as f64 * dt, stress / material.youngs_modulus_pa);
+            }
+        }
+    }
     let (a1, th1) = fits[0].amplitude_phase();
     let (a2, th2) = fits[1].amplitude_phase();
     let d = spacing as f64 * cell;

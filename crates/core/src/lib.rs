@@ -29,5 +29,6 @@ pub mod shaper;
 pub mod solver;
 pub mod specimen;
 pub mod striker;
+pub mod transit;
 
 pub use error::{Error, Result};

@@ -683,10 +683,14 @@ fn reduce_simulated_records(
         transmission_strain: strain("transmission")?,
     };
     let reduction_options = crate::reduce::ReductionOptions {
-        dispersion: if options.dispersion == Dispersion::None {
-            crate::reduce::DispersionCorrection::None
-        } else {
-            crate::reduce::DispersionCorrection::Bancroft
+        // The correction that undoes the bars' own theory: none for elementary bars, the exact
+        // first mode for bars that carry it, the lab's Bancroft fit for the Love rods.
+        dispersion: match options.dispersion {
+            Dispersion::None => crate::reduce::DispersionCorrection::None,
+            Dispersion::PochhammerChree => crate::reduce::DispersionCorrection::PochhammerChree,
+            Dispersion::LoveRod | Dispersion::RayleighLove => {
+                crate::reduce::DispersionCorrection::Bancroft
+            }
         },
         specimen_radii_m: specimen_radii,
         smoothing_window_s: options.reduction_smoothing_s,

@@ -304,6 +304,9 @@ pub fn simulate_chain_with(
         recorders.extend(extra.iter_mut().map(|r| &mut **r as &mut dyn Recorder));
         chain.run(steps, &mut recorders)?;
     }
+    if let Some(s) = snapshots.as_mut() {
+        s.finish(&chain.bodies);
+    }
     let striker = &chain.bodies[0];
     Ok(ChainResult {
         time_s: gauges.time_s,

@@ -263,12 +263,17 @@ pub struct BarSnapshots {
 }
 
 /// Stress fields of every bar every `every` steps (not at step 0), at `spacing_m` along each bar.
+/// A dispersive delay line's fields are computed after the run from its histories
+/// ([`SnapshotRecorder::finish`], [`Bar::stress_history`]): reading them step by step would cost
+/// a convolution per point and snapshot.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SnapshotRecorder {
     /// Sampling interval in steps.
     pub every: usize,
     /// One field per bar of the chain, in chain order.
     pub snapshots: Vec<BarSnapshots>,
+    /// Steps recorded.
+    steps: Vec<usize>,
 }
 
 impl SnapshotRecorder {
@@ -288,7 +293,25 @@ impl SnapshotRecorder {
                 }
             })
             .collect();
-        SnapshotRecorder { every, snapshots }
+        SnapshotRecorder {
+            every,
+            snapshots,
+            steps: Vec::new(),
+        }
+    }
+
+    /// Fills the fields of the dispersive delay lines among `bodies` (the same chain, after the
+    /// run), left empty while it ran.
+    pub fn finish(&mut self, bodies: &[Body]) {
+        for (b, s) in bodies
+            .iter()
+            .filter_map(Body::as_bar)
+            .zip(self.snapshots.iter_mut())
+        {
+            if let Some(rows) = b.stress_history(&s.x_m, &self.steps) {
+                s.stress_pa = rows;
+            }
+        }
     }
 }
 
@@ -297,14 +320,17 @@ impl Recorder for SnapshotRecorder {
         if step == 0 || !step.is_multiple_of(self.every) {
             return;
         }
+        self.steps.push(step);
         for (b, s) in bodies
             .iter()
             .filter_map(Body::as_bar)
             .zip(self.snapshots.iter_mut())
         {
             s.time_s.push(time_s);
-            s.stress_pa
-                .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+            if b.transit_model().is_none() {
+                s.stress_pa
+                    .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+            }
         }
     }
 }

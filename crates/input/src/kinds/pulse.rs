@@ -78,7 +78,7 @@ pub(super) const DISPERSION: Key = Key {
     key: "dispersion",
     unit: "",
     default: "fidelity: none, none, love-rod",
-    meaning: "bar theory: none (elementary) or love-rod (lateral inertia)",
+    meaning: "bar theory: none (elementary), love-rod (lateral inertia, finite differences), rayleigh-love or pochhammer-chree (that relation carried by the travelling waves of a delay line: uniform bars a whole number of cells long)",
 };
 
 /// `end_time_s` (pulse and shpb).
@@ -228,15 +228,13 @@ pub(super) fn parse_bars(
     let knobs = fidelity.bar_knobs();
     let dispersion = match f.dispersion.as_deref() {
         None => knobs.dispersion,
-        Some("none") => Dispersion::None,
-        Some("love-rod") => Dispersion::LoveRod,
-        Some(other) => {
-            return Err(v.error(
+        Some(name) => Dispersion::parse(name).ok_or_else(|| {
+            v.error(
                 "dispersion",
-                format!("unknown model `{other}`"),
-                "none, love-rod",
-            ));
-        }
+                format!("unknown model `{name}`"),
+                Dispersion::ALL.map(Dispersion::name).join(", "),
+            )
+        })?,
     };
     let c0 = apparatus.material.wave_speed_m_s();
     // A cylinder gets at least CYLINDER_MIN_CELLS cells (docs/physics.md §6.9): the default
@@ -339,13 +337,7 @@ pub(super) fn parse_bars(
 pub(super) fn check_bar_key_docs() {
     let fmt = |f: Fidelity| {
         let k = f.bar_knobs();
-        (
-            format!("{:e}", k.cell_size_m),
-            match k.dispersion {
-                Dispersion::None => "none",
-                Dispersion::LoveRod => "love-rod",
-            },
-        )
+        (format!("{:e}", k.cell_size_m), k.dispersion.name())
     };
     let (cells, dispersions): (Vec<String>, Vec<&str>) = Fidelity::ALL.map(fmt).into_iter().unzip();
     assert_eq!(CELL_SIZE.default, format!("fidelity: {}", cells.join(", ")));

@@ -1,0 +1,391 @@
+//! Geometric dispersion carried by the travelling waves of a delay-line bar (docs/physics.md
+//! §6.2.1): the transit filter that turns a wave injected at one end into the wave that has
+//! travelled d cells along a uniform bar, for the Rayleigh–Love rod or the exact first
+//! Pochhammer–Chree mode.
+//!
+//! A bar of cells Δx at Courant 1 (Δx = c0 Δt) carries each travelling wave a whole cell a step:
+//! the delay line is exact for the elementary theory, where every frequency travels at c0. With
+//! a phase velocity c(ω) < c0 a component of angular frequency ω takes d Δx/c(ω) to cross d
+//! cells, i.e. d steps plus a residual lag of `d φ(Ω)/Ω` steps, with Ω = ωΔt and the residual
+//! phase per cell
+//!
+//! ```text
+//! φ(Ω) = Ω (c0/c(Ω) − 1)  ≥ 0.
+//! ```
+//!
+//! The transit filter over d cells is the all-pass response `H_d(Ω) = exp(−i d φ(Ω))` (the whole
+//! delay is d steps of the delay line plus H_d). Its impulse response is computed once per
+//! distance on an FFT grid, shifted by `lead` samples so that its small acausal precursor (the
+//! first mode alone is not exactly causal) sits at non-negative indices, and truncated where the
+//! energy left out on either side is below [`TAIL_ENERGY`] of the whole; the taps are then
+//! scaled so that they sum to one (a static strain passes unchanged).
+//!
+//! Rayleigh–Love: `ω = c0 k/√(1 + βk²)`, β = ν²a²/2 (docs/physics.md §6.3), so
+//! `kΔx = Ω/√(1 − βΩ²/Δx²)` and `φ = kΔx − Ω` below the cut-off `Ω_c = Δx/√β`; above it the
+//! wave is evanescent and decays by `|k|Δx` nepers a cell. Pochhammer–Chree: c/c0 of the first
+//! mode at f a/c0 = Ω a/(2π Δx) ([`crate::dispersion`]), tabulated once per Poisson ratio and
+//! process and interpolated (4-point Lagrange; within 3e-8 of the root, unit test).
+
+use crate::dispersion::{ModeTable, mode_table};
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex64;
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+/// Largest share of a transit filter's impulse-response energy left out by truncation, on
+/// either side (module docs): 1e-12 of the energy is 1e-6 of the amplitude.
+pub const TAIL_ENERGY: f64 = 1e-12;
+
+/// The dispersion relation the travelling waves of a delay line follow.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TransitModel {
+    /// Rayleigh–Love rod, c/c0 = 1/√(1 + ν²k²a²/2) (docs/physics.md §6.3).
+    RayleighLove,
+    /// The exact first longitudinal mode of a solid cylinder (docs/physics.md §7.9).
+    PochhammerChree,
+}
+
+/// The residual phase per cell of one bar on an FFT grid, and the band it passes (module docs).
+#[derive(Debug, Clone)]
+pub struct TransitDesign {
+    model: TransitModel,
+    poisson_ratio: f64,
+    /// a/Δx.
+    radius_cells: f64,
+    table: Option<Arc<ModeTable>>,
+    n_fft: usize,
+    /// φ per cell, bins 0..=n/2, rad.
+    phase: Vec<f64>,
+    /// Weight of each bin in one transit: 1 in the pass band, a smooth step to 0 across the
+    /// taper (module docs, "Band").
+    gain: Vec<f64>,
+}
+
+/// The impulse response of the transit over some cells: `taps[j]` weighs the wave injected
+/// `j − lead` steps before the pure delay would deliver it (`lead` ≤ the cells: module docs,
+/// "Causality").
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransitFilter {
+    /// Samples of precursor ahead of the pure delay.
+    pub lead: usize,
+    /// Impulse response, summing to one.
+    pub taps: Vec<f64>,
+}
+
+/// Smooth (C∞) step weight: 1 up to `a`, 0 from `b`, `S(x) = e^{−1/x}/(e^{−1/x} + e^{−1/(1−x)})`
+/// of x = (b − w)/(b − a) between, so the impulse response has no algebraic tail.
+fn taper(w: f64, a: f64, b: f64) -> f64 {
+    if w <= a {
+        1.0
+    } else if w >= b {
+        0.0
+    } else {
+        let x = (b - w) / (b - a);
+        let (p, q) = ((-1.0 / x).exp(), (-1.0 / (1.0 - x)).exp());
+        p / (p + q)
+    }
+}
+
+impl TransitDesign {
+    /// The design for a bar of Poisson's ratio `poisson_ratio`, radius `radius_m` and cells
+    /// `cell_m` (= c0 Δt) whose filters reach up to `max_cells` cells.
+    pub fn new(
+        model: TransitModel,
+        poisson_ratio: f64,
+        radius_m: f64,
+        cell_m: f64,
+        max_cells: usize,
+    ) -> TransitDesign {
+        // The slowest group velocity passed is 0.38 c0 (Pochhammer–Chree, ν ≤ 0.5) or 0.29 c0
+        // (Rayleigh–Love at the end of its taper): at most 2.5 steps a cell beyond the delay.
+        let span = (5.0 * max_cells as f64) as usize + 512;
+        let n_fft = span.next_power_of_two().max(1024);
+        let half = n_fft / 2;
+        let table = (model == TransitModel::PochhammerChree).then(|| mode_table(poisson_ratio));
+        let mut design = TransitDesign {
+            model,
+            poisson_ratio,
+            radius_cells: radius_m / cell_m,
+            table,
+            n_fft,
+            phase: Vec::new(),
+            gain: Vec::new(),
+        };
+        (design.phase, design.gain) = (0..=half)
+            .map(|k| design.phase_and_gain(2.0 * PI * k as f64 / n_fft as f64))
+            .unzip();
+        design
+    }
+
+    /// Residual phase per cell φ(Ω) (rad) and the band's weight at Ω = ωΔt ∈ [0, π] (module docs).
+    pub fn phase_and_gain(&self, w: f64) -> (f64, f64) {
+        match self.model {
+            TransitModel::RayleighLove => {
+                let beta = 0.5 * (self.poisson_ratio * self.radius_cells).powi(2);
+                let cutoff = 1.0 / beta.sqrt();
+                let (a, b) = ((0.5 * cutoff).min(0.5 * PI), (0.75 * cutoff).min(PI));
+                let s = 1.0 - beta * w * w;
+                if w < b && s > 0.0 {
+                    (w / s.sqrt() - w, taper(w, a, b))
+                } else {
+                    (0.0, 0.0)
+                }
+            }
+            TransitModel::PochhammerChree => {
+                let y = w * self.radius_cells / (2.0 * PI);
+                let ratio = self.table.as_ref().map_or(1.0, |t| t.ratio(y));
+                (w * (1.0 / ratio - 1.0), taper(w, 0.5 * PI, PI))
+            }
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> TransitModel {
+        self.model
+    }
+
+    /// The response exp(−i d φ) times the band's weight over `cells` cells at bin k of the
+    /// design's grid (Ω = 2πk/n).
+    fn response(&self, k: usize, cells: f64) -> Complex64 {
+        Complex64::from_polar(self.gain[k], -cells * self.phase[k])
+    }
+
+    /// The transit filter over `cells` cells (module docs).
+    pub fn filter(&self, cells: usize) -> TransitFilter {
+        if cells == 0 {
+            return TransitFilter {
+                lead: 0,
+                taps: vec![1.0],
+            };
+        }
+        let n = self.n_fft;
+        let d = cells as f64;
+        let mut spectrum: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
+        for k in 0..=n / 2 {
+            let h = self.response(k, d);
+            spectrum[k] = h;
+            if k > 0 && k < n / 2 {
+                spectrum[n - k] = h.conj();
+            }
+        }
+        FftPlanner::<f64>::new()
+            .plan_fft_inverse(n)
+            .process(&mut spectrum);
+        let h: Vec<f64> = spectrum.iter().map(|c| c.re / n as f64).collect();
+        let total: f64 = h.iter().map(|x| x * x).sum();
+        let cut = TAIL_ENERGY * total;
+        // Causal part: indices 0..n/2; precursor: n − 1, n − 2, … (negative times).
+        let mut tail = 0.0;
+        let mut len = n / 2;
+        while len > 1 && tail + h[len - 1] * h[len - 1] <= cut {
+            tail += h[len - 1] * h[len - 1];
+            len -= 1;
+        }
+        let mut ahead = 0.0;
+        let mut lead = n / 2 - 1;
+        while lead > 0 && ahead + h[n - lead] * h[n - lead] <= cut {
+            ahead += h[n - lead] * h[n - lead];
+            lead -= 1;
+        }
+        // Causality: a wave read d cells from where it entered was injected at least d steps
+        // before the pure delay delivers it, so at most d samples of precursor can be known.
+        let lead = lead.min(cells);
+        let mut taps: Vec<f64> = (1..=lead).rev().map(|t| h[n - t]).collect();
+        taps.extend_from_slice(&h[..len]);
+        let sum: f64 = taps.iter().sum();
+        if sum != 0.0 && sum.is_finite() {
+            for t in &mut taps {
+                *t /= sum;
+            }
+        }
+        TransitFilter { lead, taps }
+    }
+}
+
+/// One point of [`TransitDesign::stretch_history`]: `w0` times the stretch of element `element`
+/// plus `w1` times that of the next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StretchPoint {
+    /// First element e.
+    pub element: usize,
+    /// Weight of element e.
+    pub w0: f64,
+    /// Weight of element e + 1 (0 when e is the last).
+    pub w1: f64,
+}
+
+impl TransitDesign {
+    /// Stretches of a dispersive delay line of `elements` elements at `points`, at the history
+    /// indices `times`, from its whole histories (module docs, "After the run"): `right[i]` and
+    /// `left[i]` are the increments injected at index i (i from the start of the histories, whose
+    /// first value stands for all earlier ones). The element fields are
+    /// `R_e(t) = (h_e ⊛ right)(t − e − 1)` and `L_e(t) = (h_{N−1−e} ⊛ left)(t − N + e)`, with the
+    /// exact responses h_c (not truncated) and the first cell of each wave undispersed, as the
+    /// delay line reads them step by step. Returns one row per point.
+    pub fn stretch_history(
+        &self,
+        right: &[f64],
+        left: &[f64],
+        elements: usize,
+        points: &[StretchPoint],
+        times: &[usize],
+    ) -> Vec<Vec<f64>> {
+        let (Some(&a0), Some(&b0)) = (right.first(), left.first()) else {
+            return vec![vec![0.0; times.len()]; points.len()];
+        };
+        let last_time = times.iter().copied().max().unwrap_or(0);
+        // Zero padding beyond the longest transit (and its 2.5-steps-a-cell tail) keeps the
+        // circular convolution linear over the times asked for.
+        let n = (last_time.max(right.len()) + 4 * elements + 64).next_power_of_two();
+        let mut planner = FftPlanner::<f64>::new();
+        let forward = planner.plan_fft_forward(n);
+        let inverse = planner.plan_fft_inverse(n);
+        let spectrum = |s: &[f64], base: f64| {
+            let mut v: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
+            for (c, &x) in v.iter_mut().zip(s) {
+                c.re = x - base;
+            }
+            forward.process(&mut v);
+            v
+        };
+        let (fa, fb) = (spectrum(right, a0), spectrum(left, b0));
+        let half = n / 2;
+        // Per bin: z = e^{−i(Ω + φ)} (one cell), the band weight G and the one-step delay.
+        let mut z = Vec::with_capacity(half + 1);
+        let mut gain = Vec::with_capacity(half + 1);
+        let mut step = Vec::with_capacity(half + 1);
+        for k in 0..=half {
+            let w = 2.0 * PI * k as f64 / n as f64;
+            let (phi, g) = self.phase_and_gain(w);
+            z.push(Complex64::from_polar(1.0, -(w + phi)));
+            gain.push(g);
+            step.push(Complex64::from_polar(1.0, -w));
+        }
+        let last = elements - 1;
+        let z_last: Vec<Complex64> = z.iter().map(|c| c.powu(last as u32)).collect();
+        // z^e of the current point's element, advanced point to point (points usually come in
+        // increasing order); |z| = 1, so z^{N−1−e} = z^{N−1} conj(z^e).
+        let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
+        let mut pw_element = 0usize;
+        points
+            .iter()
+            .map(|p| {
+                let e = p.element.min(last);
+                if e >= pw_element {
+                    for _ in pw_element..e {
+                        for (c, zk) in pw.iter_mut().zip(&z) {
+                            *c *= zk;
+                        }
+                    }
+                } else {
+                    for (c, zk) in pw.iter_mut().zip(&z) {
+                        *c = zk.powu(e as u32);
+                    }
+                }
+                pw_element = e;
+                let e1 = (e + 1).min(last);
+                let mut y: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
+                for k in 0..=half {
+                    // R_e: delay e + 1 steps, dispersion over e cells (none for e = 0);
+                    // L_e: delay N − e steps, dispersion over N − 1 − e cells (none for e = N − 1).
+                    let g = gain[k];
+                    let zr = pw[k];
+                    let zl = z_last[k] * zr.conj();
+                    let (gr0, gl0) = (
+                        if e == 0 { 1.0 } else { g },
+                        if e == last { 1.0 } else { g },
+                    );
+                    let mut h_r = zr * (gr0 * p.w0);
+                    let mut h_l = zl * (gl0 * p.w0);
+                    if p.w1 != 0.0 {
+                        let gl1 = if e1 == last { 1.0 } else { g };
+                        let zr1 = if e1 == e { zr } else { zr * z[k] };
+                        h_r += zr1 * (g * p.w1);
+                        h_l += if e1 == e { zl } else { zl * z[k].conj() } * (gl1 * p.w1);
+                    }
+                    let v = (fa[k] * h_r + fb[k] * h_l) * step[k];
+                    y[k] = v;
+                    if k > 0 && k < half {
+                        y[n - k] = v.conj();
+                    }
+                }
+                y[half].im = 0.0;
+                inverse.process(&mut y);
+                let dc = (a0 + b0) * (p.w0 + p.w1);
+                times.iter().map(|&t| y[t].re / n as f64 + dc).collect()
+            })
+            .collect()
+    }
+}
+
+/// max over frequency of |Σ_j h_j e^{−iΩj}|², on a grid 8 times finer than the taps are long.
+pub fn max_power_gain(taps: &[f64]) -> f64 {
+    let n = (8 * taps.len()).next_power_of_two().max(64);
+    let mut v: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
+    for (c, &t) in v.iter_mut().zip(taps) {
+        c.re = t;
+    }
+    FftPlanner::<f64>::new().plan_fft_forward(n).process(&mut v);
+    v.iter().map(|c| c.norm_sqr()).fold(0.0, f64::max)
+}
+
+/// Σ a_i b_i in four independent lanes (so the compiler vectorises it).
+#[inline]
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let chunks = n / 4;
+    for (ca, cb) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        for l in 0..4 {
+            acc[l] += ca[l] * cb[l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for i in 4 * chunks..n {
+        s += a[i] * b[i];
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A filter's DFT is exp(−i d φ) in its band (at the design's bins), and its taps sum to one.
+    #[test]
+    fn filters_are_the_all_pass_transit_of_each_model() {
+        for model in [TransitModel::PochhammerChree, TransitModel::RayleighLove] {
+            let design = TransitDesign::new(model, 0.31, 9.525e-3, 1e-3, 400);
+            let f = design.filter(400);
+            assert!((f.taps.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            assert!(
+                f.taps.len() < design.n_fft / 2,
+                "{model:?}: {} taps",
+                f.taps.len()
+            );
+            for k in [3usize, 40, 150, 300, 700] {
+                let w = 2.0 * PI * k as f64 / design.n_fft as f64;
+                let hk: Complex64 = f
+                    .taps
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &t)| Complex64::from_polar(t, -w * (j as f64 - f.lead as f64)))
+                    .sum();
+                let expected = design.response(k, 400.0);
+                assert!(
+                    (hk - expected).norm() < 1e-5,
+                    "{model:?} bin {k}: {hk} vs {expected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn dot_is_the_sum_of_products() {
+        let a: Vec<f64> = (0..11).map(|i| i as f64).collect();
+        let b: Vec<f64> = (0..11).map(|i| 1.0 / (1.0 + i as f64)).collect();
+        let direct: f64 = a.iter().zip(&b).map(|(x, y)| x * y).sum();
+        assert!((dot(&a, &b) - direct).abs() < 1e-12);
+    }
+}
