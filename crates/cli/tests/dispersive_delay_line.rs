@@ -230,6 +230,33 @@ fn fields_after_the_run_are_the_fields_read_during_it() {
     );
 }
 
+/// A gauge's series computed after the run (what the recorders write for a dispersive bar) is
+/// what it read step by step: a 3.3 mm grid (stretch between its ends) and a point.
+#[test]
+fn gauge_series_after_the_run_are_the_readings() {
+    let (xa, xb, x) = (0.49835, 0.50165, 0.6101);
+    for dispersion in [Dispersion::PochhammerChree, Dispersion::RayleighLove] {
+        let mut b = bar(1.0, DIAMETER_M, dispersion);
+        let (mut grid, mut point, mut steps) = (Vec::new(), Vec::new(), Vec::new());
+        for n in 0..1200 {
+            steps.push(n);
+            grid.push(b.stretch_between_m(xa, xb));
+            point.push(b.strain_at(x));
+            b.step(pulse_n(n as f64 * b.dt_s()), 0.0);
+        }
+        let grid_after = b.stretch_between_history(xa, xb, &steps).unwrap();
+        let point_after = b.strain_history(x, &steps).unwrap();
+        for (during, after) in [(&grid, &grid_after), (&point, &point_after)] {
+            let peak = during.iter().fold(0.0f64, |m, &v| m.max(v.abs()));
+            let worst = during
+                .iter()
+                .zip(after)
+                .fold(0.0f64, |m, (d, a)| m.max((d - a).abs()));
+            assert!(worst < 1e-5 * peak, "{dispersion:?}: {:e}", worst / peak);
+        }
+    }
+}
+
 /// Dispersion on travelling waves needs a delay line: a bar of two segments, or one whose
 /// length is not a whole number of cells, is refused with the key and what would do.
 #[test]

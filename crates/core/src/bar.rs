@@ -1024,8 +1024,9 @@ impl Bar {
                 return Err(val.error(
                     "dispersion",
                     format!(
-                        "{:?} rides on the travelling waves of a delay line, but this bar is {}",
-                        spec.dispersion,
+                        "dispersion = \"{}\" rides on the travelling waves of a delay line, but bar {} is {}",
+                        spec.dispersion.name(),
+                        spec.name,
                         if scheme == BarScheme::FiniteDifference {
                             "forced onto finite differences".to_string()
                         } else if bar.segments.len() > 1 {
@@ -1537,38 +1538,85 @@ impl Bar {
         (1.0 - t) * strain(e) + t * strain(e + 1)
     }
 
-    /// Axial stress at each of `x_m` at each of the past `steps` (≤ the current step) of a
-    /// dispersive delay line, one row per step, from its whole histories by FFT (module docs,
-    /// "Dispersive delay line"; what [`Bar::stress_at`] read then, to the filters' truncation),
-    /// Pa; `None` for any other bar.
-    pub fn stress_history(&self, x_m: &[f64], steps: &[usize]) -> Option<Vec<Vec<f64>>> {
+    /// Weighted element stretches over the past `steps` (≤ the current step) of a dispersive
+    /// delay line, from its whole histories by FFT (module docs, "Dispersive delay line"): one
+    /// row per point, one column per step; `None` for any other bar.
+    fn transit_history(&self, points: Vec<StretchPoint>, steps: &[usize]) -> Option<Vec<Vec<f64>>> {
         let t = self.transit()?;
-        let seg = &self.segments[0];
-        let scale = seg.youngs_modulus_pa / seg.dx_m;
-        let points: Vec<StretchPoint> = x_m
-            .iter()
-            .map(|&x| {
-                let (_, e, w) = self.strain_point(x);
-                StretchPoint {
-                    element: e,
-                    w0: (1.0 - w) * scale,
-                    w1: w * scale,
-                }
+        // Terms by element, merged (the FFT evaluation walks the elements upward).
+        let points: Vec<StretchPoint> = points
+            .into_iter()
+            .map(|mut p| {
+                p.sort_by_key(|&(e, _)| e);
+                p.dedup_by(|b, a| {
+                    let same = a.0 == b.0;
+                    if same {
+                        a.1 += b.1;
+                    }
+                    same
+                });
+                p
             })
             .collect();
         let times: Vec<usize> = steps.iter().map(|&n| n + t.offset).collect();
-        let columns = t.design.stretch_history(
+        Some(t.design.stretch_history(
             &t.injected_right,
             &t.injected_left,
             self.k.len(),
             &points,
             &times,
-        );
+        ))
+    }
+
+    /// [`Bar::strain_at`]'s reading of x as element stretches, each weight scaled by `scale`.
+    fn strain_terms(&self, x_m: f64, scale: f64) -> StretchPoint {
+        let (k, e, w) = self.strain_point(x_m);
+        let scale = scale / self.segments[k].dx_m;
+        if w == 0.0 {
+            vec![(e, scale)]
+        } else {
+            vec![(e, (1.0 - w) * scale), (e + 1, w * scale)]
+        }
+    }
+
+    /// Axial stress at each of `x_m` at each of the past `steps` (≤ the current step) of a
+    /// dispersive delay line, one row per step, from its whole histories by FFT (module docs,
+    /// "Dispersive delay line"; what [`Bar::stress_at`] read then, to the filters' truncation,
+    /// with each wave's whole precursor), Pa; `None` for any other bar.
+    pub fn stress_history(&self, x_m: &[f64], steps: &[usize]) -> Option<Vec<Vec<f64>>> {
+        let e_pa = self.segments.first()?.youngs_modulus_pa;
+        let points = x_m.iter().map(|&x| self.strain_terms(x, e_pa)).collect();
+        let columns = self.transit_history(points, steps)?;
         Some(
             (0..steps.len())
                 .map(|i| columns.iter().map(|c| c[i]).collect())
                 .collect(),
         )
+    }
+
+    /// [`Bar::strain_at`] at x over the past `steps` of a dispersive delay line ([`Bar::stress_history`]).
+    pub fn strain_history(&self, x_m: f64, steps: &[usize]) -> Option<Vec<f64>> {
+        let points = vec![self.strain_terms(x_m, 1.0)];
+        self.transit_history(points, steps)?.pop()
+    }
+
+    /// [`Bar::stretch_between_m`] over the past `steps` of a dispersive delay line
+    /// ([`Bar::stress_history`]), m.
+    pub fn stretch_between_history(
+        &self,
+        x_a_m: f64,
+        x_b_m: f64,
+        steps: &[usize],
+    ) -> Option<Vec<f64>> {
+        let (la, wa) = self.node_interval(x_a_m);
+        let (lb, wb) = self.node_interval(x_b_m);
+        let mut terms: StretchPoint = if lb >= la {
+            (la..lb).map(|e| (e, 1.0)).collect()
+        } else {
+            (lb..la).map(|e| (e, -1.0)).collect()
+        };
+        terms.extend([(lb, wb), (la, -wa)]);
+        self.transit_history(vec![terms], steps)?.pop()
     }
 
     /// Axial stress E·ε at x with E of the segment there, Pa (tension positive).

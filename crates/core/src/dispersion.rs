@@ -254,32 +254,34 @@ fn first_root(lo: f64, g: impl Fn(f64) -> f64) -> f64 {
     1.0
 }
 
-/// The first-mode root at f a/c0 = `y` bisected to 1e-14 inside ±1e-6 of `hint` (the table's
-/// value, good to 3e-8), or by [`velocity_ratio_at_normalised_frequency`]'s scan if the root is
-/// not there: the same root in about 27 evaluations instead of about 150.
+/// The first-mode root at f a/c0 = `y` refined to 1e-14 by the Illinois method inside ±1e-6 of
+/// `hint` (the table's value, good to 3e-8), or by [`velocity_ratio_at_normalised_frequency`]'s
+/// scan if the root is not there: the same root in about 8 evaluations instead of about 150.
 fn velocity_ratio_near(poisson_ratio: f64, y: f64, hint: f64) -> f64 {
     let w = y.abs();
     if w < LONG_WAVE_LIMIT {
         return velocity_ratio_at_normalised_frequency(poisson_ratio, w);
     }
     let g = |x: f64| frequency_function(poisson_ratio, 2.0 * PI * w / x, x);
-    let (mut a, mut b) = (hint - 1e-6, (hint + 1e-6).min(1.0));
-    let ga = g(a);
+    let (a, b) = (hint - 1e-6, (hint + 1e-6).min(1.0));
+    let (ga, gb) = (g(a), g(b));
     if ga == 0.0 {
         return a;
     }
-    if ga.signum() == g(b).signum() {
+    if ga.signum() == gb.signum() {
         return velocity_ratio_at_normalised_frequency(poisson_ratio, w);
     }
-    while b - a > 1e-14 {
-        let m = 0.5 * (a + b);
-        if g(m).signum() == ga.signum() {
-            a = m;
-        } else {
-            b = m;
-        }
-    }
-    0.5 * (a + b)
+    let s = ga.signum();
+    let (lo, hi) = crate::numeric::illinois(
+        a,
+        b,
+        s * ga,
+        s * gb,
+        200,
+        |lo, hi| hi - lo <= 1e-14,
+        |x| s * g(x),
+    );
+    0.5 * (lo + hi)
 }
 
 /// Below this a/Λ (or f a/c0) the solver uses Rayleigh's long-wave limit

@@ -202,26 +202,34 @@ impl TransitDesign {
     }
 }
 
-/// One point of [`TransitDesign::stretch_history`]: `w0` times the stretch of element `element`
-/// plus `w1` times that of the next.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StretchPoint {
-    /// First element e.
-    pub element: usize,
-    /// Weight of element e.
-    pub w0: f64,
-    /// Weight of element e + 1 (0 when e is the last).
-    pub w1: f64,
+/// One point of [`TransitDesign::stretch_history`]: Σ weight × stretch of element, over its
+/// terms (elements in increasing order).
+pub type StretchPoint = Vec<(usize, f64)>;
+
+/// The times asked of [`TransitDesign::stretch_history`] as `first + stride·q`, q = 0, 1, …, if
+/// they are such a progression with `stride` > 1.
+fn progression(times: &[usize]) -> Option<(usize, usize)> {
+    let (&first, &second) = (times.first()?, times.get(1)?);
+    let stride = second.checked_sub(first).filter(|&s| s > 1)?;
+    times
+        .windows(2)
+        .all(|w| w[1] == w[0] + stride)
+        .then_some((first, stride))
 }
 
 impl TransitDesign {
     /// Stretches of a dispersive delay line of `elements` elements at `points`, at the history
     /// indices `times`, from its whole histories (module docs, "After the run"): `right[i]` and
-    /// `left[i]` are the increments injected at index i (i from the start of the histories, whose
-    /// first value stands for all earlier ones). The element fields are
+    /// `left[i]` are the increments injected at index i (i from the start of the histories,
+    /// whose first value stands for all earlier ones). The element fields are
     /// `R_e(t) = (h_e ⊛ right)(t − e − 1)` and `L_e(t) = (h_{N−1−e} ⊛ left)(t − N + e)`, with the
-    /// exact responses h_c (not truncated) and the first cell of each wave undispersed, as the
-    /// delay line reads them step by step. Returns one row per point.
+    /// exact responses h_c (not truncated, precursor included) and the first cell of each wave
+    /// undispersed, as the delay line reads them step by step. Returns one row per point.
+    ///
+    /// One FFT of each history, then per point its spectrum (z^e by recurrence from the previous
+    /// point, |z| = 1) and one inverse FFT; when the times are a progression of stride K (x–t
+    /// snapshots), the spectrum is folded K times first (sampling every K-th value), so the
+    /// inverse FFT is K times shorter.
     pub fn stretch_history(
         &self,
         right: &[f64],
@@ -230,19 +238,34 @@ impl TransitDesign {
         points: &[StretchPoint],
         times: &[usize],
     ) -> Vec<Vec<f64>> {
-        let (Some(&a0), Some(&b0)) = (right.first(), left.first()) else {
+        let (Some(&a0), Some(&b0), Some(&last_time)) =
+            (right.first(), left.first(), times.iter().max())
+        else {
             return vec![vec![0.0; times.len()]; points.len()];
         };
-        let last_time = times.iter().copied().max().unwrap_or(0);
-        // Zero padding beyond the longest transit (and its 2.5-steps-a-cell tail) keeps the
-        // circular convolution linear over the times asked for.
-        let n = (last_time.max(right.len()) + 4 * elements + 64).next_power_of_two();
+        // The histories before the first value that differs from the constant past add
+        // nothing; start there (less a transit's precursor) to keep the transform short.
+        let changed = |s: &[f64], base: f64| s.iter().position(|&x| x != base).unwrap_or(s.len());
+        let start = changed(right, a0)
+            .min(changed(left, b0))
+            .saturating_sub(2 * elements)
+            .min(times.iter().copied().min().unwrap_or(0));
+        let span = last_time.max(right.len()) - start;
+        // Zero padding beyond the longest transit's tail (group delay beyond c0: 1.6 steps a
+        // cell at most for Pochhammer–Chree, 2.5 for the Rayleigh–Love band) and its precursor
+        // keeps the circular convolution linear over the times asked for.
+        let tail = match self.model {
+            TransitModel::PochhammerChree => 1.7,
+            TransitModel::RayleighLove => 2.6,
+        };
+        let need = span + (tail * elements as f64) as usize + 256;
+        let fold = progression(times).map_or(1, |(_, k)| k);
+        let n = fold * need.div_ceil(fold).next_power_of_two();
         let mut planner = FftPlanner::<f64>::new();
         let forward = planner.plan_fft_forward(n);
-        let inverse = planner.plan_fft_inverse(n);
         let spectrum = |s: &[f64], base: f64| {
             let mut v: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
-            for (c, &x) in v.iter_mut().zip(s) {
+            for (c, &x) in v.iter_mut().zip(&s[start.min(s.len())..]) {
                 c.re = x - base;
             }
             forward.process(&mut v);
@@ -250,69 +273,105 @@ impl TransitDesign {
         };
         let (fa, fb) = (spectrum(right, a0), spectrum(left, b0));
         let half = n / 2;
-        // Per bin: z = e^{−i(Ω + φ)} (one cell), the band weight G and the one-step delay.
-        let mut z = Vec::with_capacity(half + 1);
-        let mut gain = Vec::with_capacity(half + 1);
-        let mut step = Vec::with_capacity(half + 1);
-        for k in 0..=half {
+        let last = elements - 1;
+        let bins: Vec<usize> = (0..=half).collect();
+        // Per bin (0..=n/2): z = e^{−i(Ω + φ)} (one cell), the band's weight, and the history
+        // spectra times the one-step delay (the left one carried over the whole bar, z^{N−1}).
+        let mut z = Vec::with_capacity(bins.len());
+        let mut gain = Vec::with_capacity(bins.len());
+        let mut u = Vec::with_capacity(bins.len());
+        let mut v = Vec::with_capacity(bins.len());
+        for &k in &bins {
             let w = 2.0 * PI * k as f64 / n as f64;
             let (phi, g) = self.phase_and_gain(w);
-            z.push(Complex64::from_polar(1.0, -(w + phi)));
+            let zk = Complex64::from_polar(1.0, -(w + phi));
+            let delay = Complex64::from_polar(1.0, -w);
+            z.push(zk);
             gain.push(g);
-            step.push(Complex64::from_polar(1.0, -w));
+            u.push(fa[k] * delay);
+            v.push(fb[k] * delay * zk.powu(last as u32));
         }
-        let last = elements - 1;
-        let z_last: Vec<Complex64> = z.iter().map(|c| c.powu(last as u32)).collect();
-        // z^e of the current point's element, advanced point to point (points usually come in
-        // increasing order); |z| = 1, so z^{N−1−e} = z^{N−1} conj(z^e).
-        let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
+        // Times relative to the transform's start; sampled every `fold` from `offset`.
+        let local: Vec<usize> = times.iter().map(|&t| t - start).collect();
+        let (offset, m) = (local[0] % fold, n / fold);
+        let inverse = planner.plan_fft_inverse(m);
+        // y(offset + fold·q) = (1/n) Σ_k Y_k e^{2πik·offset/n} e^{2πikq/m}, over each k ≤ n/2
+        // and its mirror n − k (Y_{n−k} = conj Y_k): the two phase turns and folded slots.
+        let turn =
+            |k: usize| Complex64::from_polar(1.0, 2.0 * PI * ((k * offset) % n) as f64 / n as f64);
+        let turns: Vec<(Complex64, Complex64)> =
+            bins.iter().map(|&k| (turn(k), turn(n - k))).collect();
+        let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); bins.len()];
         let mut pw_element = 0usize;
+        let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
+        let mut folded = vec![Complex64::new(0.0, 0.0); m];
         points
             .iter()
             .map(|p| {
-                let e = p.element.min(last);
-                if e >= pw_element {
-                    for _ in pw_element..e {
-                        for (c, zk) in pw.iter_mut().zip(&z) {
+                let Some(&(first, _)) = p.first() else {
+                    return vec![0.0; times.len()];
+                };
+                let e0 = first.min(last);
+                if e0 >= pw_element {
+                    // z^Δ for this stride, kept while points come at the same spacing.
+                    let stride = e0 - pw_element;
+                    if stride > 0 {
+                        if stride != z_stride.0 {
+                            z_stride = (stride, z.iter().map(|c| c.powu(stride as u32)).collect());
+                        }
+                        for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
                             *c *= zk;
                         }
                     }
                 } else {
                     for (c, zk) in pw.iter_mut().zip(&z) {
-                        *c = zk.powu(e as u32);
+                        *c = zk.powu(e0 as u32);
                     }
                 }
-                pw_element = e;
-                let e1 = (e + 1).min(last);
-                let mut y: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
-                for k in 0..=half {
-                    // R_e: delay e + 1 steps, dispersion over e cells (none for e = 0);
-                    // L_e: delay N − e steps, dispersion over N − 1 − e cells (none for e = N − 1).
-                    let g = gain[k];
-                    let zr = pw[k];
-                    let zl = z_last[k] * zr.conj();
-                    let (gr0, gl0) = (
-                        if e == 0 { 1.0 } else { g },
-                        if e == last { 1.0 } else { g },
-                    );
-                    let mut h_r = zr * (gr0 * p.w0);
-                    let mut h_l = zl * (gl0 * p.w0);
-                    if p.w1 != 0.0 {
-                        let gl1 = if e1 == last { 1.0 } else { g };
-                        let zr1 = if e1 == e { zr } else { zr * z[k] };
-                        h_r += zr1 * (g * p.w1);
-                        h_l += if e1 == e { zl } else { zl * z[k].conj() } * (gl1 * p.w1);
+                pw_element = e0;
+                let ends = p.iter().any(|&(e, _)| e == 0 || e >= last);
+                folded.fill(Complex64::new(0.0, 0.0));
+                for (j, &k) in bins.iter().enumerate() {
+                    let g = gain[j];
+                    let (mut zr, mut h_r, mut h_l) =
+                        (pw[j], Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+                    let mut at = e0;
+                    for &(e, weight) in p {
+                        let e = e.min(last);
+                        while at < e {
+                            zr *= z[j];
+                            at += 1;
+                        }
+                        // R_e: dispersion over e cells (none for e = 0); L_e: over N − 1 − e
+                        // (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
+                        if ends {
+                            let gr = if e == 0 { 1.0 } else { g };
+                            let gl = if e == last { 1.0 } else { g };
+                            h_r += zr * (gr * weight);
+                            h_l += zr.conj() * (gl * weight);
+                        } else {
+                            h_r += zr * weight;
+                            h_l += zr.conj() * weight;
+                        }
                     }
-                    let v = (fa[k] * h_r + fb[k] * h_l) * step[k];
-                    y[k] = v;
-                    if k > 0 && k < half {
-                        y[n - k] = v.conj();
+                    let mut value = u[j] * h_r + v[j] * h_l;
+                    if !ends {
+                        value *= g;
+                    }
+                    let (t_k, t_mirror) = turns[j];
+                    if k == 0 || 2 * k == n {
+                        folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
+                    } else {
+                        folded[k % m] += value * t_k;
+                        folded[(n - k) % m] += value.conj() * t_mirror;
                     }
                 }
-                y[half].im = 0.0;
-                inverse.process(&mut y);
-                let dc = (a0 + b0) * (p.w0 + p.w1);
-                times.iter().map(|&t| y[t].re / n as f64 + dc).collect()
+                inverse.process(&mut folded);
+                let dc: f64 = (a0 + b0) * p.iter().map(|&(_, w)| w).sum::<f64>();
+                local
+                    .iter()
+                    .map(|&t| folded[(t - offset) / fold].re / n as f64 + dc)
+                    .collect()
             })
             .collect()
     }

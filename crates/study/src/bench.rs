@@ -60,6 +60,9 @@ pub struct Bench {
     pub presets: Vec<Row>,
     /// Physics knobs switched one at a time on the `standard` preset, against `standard`.
     pub knobs: Vec<Row>,
+    /// The bars' dispersion (issue 20): each theory at 1 mm and 0.125 mm cells against
+    /// `reference` (the Love-rod chain at 0.125 mm), and against the same theory at 0.125 mm.
+    pub dispersion: Vec<(Row, Row)>,
     /// Memory against bar length (standard preset, fixed run duration, no snapshots), measured
     /// first and in ascending size so the process's high-water mark tracks each run.
     pub memory: Vec<MemoryRow>,
@@ -260,6 +263,28 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
         knobs.push(row(label, t, p.estimate().updates(), &out, &standard));
     }
 
+    progress("dispersion");
+    let mut dispersion = Vec::new();
+    for theory in ["none", "love-rod", "rayleigh-love", "pochhammer-chree"] {
+        let (t_fine, fine) = if theory == "love-rod" {
+            (t_ref, reference.clone())
+        } else {
+            timed(&load(Fidelity::Reference, &[("dispersion", s(theory))])?, 1)?
+        };
+        let coarse_params = load(Fidelity::Standard, &[("dispersion", s(theory))])?;
+        let (t_coarse, coarse) = timed(&coarse_params, repeats)?;
+        let n_coarse = coarse_params.estimate().updates();
+        let label = |cell: &str| format!("`{theory}`, {cell}");
+        dispersion.push((
+            row(&label("1 mm"), t_coarse, n_coarse, &coarse, &reference),
+            row(&label("1 mm"), t_coarse, n_coarse, &coarse, &fine),
+        ));
+        dispersion.push((
+            row(&label("0.125 mm"), t_fine, n_ref, &fine, &reference),
+            row(&label("0.125 mm"), t_fine, n_ref, &fine, &fine),
+        ));
+    }
+
     progress("minimal loops");
     let est = base.estimate();
     let node_step = StepCost {
@@ -283,6 +308,7 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
     Ok(Bench {
         presets,
         knobs,
+        dispersion,
         memory,
         node_step,
         dem_step,
@@ -327,6 +353,23 @@ pub fn markdown(b: &Bench) -> String {
             r.displacement_at_peak_m * 1e6,
             100.0 * r.displacement_error,
             100.0 * r.signal_rms_error
+        ));
+    }
+    t.push_str("\n| bars (dispersion, cell) | run time (ms) | ratio to standard | peak force (kN) | vs reference | δ at peak (µm) | vs reference | gauge signal RMS vs reference | peak vs same theory at 0.125 mm | δ at peak vs same | gauge signal RMS vs same |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (r, own) in &b.dispersion {
+        t.push_str(&format!(
+            "| {} | {:.1} | {:.2} | {:.4} | {:.1e} | {:.3} | {:.1e} | {:.1e} | {:.1e} | {:.1e} | {:.1e} |\n",
+            r.label,
+            r.runtime_s * 1e3,
+            r.runtime_s / t_std,
+            r.peak_force_n * 1e-3,
+            r.peak_error,
+            r.displacement_at_peak_m * 1e6,
+            r.displacement_error,
+            r.signal_rms_error,
+            own.peak_error,
+            own.displacement_error,
+            own.signal_rms_error
         ));
     }
     t.push_str(

@@ -304,6 +304,7 @@ pub fn simulate_chain_with(
         recorders.extend(extra.iter_mut().map(|r| &mut **r as &mut dyn Recorder));
         chain.run(steps, &mut recorders)?;
     }
+    gauges.finish(&chain.bodies);
     if let Some(s) = snapshots.as_mut() {
         s.finish(&chain.bodies);
     }

@@ -42,7 +42,20 @@ pub fn gauge_strain(bar: &Bar, g: &GaugeProbe) -> f64 {
     bar.stretch_between_m(g.x_m - 0.5 * g.length_m, g.x_m + 0.5 * g.length_m) / g.length_m
 }
 
-/// Gauge strains every `every` steps, on a common time axis.
+/// [`gauge_strain`] over the past `steps` of a dispersive delay line, from its histories
+/// ([`Bar::stress_history`]); `None` for any other bar.
+pub fn gauge_strain_history(bar: &Bar, g: &GaugeProbe, steps: &[usize]) -> Option<Vec<f64>> {
+    if g.length_m <= 0.0 {
+        return bar.strain_history(g.x_m, steps);
+    }
+    let stretch =
+        bar.stretch_between_history(g.x_m - 0.5 * g.length_m, g.x_m + 0.5 * g.length_m, steps)?;
+    Some(stretch.into_iter().map(|s| s / g.length_m).collect())
+}
+
+/// Gauge strains every `every` steps, on a common time axis. Gauges on dispersive delay lines
+/// are computed after the run ([`GaugeRecorder::finish`]): with each wave's whole precursor, and
+/// without a convolution per step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GaugeRecorder {
     /// The gauges.
@@ -53,6 +66,8 @@ pub struct GaugeRecorder {
     pub time_s: Vec<f64>,
     /// Strain per gauge (positive in tension), in the order of `gauges`.
     pub strain: Vec<Vec<f64>>,
+    /// Steps recorded.
+    steps: Vec<usize>,
 }
 
 impl GaugeRecorder {
@@ -63,6 +78,18 @@ impl GaugeRecorder {
             gauges,
             every,
             time_s: Vec::with_capacity(capacity),
+            steps: Vec::with_capacity(capacity),
+        }
+    }
+
+    /// Fills the series of the gauges on dispersive delay lines among `bodies` (the same chain,
+    /// after the run), held at zero while it ran.
+    pub fn finish(&mut self, bodies: &[Body]) {
+        for (g, s) in self.gauges.iter().zip(self.strain.iter_mut()) {
+            let bar = bodies[g.bar].as_bar().expect("gauges sit on bars");
+            if let Some(series) = gauge_strain_history(bar, g, &self.steps) {
+                *s = series;
+            }
         }
     }
 }
@@ -73,9 +100,14 @@ impl Recorder for GaugeRecorder {
             return;
         }
         self.time_s.push(time_s);
+        self.steps.push(step);
         for (g, s) in self.gauges.iter().zip(self.strain.iter_mut()) {
             let bar = bodies[g.bar].as_bar().expect("gauges sit on bars");
-            s.push(gauge_strain(bar, g));
+            s.push(if bar.transit_model().is_some() {
+                0.0
+            } else {
+                gauge_strain(bar, g)
+            });
         }
     }
 }
