@@ -85,7 +85,7 @@
 //! run (`solver::chain::CHECK_INTERVAL_STEPS`).
 
 use crate::error::{Error, Named, Result};
-use crate::transit::{StretchPoint, TransitDesign, TransitFilter, TransitModel};
+use crate::transit::{BlockConvolver, StretchPoint, TransitDesign, TransitFilter, TransitModel};
 use std::f64::consts::PI;
 
 /// Largest number of nodes a bar may have (a memory guard: ~100 bytes per node).
@@ -638,6 +638,11 @@ struct Transit {
     delivered_sq: f64,
     /// max |H|² − 1 (≥ 0) of the end-to-end filter as truncated: the most energy it can add.
     ends_gain_excess: f64,
+    /// The end-to-end filter applied in blocks ([`BlockConvolver`]) to the right- and
+    /// left-going histories, when the bar is long enough for blocks; else the direct sum.
+    blocks: Option<Box<[BlockConvolver; 2]>>,
+    /// Steps by which an arrival lags the newest injection it uses: N − lead (≥ 1).
+    lag: usize,
 }
 
 /// A transit filter with its taps oldest first (for a dot product with a history slice).
@@ -668,6 +673,8 @@ impl Transit {
     fn new(design: TransitDesign, n: usize) -> Transit {
         let filter = design.filter(n - 1);
         let ends_gain_excess = (crate::transit::max_power_gain(&filter.taps) - 1.0).max(0.0);
+        let lag = n - filter.lead;
+        let blocks = BlockConvolver::new(&filter.taps, lag).map(|c| Box::new([c.clone(), c]));
         let ends = ReversedFilter::new(filter);
         // Room for the longest filter behind the oldest pure-delay read (interior filters,
         // over fewer cells, are shorter; the slack covers their rounding).
@@ -684,6 +691,8 @@ impl Transit {
             injected_sq: 0.0,
             delivered_sq: 0.0,
             ends_gain_excess,
+            blocks,
+            lag,
         };
         t.injected_right = vec![0.0; offset];
         t.injected_left = vec![0.0; offset];
@@ -706,11 +715,42 @@ impl Transit {
         self.step = 0;
         self.injected_sq = right.iter().chain(left).map(|x| x * x).sum();
         self.delivered_sq = 0.0;
+        if let Some(blocks) = self.blocks.as_mut() {
+            // The windows of the blocks before the first, from the initial field.
+            let b = blocks[0].block();
+            let past = blocks[0].history_blocks();
+            for (c, h) in blocks
+                .iter_mut()
+                .zip([&self.injected_right, &self.injected_left])
+            {
+                c.clear();
+                for k in (1..=past).rev() {
+                    let start = self.offset - self.lag - (k + 1) * b;
+                    c.push(&h[start..start + 2 * b]);
+                }
+            }
+        }
         self.update_arrivals();
     }
 
     /// Arrivals at the current step n: D̃ = Σ h_j A[n − N − j + lead], Ẽ likewise from B.
     fn update_arrivals(&mut self) {
+        if let Some(blocks) = self.blocks.as_mut() {
+            // u[n'] = history[n' + offset − lag]; block k's window is u[kB − B, kB + B).
+            let b = blocks[0].block();
+            let i = self.step % b;
+            if i == 0 {
+                let start = self.step + self.offset - self.lag - b;
+                for (c, h) in blocks
+                    .iter_mut()
+                    .zip([&self.injected_right, &self.injected_left])
+                {
+                    c.process(&h[start..start + 2 * b]);
+                }
+            }
+            self.arrival = [blocks[0].output(i), blocks[1].output(i)];
+            return;
+        }
         let idx = self.step + self.offset - self.elements(); // A[n − N]
         self.arrival = [
             self.ends.apply(&self.injected_right, idx),
