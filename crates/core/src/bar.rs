@@ -1931,6 +1931,24 @@ impl Bar {
     }
 }
 
+/// The largest cell ≤ `at_most_m` that makes every length of `lengths_m` a whole number of cells
+/// (to 1e-9 of a cell), so that bars of one wave speed can all run as (dispersive) delay lines
+/// (docs/physics.md §6.2.1); tries up to four times the cells of the first length at `at_most_m`;
+/// `None` if no such cell is found.
+pub fn delay_line_cell_m(lengths_m: &[f64], at_most_m: f64) -> Option<f64> {
+    let (&first, rest) = lengths_m.split_first()?;
+    if !(first > 0.0 && at_most_m > 0.0) {
+        return None;
+    }
+    let start = ((first / at_most_m) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+    (start..=4 * start).map(|n| first / n as f64).find(|&cell| {
+        rest.iter().all(|&l| {
+            let cells = l / cell;
+            (cells - cells.round()).abs() <= 1e-9 && cells.round() >= 1.0
+        })
+    })
+}
+
 /// Compression-only rigid contact between the right end of `left` and the left end of `right`
 /// (same Δt): the force (N, ≥ 0, compressive) that closes the gap exactly at the end of the
 /// coming step if it would otherwise close, else 0; apply it as `left.step(.., −F)`, `right.step(F, ..)`.
@@ -2222,6 +2240,17 @@ mod tests {
     //! The delay line (module docs, "Delay line") against the leapfrog on every node: the same
     //! discrete solution to rounding, and the same energy identity.
     use super::*;
+
+    /// The authors' bars (1.21, 1.02 and 0.10 m) are whole numbers of 1 mm cells, and of 10/3 mm
+    /// cells but of no cell between 10/3 and 4 mm.
+    #[test]
+    fn delay_line_cells_divide_every_bar() {
+        let bars = [1.21, 1.02, 0.10];
+        assert_eq!(delay_line_cell_m(&bars, 1e-3), Some(1.21 / 1210.0));
+        let fast = delay_line_cell_m(&bars, 4e-3).unwrap();
+        assert!((fast - 1e-2 / 3.0).abs() < 1e-15, "{fast}");
+        assert_eq!(delay_line_cell_m(&[1.0, 0.3333333], 1e-3), None);
+    }
 
     /// Steel, 19.05 mm (the authors' bars).
     fn steel_segment(length_m: f64) -> Segment {

@@ -241,6 +241,21 @@ pub(super) fn parse_bars(
     // cell is refined to it, an explicit one that cannot is refused.
     let cylinder_cell = cylinder.map(|c| c.largest_bar_cell_m(c0, CYLINDER_MIN_CELLS));
     let default_cell = cylinder_cell.map_or(knobs.cell_size_m, |c| c.min(knobs.cell_size_m));
+    // Dispersion on the travelling waves needs bars of whole cells (docs/physics.md §6.2.1):
+    // the preset's cell is refined to the largest that divides every bar (10/3 mm for the
+    // authors' bars at `fast`); an explicit cell that does not is refused by the bars.
+    let default_cell = match dispersion.transit_model() {
+        Some(_) => shpb_core::bar::delay_line_cell_m(
+            &[
+                apparatus.incident.length_m,
+                apparatus.striker.length_m,
+                apparatus.transmission.length_m,
+            ],
+            default_cell,
+        )
+        .unwrap_or(default_cell),
+        None => default_cell,
+    };
     let cell = v.in_range(
         "cell_size_m",
         f.cell_size_m.unwrap_or(default_cell),
