@@ -950,6 +950,9 @@ pub struct Bar {
     /// The energy that has passed through the ledger (|energy| at the last full recomputation plus
     /// every step's |work| and absorbed energy since): the scale of its rounding error, J.
     ledger_turnover_j: f64,
+    /// Σ m v^{n−1/2} of a dispersive delay line, carried by the impulse of each step
+    /// ([`Bar::momentum_kg_m_s`]), kg·m/s.
+    momentum_half: f64,
 }
 
 /// Largest accepted difference between a bar's energy ledger and its full recomputation, relative
@@ -1050,6 +1053,7 @@ impl Bar {
             work_j: 0.0,
             ledger_j: 0.0,
             ledger_turnover_j: 0.0,
+            momentum_half: 0.0,
         };
         let uniform_courant_1 = bar.segments.len() == 1
             && (bar.courant_number(0) - 1.0).abs() <= DELAY_LINE_COURANT_SLACK;
@@ -1175,6 +1179,11 @@ impl Bar {
     fn rebase_energy_ledger(&mut self) {
         self.ledger_j = self.recomputed_energy_j();
         self.ledger_turnover_j = self.ledger_j.abs();
+        if self.transit().is_some() {
+            self.momentum_half = (0..self.mass.len())
+                .map(|i| self.mass[i] * self.half_step_velocity_m_s(i))
+                .sum();
+        }
     }
 
     /// w = A⁻¹ (f_int(u^n) − D v^{n−1/2}): the free velocity change per unit time of the coming step.
@@ -1440,6 +1449,32 @@ impl Bar {
         self.mass[i]
     }
 
+    /// Momentum Σ m v of the nodes at level n, kg·m/s: the sum over the nodes of
+    /// [`Bar::velocity_m_s`]; for a dispersive delay line (whose interior reads cost a
+    /// convolution each) the same quantity from its impulse ledger: Σ m v^{n−1/2} carried by the
+    /// end velocities' changes and the end springs' forces, plus half the coming step's.
+    pub fn momentum_kg_m_s(&self) -> f64 {
+        let last = self.mass.len() - 1;
+        match &self.waves {
+            Some(w) if w.transit.is_some() => {
+                let coming = self.dt_s
+                    * (self.k[last - 1] * w.stretch(last - 1) - self.k[0] * w.stretch(0))
+                    + [0, last]
+                        .iter()
+                        .map(|&i| {
+                            self.mass[i]
+                                * self.dt_s
+                                * (self.w[i] + self.force_response(i, self.last_force))
+                        })
+                        .sum::<f64>();
+                self.momentum_half + 0.5 * coming
+            }
+            _ => (0..=last)
+                .map(|i| self.node_mass_kg(i) * self.velocity_m_s(i))
+                .sum(),
+        }
+    }
+
     /// Sets the whole bar moving rigidly at `v_m_s` (a striker): v^{−1/2} = v, fixed end nodes stay at rest.
     pub fn set_initial_velocity(&mut self, v_m_s: f64) {
         self.v.fill(v_m_s);
@@ -1484,6 +1519,14 @@ impl Bar {
             },
         ];
         let v_before = [self.v[0], self.v[last]];
+        // A dispersive delay line's momentum: the interior nodes change by the springs at the
+        // ends, Δt (k s_{N−1} − k s_0) (every spring force between them cancels).
+        let interior_impulse = match &self.waves {
+            Some(w) if w.transit.is_some() => {
+                dt * (self.k[last - 1] * w.stretch(last - 1) - self.k[0] * w.stretch(0))
+            }
+            _ => 0.0,
+        };
         match &self.love {
             None => {
                 self.w[0] += self.inv_a[0] * f[0];
@@ -1503,6 +1546,11 @@ impl Bar {
             for node in [0, last] {
                 self.v[node] += dt * self.w[node];
                 self.u[node] += dt * self.v[node];
+            }
+            if waves.transit.is_some() {
+                self.momentum_half += interior_impulse
+                    + self.mass[0] * (self.v[0] - v_before[0])
+                    + self.mass[last] * (self.v[last] - v_before[1]);
             }
             waves.advance(dt * self.v[0], dt * self.v[last]);
         } else {

@@ -170,9 +170,7 @@ impl Body {
     /// Momentum Σ m v, kg·m/s (a bar's nodes at level n, a mass at its last half level).
     pub fn momentum_kg_m_s(&self) -> f64 {
         match self {
-            Body::Bar(b) => (0..b.node_count())
-                .map(|i| b.node_mass_kg(i) * b.velocity_m_s(i))
-                .sum(),
+            Body::Bar(b) => b.momentum_kg_m_s(),
             Body::Mass(m) => m.mass_kg * m.velocity_m_s,
         }
     }
