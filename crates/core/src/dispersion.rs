@@ -388,41 +388,16 @@ impl ModeTable {
 /// stopped when an iterate moves by less than 1e-15 of itself (superlinear: about six
 /// evaluations from a narrow bracket, where a stop on the bracket's width would wait for its
 /// far side).
-fn illinois_to_rounding(
-    mut a: f64,
-    mut b: f64,
-    mut ga: f64,
-    mut gb: f64,
-    g: impl Fn(f64) -> f64,
-) -> f64 {
-    let (mut side, mut previous) = (0, f64::NAN);
-    for _ in 0..200 {
-        let mut x = (a * gb - b * ga) / (gb - ga);
-        if !(x > a.min(b) && x < a.max(b)) {
-            x = 0.5 * (a + b);
-        }
-        let gx = g(x);
-        if gx == 0.0 || (x - previous).abs() <= 1e-15 * x.abs() {
-            return x;
-        }
-        previous = x;
-        if gx.signum() == ga.signum() {
-            a = x;
-            ga = gx;
-            if side == -1 {
-                gb *= 0.5;
-            }
-            side = -1;
-        } else {
-            b = x;
-            gb = gx;
-            if side == 1 {
-                ga *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    previous
+fn illinois_to_rounding(a: f64, b: f64, ga: f64, gb: f64, g: impl Fn(f64) -> f64) -> f64 {
+    crate::numeric::illinois_until(
+        a,
+        b,
+        ga,
+        gb,
+        200,
+        |u, previous, _, _| (u - previous).abs() <= 1e-15 * u.abs(),
+        g,
+    )
 }
 
 /// The first-mode root at f a/c0 = `y` next to `previous` (the root at the previous y of a

@@ -101,6 +101,50 @@ pub fn bisect(
     (lo, hi)
 }
 
+/// Root of g on `[lo, hi]` (g(lo) = `g_lo` and g(hi) = `g_hi` of opposite signs) by the plain
+/// Illinois method (Dowell & Jarratt, BIT 11, 168 (1971)): the iterate u = (lo g_hi − hi g_lo)/
+/// (g_hi − g_lo) replaces the end whose g has its sign, and the kept end's g is halved when the
+/// same end moves twice in a row. Returns u as soon as g(u) = 0 or
+/// `stop(u, previous u, lo, hi)` holds (judged on the bracket before u enters it), else the
+/// bracket's midpoint after `max_iter` evaluations. Unlike [`illinois`] it has no bisection
+/// safeguard, so a stop on the iterate's own motion ends the superlinear run without waiting
+/// for the far side of the bracket.
+pub fn illinois_until(
+    mut lo: f64,
+    mut hi: f64,
+    mut g_lo: f64,
+    mut g_hi: f64,
+    max_iter: usize,
+    stop: impl Fn(f64, f64, f64, f64) -> bool,
+    g: impl Fn(f64) -> f64,
+) -> f64 {
+    let (mut side, mut previous) = (0, f64::NAN);
+    for _ in 0..max_iter {
+        let u = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+        let gu = g(u);
+        if gu == 0.0 || stop(u, previous, lo, hi) {
+            return u;
+        }
+        previous = u;
+        if gu.signum() == g_lo.signum() {
+            lo = u;
+            g_lo = gu;
+            if side == -1 {
+                g_hi *= 0.5;
+            }
+            side = -1;
+        } else {
+            hi = u;
+            g_hi = gu;
+            if side == 1 {
+                g_lo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// Root of g on `[lo, hi]` with g(lo) = `g_lo` > 0 ≥ g(hi) = `g_hi` by the Illinois method
 /// (regula falsi that halves the kept end's value when the same end moves twice in a row;
 /// Dowell & Jarratt, BIT 11, 168 (1971)), safeguarded by a bisection step whenever the bracket has

@@ -304,7 +304,7 @@ pub fn solve_approach_speed(law: &dyn Contact, delta: f64, a: f64, b: f64) -> f6
     let u_hi = a - b * force(0.0);
     let f_hi = force(u_hi.max(0.0));
     let u_lo = a - b * f_hi;
-    let (mut lo, mut hi) = (u_lo.min(u_hi), u_lo.max(u_hi));
+    let (lo, hi) = (u_lo.min(u_hi), u_lo.max(u_hi));
     // F(u_hi) is known already when u_hi ≥ 0 (the usual case: F does not fall with the rate, so
     // u_lo ≤ u_hi): the same number, one law evaluation fewer a step.
     let g_at = |u: f64| {
@@ -314,7 +314,7 @@ pub fn solve_approach_speed(law: &dyn Contact, delta: f64, a: f64, b: f64) -> f6
             g(u)
         }
     };
-    let (mut glo, mut ghi) = (g_at(lo), g_at(hi));
+    let (glo, ghi) = (g_at(lo), g_at(hi));
     if glo >= 0.0 {
         return lo;
     }
@@ -322,30 +322,15 @@ pub fn solve_approach_speed(law: &dyn Contact, delta: f64, a: f64, b: f64) -> f6
         return hi;
     }
     // Illinois (modified regula falsi): superlinear, never leaves the bracket.
-    let mut side = 0;
-    for _ in 0..100 {
-        let u = (lo * ghi - hi * glo) / (ghi - glo);
-        let gu = g(u);
-        if gu == 0.0 || (hi - lo) <= 1e-13 * (hi.abs() + lo.abs()) + 1e-18 {
-            return u;
-        }
-        if gu < 0.0 {
-            lo = u;
-            glo = gu;
-            if side == -1 {
-                ghi *= 0.5;
-            }
-            side = -1;
-        } else {
-            hi = u;
-            ghi = gu;
-            if side == 1 {
-                glo *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    0.5 * (lo + hi)
+    crate::numeric::illinois_until(
+        lo,
+        hi,
+        glo,
+        ghi,
+        100,
+        |_, _, lo, hi| (hi - lo) <= 1e-13 * (hi.abs() + lo.abs()) + 1e-18,
+        g,
+    )
 }
 
 /// Time series of the contact, as written to `/contact` (datasets a scene lacks are `None`).
