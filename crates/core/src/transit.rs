@@ -312,6 +312,21 @@ impl TransitDesign {
             |k: usize| Complex64::from_polar(1.0, 2.0 * PI * ((k * offset) % n) as f64 / n as f64);
         let turns: Vec<(Complex64, Complex64)> =
             bins.iter().map(|&k| (turn(k), turn(n - k))).collect();
+        // Inside the bar (both waves weighted by the band, real weights) the value at bin k is
+        // g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h), h the right-going sum: with
+        // its two phase turns folded in, four real products a turn.
+        let inside: Vec<[Complex64; 4]> = (0..bins.len())
+            .map(|j| {
+                let (sum, difference) = ((u[j] + v[j]) * gain[j], (u[j] - v[j]) * gain[j]);
+                let (t_k, t_mirror) = turns[j];
+                [
+                    sum * t_k,
+                    difference * t_k,
+                    sum * t_mirror.conj(),
+                    difference * t_mirror.conj(),
+                ]
+            })
+            .collect();
         let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); bins.len()];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
@@ -342,10 +357,36 @@ impl TransitDesign {
                 pw_element = e0;
                 let ends = p.iter().any(|&(e, _)| e == 0 || e >= last);
                 folded.fill(Complex64::new(0.0, 0.0));
+                // The usual point inside the bar: one element, or two neighbours.
+                let pair = match p.as_slice() {
+                    [(_, w0)] if !ends => Some((*w0, 0.0)),
+                    [(e0, w0), (e1, w1)] if !ends && *e1 == e0 + 1 => Some((*w0, *w1)),
+                    _ => None,
+                };
+                if let Some((w0, w1)) = pair {
+                    for (j, &k) in bins.iter().enumerate() {
+                        let zj = z[j];
+                        let h = pw[j] * Complex64::new(w0 + w1 * zj.re, w1 * zj.im);
+                        let [s1, d1, s2, d2] = inside[j];
+                        let (hr, hi) = (h.re, h.im);
+                        if k == 0 || 2 * k == n {
+                            let value = (u[j] * h + v[j] * h.conj()) * gain[j];
+                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[j].0;
+                        } else {
+                            folded[k % m] +=
+                                Complex64::new(s1.re * hr - d1.im * hi, s1.im * hr + d1.re * hi);
+                            folded[(n - k) % m] +=
+                                Complex64::new(s2.re * hr - d2.im * hi, -(s2.im * hr + d2.re * hi));
+                        }
+                    }
+                }
                 for (j, &k) in bins.iter().enumerate() {
+                    if pair.is_some() {
+                        break;
+                    }
                     let g = gain[j];
-                    let (mut zr, mut h_r, mut h_l) =
-                        (pw[j], Complex64::new(0.0, 0.0), Complex64::new(0.0, 0.0));
+                    let (mut zr, mut h_r) = (pw[j], Complex64::new(0.0, 0.0));
+                    let mut h_l = h_r;
                     let mut at = e0;
                     for &(e, weight) in p {
                         let e = e.min(last);
@@ -362,13 +403,25 @@ impl TransitDesign {
                             h_l += zr.conj() * (gl * weight);
                         } else {
                             h_r += zr * weight;
-                            h_l += zr.conj() * weight;
                         }
                     }
-                    let mut value = u[j] * h_r + v[j] * h_l;
                     if !ends {
-                        value *= g;
+                        // See `inside`: value·t_k and conj(value·conj(t_mirror)).
+                        let [s1, d1, s2, d2] = inside[j];
+                        let (hr, hi) = (h_r.re, h_r.im);
+                        let a = Complex64::new(s1.re * hr - d1.im * hi, s1.im * hr + d1.re * hi);
+                        if k == 0 || 2 * k == n {
+                            let value = (u[j] * h_r + v[j] * h_r.conj()) * g;
+                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[j].0;
+                        } else {
+                            let b =
+                                Complex64::new(s2.re * hr - d2.im * hi, s2.im * hr + d2.re * hi);
+                            folded[k % m] += a;
+                            folded[(n - k) % m] += b.conj();
+                        }
+                        continue;
                     }
+                    let value = u[j] * h_r + v[j] * h_l;
                     let (t_k, t_mirror) = turns[j];
                     if k == 0 || 2 * k == n {
                         folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
