@@ -625,7 +625,10 @@ struct Transit {
     injected_right: Vec<f64>,
     /// Left-going increments B[m] injected at the right end, likewise, m.
     injected_left: Vec<f64>,
+    /// Index of A[0] and B[0] in the histories.
     offset: usize,
+    /// Elements N of the bar.
+    elements: usize,
     /// Steps taken n.
     step: usize,
     /// [D at element N − 1, E at element 0] at the current level: the waves arriving at the ends.
@@ -669,7 +672,7 @@ impl ReversedFilter {
 }
 
 impl Transit {
-    /// The transit of a delay line of `n` elements holding the field of `waves`.
+    /// The transit of a delay line of `n` elements at rest ([`Transit::restart`] takes its field).
     fn new(design: TransitDesign, n: usize) -> Transit {
         let filter = design.filter(n - 1);
         let ends_gain_excess = (crate::transit::max_power_gain(&filter.taps) - 1.0).max(0.0);
@@ -679,12 +682,13 @@ impl Transit {
         // Room for the longest filter behind the oldest pure-delay read (interior filters,
         // over fewer cells, are shorter; the slack covers their rounding).
         let offset = n + 2 * ends.taps.len() + 16;
-        let mut t = Transit {
+        Transit {
             design,
             ends,
-            injected_right: Vec::new(),
-            injected_left: Vec::new(),
+            injected_right: vec![0.0; offset],
+            injected_left: vec![0.0; offset],
             offset,
+            elements: n,
             step: 0,
             arrival: [0.0; 2],
             interior: Default::default(),
@@ -693,10 +697,7 @@ impl Transit {
             ends_gain_excess,
             blocks,
             lag,
-        };
-        t.injected_right = vec![0.0; offset];
-        t.injected_left = vec![0.0; offset];
-        t
+        }
     }
 
     /// Restarts the histories from the field of ring buffers at step 0 (A[m] = D_{−m−1},
@@ -751,16 +752,11 @@ impl Transit {
             self.arrival = [blocks[0].output(i), blocks[1].output(i)];
             return;
         }
-        let idx = self.step + self.offset - self.elements(); // A[n − N]
+        let idx = self.step + self.offset - self.elements; // A[n − N]
         self.arrival = [
             self.ends.apply(&self.injected_right, idx),
             self.ends.apply(&self.injected_left, idx),
         ];
-    }
-
-    /// N, from the histories' layout.
-    fn elements(&self) -> usize {
-        self.offset - 2 * self.ends.taps.len() - 16
     }
 
     /// Records the increments injected at step n and moves to n + 1.
@@ -793,7 +789,7 @@ impl Transit {
 
     /// Left-going increment at element e (0 < e < N − 1): B[n − (N − e)] carried over N − 1 − e cells.
     fn left_at(&self, e: usize) -> f64 {
-        let n = self.elements();
+        let n = self.elements;
         let f = self.interior(n - 1 - e);
         f.apply(&self.injected_left, self.step + self.offset - (n - e))
     }

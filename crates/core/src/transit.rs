@@ -285,14 +285,13 @@ impl TransitDesign {
         let (fa, fb) = (spectrum(right, a0), spectrum(left, b0));
         let half = n / 2;
         let last = elements - 1;
-        let bins: Vec<usize> = (0..=half).collect();
-        // Per bin (0..=n/2): z = e^{−i(Ω + φ)} (one cell), the band's weight, and the history
+        // Per bin k = 0..=n/2: z = e^{−i(Ω + φ)} (one cell), the band's weight, and the history
         // spectra times the one-step delay (the left one carried over the whole bar, z^{N−1}).
-        let mut z = Vec::with_capacity(bins.len());
-        let mut gain = Vec::with_capacity(bins.len());
-        let mut u = Vec::with_capacity(bins.len());
-        let mut v = Vec::with_capacity(bins.len());
-        for &k in &bins {
+        let mut z = Vec::with_capacity(half + 1);
+        let mut gain = Vec::with_capacity(half + 1);
+        let mut u = Vec::with_capacity(half + 1);
+        let mut v = Vec::with_capacity(half + 1);
+        for k in 0..=half {
             let w = 2.0 * PI * k as f64 / n as f64;
             let (phi, g) = self.phase_and_gain(w);
             let zk = Complex64::from_polar(1.0, -(w + phi));
@@ -311,14 +310,14 @@ impl TransitDesign {
         let turn =
             |k: usize| Complex64::from_polar(1.0, 2.0 * PI * ((k * offset) % n) as f64 / n as f64);
         let turns: Vec<(Complex64, Complex64)> =
-            bins.iter().map(|&k| (turn(k), turn(n - k))).collect();
+            (0..=half).map(|k| (turn(k), turn(n - k))).collect();
         // Inside the bar (both waves weighted by the band, real weights) the value at bin k is
         // g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h), h the right-going sum: with
         // its two phase turns folded in, four real products a turn.
-        let inside: Vec<[Complex64; 4]> = (0..bins.len())
-            .map(|j| {
-                let (sum, difference) = ((u[j] + v[j]) * gain[j], (u[j] - v[j]) * gain[j]);
-                let (t_k, t_mirror) = turns[j];
+        let inside: Vec<[Complex64; 4]> = (0..=half)
+            .map(|k| {
+                let (sum, difference) = ((u[k] + v[k]) * gain[k], (u[k] - v[k]) * gain[k]);
+                let (t_k, t_mirror) = turns[k];
                 [
                     sum * t_k,
                     difference * t_k,
@@ -327,7 +326,7 @@ impl TransitDesign {
                 ]
             })
             .collect();
-        let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); bins.len()];
+        let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
         let mut folded = vec![Complex64::new(0.0, 0.0); m];
@@ -363,71 +362,63 @@ impl TransitDesign {
                     [(e0, w0), (e1, w1)] if !ends && *e1 == e0 + 1 => Some((*w0, *w1)),
                     _ => None,
                 };
-                if let Some((w0, w1)) = pair {
-                    for (j, &k) in bins.iter().enumerate() {
-                        let zj = z[j];
-                        let h = pw[j] * Complex64::new(w0 + w1 * zj.re, w1 * zj.im);
-                        let [s1, d1, s2, d2] = inside[j];
-                        let (hr, hi) = (h.re, h.im);
-                        if k == 0 || 2 * k == n {
-                            let value = (u[j] * h + v[j] * h.conj()) * gain[j];
-                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[j].0;
-                        } else {
+                for k in 0..=half {
+                    let g = gain[k];
+                    // The right-going sum h_r and, at the ends, the left-going one h_l.
+                    let (h_r, h_l) = match pair {
+                        Some((w0, w1)) => {
+                            let zk = z[k];
+                            (pw[k] * Complex64::new(w0 + w1 * zk.re, w1 * zk.im), None)
+                        }
+                        None => {
+                            let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
+                            let mut h_l = h_r;
+                            let mut at = e0;
+                            for &(e, weight) in p {
+                                let e = e.min(last);
+                                while at < e {
+                                    zr *= z[k];
+                                    at += 1;
+                                }
+                                // R_e: dispersion over e cells (none for e = 0); L_e: over
+                                // N − 1 − e (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
+                                if ends {
+                                    let gr = if e == 0 { 1.0 } else { g };
+                                    let gl = if e == last { 1.0 } else { g };
+                                    h_r += zr * (gr * weight);
+                                    h_l += zr.conj() * (gl * weight);
+                                } else {
+                                    h_r += zr * weight;
+                                }
+                            }
+                            (h_r, ends.then_some(h_l))
+                        }
+                    };
+                    let nyquist_or_dc = k == 0 || 2 * k == n;
+                    match h_l {
+                        // Inside the bar, see `inside`: value·t_k and conj(value·conj(t_mirror)).
+                        None if !nyquist_or_dc => {
+                            let [s1, d1, s2, d2] = inside[k];
+                            let (hr, hi) = (h_r.re, h_r.im);
                             folded[k % m] +=
                                 Complex64::new(s1.re * hr - d1.im * hi, s1.im * hr + d1.re * hi);
                             folded[(n - k) % m] +=
                                 Complex64::new(s2.re * hr - d2.im * hi, -(s2.im * hr + d2.re * hi));
                         }
-                    }
-                }
-                for (j, &k) in bins.iter().enumerate() {
-                    if pair.is_some() {
-                        break;
-                    }
-                    let g = gain[j];
-                    let (mut zr, mut h_r) = (pw[j], Complex64::new(0.0, 0.0));
-                    let mut h_l = h_r;
-                    let mut at = e0;
-                    for &(e, weight) in p {
-                        let e = e.min(last);
-                        while at < e {
-                            zr *= z[j];
-                            at += 1;
+                        None => {
+                            let value = (u[k] * h_r + v[k] * h_r.conj()) * g;
+                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
                         }
-                        // R_e: dispersion over e cells (none for e = 0); L_e: over N − 1 − e
-                        // (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
-                        if ends {
-                            let gr = if e == 0 { 1.0 } else { g };
-                            let gl = if e == last { 1.0 } else { g };
-                            h_r += zr * (gr * weight);
-                            h_l += zr.conj() * (gl * weight);
-                        } else {
-                            h_r += zr * weight;
+                        Some(h_l) => {
+                            let value = u[k] * h_r + v[k] * h_l;
+                            let (t_k, t_mirror) = turns[k];
+                            if nyquist_or_dc {
+                                folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
+                            } else {
+                                folded[k % m] += value * t_k;
+                                folded[(n - k) % m] += value.conj() * t_mirror;
+                            }
                         }
-                    }
-                    if !ends {
-                        // See `inside`: value·t_k and conj(value·conj(t_mirror)).
-                        let [s1, d1, s2, d2] = inside[j];
-                        let (hr, hi) = (h_r.re, h_r.im);
-                        let a = Complex64::new(s1.re * hr - d1.im * hi, s1.im * hr + d1.re * hi);
-                        if k == 0 || 2 * k == n {
-                            let value = (u[j] * h_r + v[j] * h_r.conj()) * g;
-                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[j].0;
-                        } else {
-                            let b =
-                                Complex64::new(s2.re * hr - d2.im * hi, s2.im * hr + d2.re * hi);
-                            folded[k % m] += a;
-                            folded[(n - k) % m] += b.conj();
-                        }
-                        continue;
-                    }
-                    let value = u[j] * h_r + v[j] * h_l;
-                    let (t_k, t_mirror) = turns[j];
-                    if k == 0 || 2 * k == n {
-                        folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
-                    } else {
-                        folded[k % m] += value * t_k;
-                        folded[(n - k) % m] += value.conj() * t_mirror;
                     }
                 }
                 inverse.process(&mut folded);
