@@ -602,7 +602,7 @@ pub fn sweep_shard_rows(
     jobs: usize,
 ) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
     crate::sweep::require_scene(scene)?;
-    let (k, n) = crate::sweep::parse_shard(&format!("{k}/{n}"))?;
+    let (k, n) = crate::sweep::check_shard(k, n)?;
     let axes = crate::sweep::parse_axes(set)?;
     // Before anything is allocated: can the sweep finish on this machine? (as `shpb sweep`)
     crate::sweep::estimate(&axes, (k, n), crate::sweep::Outputs::default())

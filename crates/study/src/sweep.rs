@@ -211,23 +211,32 @@ pub fn shard(points: Vec<Point>, k: usize, n: usize) -> Vec<Point> {
         .collect()
 }
 
-/// Parses `--shard k/n`.
+/// Parses `--shard k/n` ([`check_shard`]).
 pub fn parse_shard(text: &str) -> Result<(usize, usize)> {
-    let err = || Error::Input {
+    let (k, n) = text.split_once('/').ok_or_else(|| shard_error(text))?;
+    match (k.trim().parse(), n.trim().parse()) {
+        (Ok(k), Ok(n)) => check_shard(k, n).map_err(|_| shard_error(text)),
+        _ => Err(shard_error(text)),
+    }
+}
+
+/// Checks a shard `k` of `n` given as numbers (Python, Dask): 1 ≤ k ≤ n, else the error
+/// `--shard k/n` gets.
+pub fn check_shard(k: usize, n: usize) -> Result<(usize, usize)> {
+    if k == 0 || n == 0 || k > n {
+        return Err(shard_error(&format!("{k}/{n}")));
+    }
+    Ok((k, n))
+}
+
+/// The error of a shard outside 1 ≤ k ≤ n, quoting it as written.
+fn shard_error(text: &str) -> Error {
+    Error::Input {
         file: "command line".into(),
         key: "--shard".into(),
         problem: format!("`{text}`"),
         allowed: "k/n with 1 ≤ k ≤ n, e.g. 2/4".into(),
-    };
-    let (k, n) = text.split_once('/').ok_or_else(err)?;
-    let (k, n): (usize, usize) = (
-        k.trim().parse().map_err(|_| err())?,
-        n.trim().parse().map_err(|_| err())?,
-    );
-    if k == 0 || n == 0 || k > n {
-        return Err(err());
     }
-    Ok((k, n))
 }
 
 /// The summary of one run.

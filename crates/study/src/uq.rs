@@ -550,7 +550,7 @@ pub fn study_shard_rows(
     (k, m): (usize, usize),
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Study> {
-    let (k, m) = crate::sweep::parse_shard(&format!("{k}/{m}"))?;
+    let (k, m) = crate::sweep::check_shard(k, m)?;
     let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
     let pool = crate::sweep::thread_pool(jobs)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
