@@ -1,6 +1,7 @@
 //! The exact first longitudinal mode of a solid elastic cylinder (Pochhammer 1876, Chree 1889;
 //! docs/physics.md §7.9): its phase velocity c(f) for any Poisson's ratio 0 < ν < 0.5, the
-//! Tyas–Pope amplitude factors M1 and M2, and a per-FFT-bin cache for the reduction.
+//! Tyas–Pope amplitude factors M1 and M2, and the mode tabulated once per ν ([`ModeTable`]) for
+//! the reduction's FFT bins and the dispersive delay lines.
 //!
 //! # The frequency equation
 //!
@@ -34,7 +35,6 @@
 //! 0.005 (the next root, on the second branch, is never closer than cT − cR ≥ 0.025 c0 for
 //! 0 < ν < 0.5) and bisects the first sign change to 1e-14.
 
-use std::cell::RefCell;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -254,26 +254,6 @@ fn first_root(lo: f64, g: impl Fn(f64) -> f64) -> f64 {
     1.0
 }
 
-/// The first-mode root at f a/c0 = `y` refined to rounding by the Illinois method inside ±1e-6
-/// of `hint` (the table's value, good to 1e-10), or by [`velocity_ratio_at_normalised_frequency`]'s
-/// scan if the root is not there: the same root in about 6 evaluations instead of about 150.
-fn velocity_ratio_near(poisson_ratio: f64, y: f64, hint: f64) -> f64 {
-    let w = y.abs();
-    if w < LONG_WAVE_LIMIT {
-        return velocity_ratio_at_normalised_frequency(poisson_ratio, w);
-    }
-    let g = |x: f64| frequency_function(poisson_ratio, 2.0 * PI * w / x, x);
-    let (a, b) = (hint - 1e-6, (hint + 1e-6).min(1.0));
-    let (ga, gb) = (g(a), g(b));
-    if ga == 0.0 {
-        return a;
-    }
-    if ga.signum() == gb.signum() {
-        return velocity_ratio_at_normalised_frequency(poisson_ratio, w);
-    }
-    illinois_to_rounding(a, b, ga, gb, g)
-}
-
 /// Below this a/Λ (or f a/c0) the solver uses Rayleigh's long-wave limit
 /// `c/c0 = 1 − ν²π²(a/Λ)²` (the Rayleigh–Love rod, docs/physics.md §6.3), whose error is
 /// O((a/Λ)⁴) < 1e-16.
@@ -467,18 +447,16 @@ pub fn mode_table(poisson_ratio: f64) -> Arc<ModeTable> {
     table
 }
 
-/// The first Pochhammer–Chree mode of one bar, with its phase velocity memoised per FFT bin
-/// (the reduction evaluates the same bins for every window; docs/physics.md §7.9).
+/// The first Pochhammer–Chree mode of one bar; the reduction's FFT bins read its phase velocity
+/// from the process-wide table ([`mode_table`]; docs/physics.md §7.9).
 #[derive(Debug, Clone)]
 pub struct PochhammerChree {
     poisson_ratio: f64,
     radius_m: f64,
     c0_m_s: f64,
     rayleigh_ratio: f64,
-    /// The mode tabulated (the start of each root's search).
+    /// The mode tabulated (within 4.6e-11 of the exact root).
     table: Arc<ModeTable>,
-    /// (FFT length, bin index, step bits) → c/c0.
-    cache: RefCell<HashMap<(usize, usize, u64), f64>>,
 }
 
 impl PochhammerChree {
@@ -510,7 +488,6 @@ impl PochhammerChree {
             c0_m_s,
             rayleigh_ratio: rayleigh_velocity_ratio(poisson_ratio),
             table: mode_table(poisson_ratio),
-            cache: RefCell::new(HashMap::new()),
         })
     }
 
@@ -538,37 +515,27 @@ impl PochhammerChree {
     }
 
     /// c/c0 for bin `bin` (|k|, 0..=n/2) of an `n`-point FFT at step `dt_s`, f = bin/(n dt),
-    /// memoised.
+    /// from the table (within 4.6e-11 of the exact root; the values the dispersive delay lines
+    /// use).
     pub fn velocity_ratio_for_bin(&self, bin: usize, n: usize, dt_s: f64) -> f64 {
-        let key = (n, bin, dt_s.to_bits());
-        if let Some(&x) = self.cache.borrow().get(&key) {
-            return x;
-        }
-        let y = bin as f64 / (n as f64 * dt_s) * self.radius_m / self.c0_m_s;
-        let x = velocity_ratio_near(self.poisson_ratio, y, self.table.ratio(y));
-        self.cache.borrow_mut().insert(key, x);
-        x
+        self.table
+            .ratio(bin as f64 / (n as f64 * dt_s) * self.radius_m / self.c0_m_s)
     }
 
     /// Extra travel time over `distance_m` beyond `distance/c0` for bin `bin` of an `n`-point FFT
-    /// at step `dt_s`: `Δx (1/c(f) − 1/c0)`, s (memoised root).
+    /// at step `dt_s`: `Δx (1/c(f) − 1/c0)`, s (tabulated mode).
     pub fn delay_for_bin_s(&self, bin: usize, n: usize, dt_s: f64, distance_m: f64) -> f64 {
         let x = self.velocity_ratio_for_bin(bin, n, dt_s);
         distance_m / self.c0_m_s * (1.0 / x - 1.0)
     }
 
     /// Tyas–Pope amplitude factor M1·M2 (mean axial stress over E times the surface strain) for
-    /// bin `bin` of an `n`-point FFT at step `dt_s` (memoised root).
+    /// bin `bin` of an `n`-point FFT at step `dt_s` (tabulated mode).
     pub fn tyas_pope_factor_for_bin(&self, bin: usize, n: usize, dt_s: f64) -> f64 {
         let x = self.velocity_ratio_for_bin(bin, n, dt_s);
         let f = bin as f64 / (n as f64 * dt_s);
         let a_over_lambda = self.radius_m * f / (x * self.c0_m_s);
         tyas_pope_m1(self.poisson_ratio, a_over_lambda, x) * tyas_pope_m2(x)
-    }
-
-    /// Number of distinct bins solved so far.
-    pub fn cached_bins(&self) -> usize {
-        self.cache.borrow().len()
     }
 }
 
@@ -759,22 +726,26 @@ mod tests {
     }
 
     #[test]
-    fn bins_are_solved_once() {
+    fn bin_delays_are_the_exact_modes() {
         let pc = PochhammerChree::new(0.31, 9.525e-3, 4865.5).unwrap();
         let (n, dt) = (1024, 1e-7);
-        let first: Vec<f64> = (0..=n / 2)
+        let delays: Vec<f64> = (0..=n / 2)
             .map(|k| pc.delay_for_bin_s(k, n, dt, 0.64))
             .collect();
-        assert_eq!(pc.cached_bins(), n / 2 + 1);
-        let again: Vec<f64> = (0..=n / 2)
-            .map(|k| pc.delay_for_bin_s(k, n, dt, 0.64))
-            .collect();
-        assert_eq!(pc.cached_bins(), n / 2 + 1);
-        assert_eq!(first, again);
-        assert_eq!(first[0], 0.0);
+        assert_eq!(delays[0], 0.0);
+        // The table's values are the exact roots to 1e-10 (the test above), so the delays over
+        // 0.64 m are the exact ones to (0.64 m / c0)·1e-10/(c/c0)² ≤ 3e-14 s (c ≥ 0.57 c0).
+        for k in (1..=n / 2).step_by(7) {
+            let exact = 0.64 / 4865.5 * (1.0 / pc.velocity_ratio(k as f64 / (n as f64 * dt)) - 1.0);
+            assert!(
+                (delays[k] - exact).abs() < 3e-14,
+                "bin {k}: {} vs {exact}",
+                delays[k]
+            );
+        }
         // Every delay lies between 0 and the one of the slowest component (≥ 0.95 cR).
         let slowest = 0.64 / 4865.5 * (1.0 / (0.95 * pc.rayleigh_ratio()) - 1.0);
-        assert!(first.iter().all(|&d| (0.0..slowest).contains(&d)));
+        assert!(delays.iter().all(|&d| (0.0..slowest).contains(&d)));
         let e = PochhammerChree::new(0.5, 9.525e-3, 4865.5).unwrap_err();
         assert!(e.to_string().contains("poisson_ratio"), "{e}");
         assert!(e.to_string().contains("less than 0.5"), "{e}");
