@@ -87,6 +87,7 @@
 use crate::error::{Error, Named, Result};
 use crate::transit::{BlockConvolver, StretchPoint, TransitDesign, TransitFilter, TransitModel};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Largest number of nodes a bar may have (a memory guard: ~100 bytes per node).
 pub const MAX_NODES: usize = 20_000_000;
@@ -617,7 +618,8 @@ struct Waves {
 /// line"): every increment injected, and the transit filters that read them.
 #[derive(Debug, Clone)]
 struct Transit {
-    design: TransitDesign,
+    /// The design, shared with every bar like this one ([`crate::transit::shared_design`]).
+    design: Arc<TransitDesign>,
     /// The end-to-end filter (N − 1 cells), taps oldest first.
     ends: ReversedFilter,
     /// Right-going increments A[m] injected at the left end at step m, at index m + offset
@@ -673,9 +675,10 @@ impl ReversedFilter {
 
 impl Transit {
     /// The transit of a delay line of `n` elements at rest ([`Transit::restart`] takes its field).
-    fn new(design: TransitDesign, n: usize) -> Transit {
-        let filter = design.filter(n - 1);
-        let ends_gain_excess = (crate::transit::max_power_gain(&filter.taps) - 1.0).max(0.0);
+    fn new(design: Arc<TransitDesign>, n: usize) -> Transit {
+        let shared = design.shared_filter(n - 1);
+        let ends_gain_excess = (shared.max_power_gain() - 1.0).max(0.0);
+        let filter = shared.filter.clone();
         let lag = n - filter.lead;
         let blocks = BlockConvolver::new(&filter.taps, lag).map(|c| Box::new([c.clone(), c]));
         let ends = ReversedFilter::new(filter);
@@ -774,7 +777,9 @@ impl Transit {
         if let Some(f) = self.interior.borrow().get(&cells) {
             return std::sync::Arc::clone(f);
         }
-        let f = std::sync::Arc::new(ReversedFilter::new(self.design.filter(cells)));
+        let f = Arc::new(ReversedFilter::new(
+            self.design.shared_filter(cells).filter.clone(),
+        ));
         self.interior
             .borrow_mut()
             .insert(cells, std::sync::Arc::clone(&f));
@@ -1086,7 +1091,7 @@ impl Bar {
                 ));
             };
             let seg = &spec.segments[0];
-            let design = TransitDesign::new(
+            let design = crate::transit::shared_design(
                 model,
                 seg.material.poisson_ratio,
                 0.5 * seg.diameter_m,
@@ -2087,7 +2092,8 @@ pub fn scheme_wavenumber_rad_m(
 ) -> f64 {
     if let Some(model) = dispersion.transit_model() {
         // The grid at Courant 1 carries Ω = ωΔt exactly; the transit adds φ(Ω) a cell.
-        let design = TransitDesign::new(model, material.poisson_ratio, 0.5 * diameter_m, cell_m, 1);
+        let design =
+            TransitDesign::relation(model, material.poisson_ratio, 0.5 * diameter_m, cell_m);
         let w = angular_frequency_rad_s * dt_s;
         return (w + design.phase_and_gain(w).0) / cell_m;
     }

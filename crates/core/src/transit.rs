@@ -29,8 +29,9 @@
 use crate::dispersion::{ModeTable, mode_table};
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex64;
+use std::collections::HashMap;
 use std::f64::consts::PI;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Largest share of a transit filter's impulse-response energy left out by truncation, on
 /// either side (module docs): 1e-16 of the energy is 1e-8 of the amplitude, below the
@@ -47,7 +48,7 @@ pub enum TransitModel {
 }
 
 /// The residual phase per cell of one bar on an FFT grid, and the band it passes (module docs).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct TransitDesign {
     model: TransitModel,
     poisson_ratio: f64,
@@ -60,6 +61,67 @@ pub struct TransitDesign {
     /// Weight of each bin in one transit: 1 in the pass band, a smooth step to 0 across the
     /// taper (module docs, "Band").
     gain: Vec<f64>,
+    /// Filters designed so far, by cells ([`TransitDesign::shared_filter`]).
+    filters: Mutex<HashMap<usize, Arc<SharedFilter>>>,
+}
+
+/// A transit filter kept by its design, with its largest power gain worked out once.
+#[derive(Debug)]
+pub struct SharedFilter {
+    /// The filter.
+    pub filter: TransitFilter,
+    power_gain: OnceLock<f64>,
+}
+
+impl SharedFilter {
+    /// max |H|² of the filter as truncated ([`max_power_gain`]).
+    pub fn max_power_gain(&self) -> f64 {
+        *self
+            .power_gain
+            .get_or_init(|| max_power_gain(&self.filter.taps))
+    }
+}
+
+/// Most designs kept by [`shared_design`] (a guard for sweeps over many grids: the cache starts
+/// afresh when full).
+const SHARED_DESIGNS: usize = 64;
+
+/// The design of [`TransitDesign::new`], shared by every bar of the same model, Poisson's ratio,
+/// a/Δx and FFT length in the process (the input's checks and the run build the same bars, a
+/// sweep builds them again for every point): identical to a fresh one, filters included.
+pub fn shared_design(
+    model: TransitModel,
+    poisson_ratio: f64,
+    radius_m: f64,
+    cell_m: f64,
+    max_cells: usize,
+) -> Arc<TransitDesign> {
+    type Key = (TransitModel, u64, u64, usize);
+    static DESIGNS: OnceLock<Mutex<HashMap<Key, Arc<TransitDesign>>>> = OnceLock::new();
+    let relation = TransitDesign::relation(model, poisson_ratio, radius_m, cell_m);
+    let key = (
+        model,
+        poisson_ratio.to_bits(),
+        relation.radius_cells.to_bits(),
+        TransitDesign::fft_length(model, poisson_ratio, radius_m, cell_m, max_cells),
+    );
+    let designs = DESIGNS.get_or_init(|| Mutex::new(HashMap::new()));
+    if let Some(d) = designs.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return Arc::clone(d);
+    }
+    let design = Arc::new(TransitDesign::new(
+        model,
+        poisson_ratio,
+        radius_m,
+        cell_m,
+        max_cells,
+    ));
+    let mut designs = designs.lock().unwrap_or_else(|e| e.into_inner());
+    if designs.len() >= SHARED_DESIGNS {
+        designs.clear();
+    }
+    designs.insert(key, Arc::clone(&design));
+    design
 }
 
 /// The impulse response of the transit over some cells: `taps[j]` weighs the wave injected
@@ -89,7 +151,8 @@ fn taper(w: f64, a: f64, b: f64) -> f64 {
 
 impl TransitDesign {
     /// The design for a bar of Poisson's ratio `poisson_ratio`, radius `radius_m` and cells
-    /// `cell_m` (= c0 Δt) whose filters reach up to `max_cells` cells.
+    /// `cell_m` (= c0 Δt) whose filters reach up to `max_cells` cells ([`shared_design`] keeps
+    /// one per process).
     pub fn new(
         model: TransitModel,
         poisson_ratio: f64,
@@ -97,6 +160,41 @@ impl TransitDesign {
         cell_m: f64,
         max_cells: usize,
     ) -> TransitDesign {
+        let mut design = TransitDesign::relation(model, poisson_ratio, radius_m, cell_m);
+        design.n_fft = TransitDesign::fft_length(model, poisson_ratio, radius_m, cell_m, max_cells);
+        (design.phase, design.gain) = (0..=design.n_fft / 2)
+            .map(|k| design.phase_and_gain(2.0 * PI * k as f64 / design.n_fft as f64))
+            .unzip();
+        design
+    }
+
+    /// The relation alone (for [`TransitDesign::phase_and_gain`]): no FFT grid, no filters.
+    pub fn relation(
+        model: TransitModel,
+        poisson_ratio: f64,
+        radius_m: f64,
+        cell_m: f64,
+    ) -> TransitDesign {
+        TransitDesign {
+            model,
+            poisson_ratio,
+            radius_cells: radius_m / cell_m,
+            table: (model == TransitModel::PochhammerChree).then(|| mode_table(poisson_ratio)),
+            n_fft: 0,
+            phase: Vec::new(),
+            gain: Vec::new(),
+            filters: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// FFT length of the design's grid for filters up to `max_cells` cells.
+    fn fft_length(
+        model: TransitModel,
+        poisson_ratio: f64,
+        radius_m: f64,
+        cell_m: f64,
+        max_cells: usize,
+    ) -> usize {
         // The slowest group velocity passed is 0.38 c0 (Pochhammer–Chree, ν ≤ 0.5) or 0.29 c0
         // (Rayleigh–Love at the end of its taper): at most 2.5 steps a cell beyond the delay.
         // The band's smooth step of width w (rad) adds tails on both sides that fall as
@@ -110,22 +208,7 @@ impl TransitDesign {
         // Twice that, for the tails the 1e-16 cut still reaches (the tabulated mode's
         // interpolation leaves its phase C⁰ at the nodes: algebraic tails near 1e-8).
         let span = (2.0 * (5.0 * max_cells as f64 + 400.0 / width)) as usize + 4096;
-        let n_fft = span.next_power_of_two().max(1024);
-        let half = n_fft / 2;
-        let table = (model == TransitModel::PochhammerChree).then(|| mode_table(poisson_ratio));
-        let mut design = TransitDesign {
-            model,
-            poisson_ratio,
-            radius_cells: radius_m / cell_m,
-            table,
-            n_fft,
-            phase: Vec::new(),
-            gain: Vec::new(),
-        };
-        (design.phase, design.gain) = (0..=half)
-            .map(|k| design.phase_and_gain(2.0 * PI * k as f64 / n_fft as f64))
-            .unzip();
-        design
+        span.next_power_of_two().max(1024)
     }
 
     /// Residual phase per cell φ(Ω) (rad) and the band's weight at Ω = ωΔt ∈ [0, π] (module docs).
@@ -210,6 +293,27 @@ impl TransitDesign {
             }
         }
         TransitFilter { lead, taps }
+    }
+
+    /// [`TransitDesign::filter`] over `cells` cells, designed once per design.
+    pub fn shared_filter(&self, cells: usize) -> Arc<SharedFilter> {
+        if let Some(f) = self
+            .filters
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&cells)
+        {
+            return Arc::clone(f);
+        }
+        let f = Arc::new(SharedFilter {
+            filter: self.filter(cells),
+            power_gain: OnceLock::new(),
+        });
+        self.filters
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(cells, Arc::clone(&f));
+        f
     }
 }
 
@@ -326,10 +430,14 @@ impl TransitDesign {
                 ]
             })
             .collect();
+        // The same, as separate real arrays over the bins 1..half (neither DC nor Nyquist) for
+        // the usual point inside the bar ([`InteriorBins`]).
+        let interior = InteriorBins::new(&inside, &z, half);
         let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
         let mut folded = vec![Complex64::new(0.0, 0.0); m];
+        let mut sums = FoldSums::new(m);
         points
             .iter()
             .map(|p| {
@@ -337,67 +445,80 @@ impl TransitDesign {
                     return vec![0.0; times.len()];
                 };
                 let e0 = first.min(last);
-                if e0 >= pw_element {
-                    // z^Δ for this stride, kept while points come at the same spacing.
-                    let stride = e0 - pw_element;
-                    if stride > 0 {
-                        if stride != z_stride.0 {
-                            z_stride = (stride, z.iter().map(|c| c.powu(stride as u32)).collect());
-                        }
-                        for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
-                            *c *= zk;
-                        }
-                    }
-                } else {
-                    for (c, zk) in pw.iter_mut().zip(&z) {
-                        *c = zk.powu(e0 as u32);
-                    }
-                }
-                pw_element = e0;
                 let ends = p.iter().any(|&(e, _)| e == 0 || e >= last);
-                folded.fill(Complex64::new(0.0, 0.0));
                 // The usual point inside the bar: one element, or two neighbours.
                 let pair = match p.as_slice() {
                     [(_, w0)] if !ends => Some((*w0, 0.0)),
                     [(e0, w0), (e1, w1)] if !ends && *e1 == e0 + 1 => Some((*w0, *w1)),
                     _ => None,
                 };
+                // z^Δ for this stride, kept while points come at the same spacing.
+                let stride = e0.checked_sub(pw_element).filter(|&s| s > 0);
+                if let Some(stride) = stride
+                    && stride != z_stride.0
+                {
+                    z_stride = (stride, z.iter().map(|c| c.powu(stride as u32)).collect());
+                }
+                if e0 < pw_element {
+                    for (c, zk) in pw.iter_mut().zip(&z) {
+                        *c = zk.powu(e0 as u32);
+                    }
+                }
+                pw_element = e0;
+                folded.fill(Complex64::new(0.0, 0.0));
+                if let Some((w0, w1)) = pair {
+                    // Bins 1..half in one pass (advancing z^e by the stride on the way), then DC
+                    // and Nyquist.
+                    let step = stride.map(|_| z_stride.1.as_slice());
+                    sums.interior(&interior, &mut pw, step, (w0, w1), m);
+                    sums.add_to(&mut folded);
+                    for k in [0, half] {
+                        let h_r = pw[k] * Complex64::new(w0 + w1 * z[k].re, w1 * z[k].im);
+                        let value = (u[k] * h_r + v[k] * h_r.conj()) * gain[k];
+                        folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
+                    }
+                    inverse.process(&mut folded);
+                    let dc: f64 = (a0 + b0) * (w0 + w1);
+                    return local
+                        .iter()
+                        .map(|&t| folded[(t - offset) / fold].re / n as f64 + dc)
+                        .collect();
+                }
+                if stride.is_some() {
+                    for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
+                        *c *= zk;
+                    }
+                }
                 for k in 0..=half {
                     let g = gain[k];
                     // The right-going sum h_r and, at the ends, the left-going one h_l.
-                    let (h_r, h_l) = match pair {
-                        Some((w0, w1)) => {
-                            let zk = z[k];
-                            (pw[k] * Complex64::new(w0 + w1 * zk.re, w1 * zk.im), None)
+                    let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
+                    let mut h_l = h_r;
+                    let mut at = e0;
+                    for &(e, weight) in p {
+                        let e = e.min(last);
+                        while at < e {
+                            zr *= z[k];
+                            at += 1;
                         }
-                        None => {
-                            let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
-                            let mut h_l = h_r;
-                            let mut at = e0;
-                            for &(e, weight) in p {
-                                let e = e.min(last);
-                                while at < e {
-                                    zr *= z[k];
-                                    at += 1;
-                                }
-                                // R_e: dispersion over e cells (none for e = 0); L_e: over
-                                // N − 1 − e (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
-                                if ends {
-                                    let gr = if e == 0 { 1.0 } else { g };
-                                    let gl = if e == last { 1.0 } else { g };
-                                    h_r += zr * (gr * weight);
-                                    h_l += zr.conj() * (gl * weight);
-                                } else {
-                                    h_r += zr * weight;
-                                }
-                            }
-                            (h_r, ends.then_some(h_l))
+                        // R_e: dispersion over e cells (none for e = 0); L_e: over
+                        // N − 1 − e (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
+                        if ends {
+                            let gr = if e == 0 { 1.0 } else { g };
+                            let gl = if e == last { 1.0 } else { g };
+                            h_r += zr * (gr * weight);
+                            h_l += zr.conj() * (gl * weight);
+                        } else {
+                            h_r += zr * weight;
                         }
-                    };
+                    }
                     let nyquist_or_dc = k == 0 || 2 * k == n;
-                    match h_l {
+                    if !ends {
                         // Inside the bar, see `inside`: value·t_k and conj(value·conj(t_mirror)).
-                        None if !nyquist_or_dc => {
+                        if nyquist_or_dc {
+                            let value = (u[k] * h_r + v[k] * h_r.conj()) * g;
+                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
+                        } else {
                             let [s1, d1, s2, d2] = inside[k];
                             let (hr, hi) = (h_r.re, h_r.im);
                             folded[k % m] +=
@@ -405,20 +526,15 @@ impl TransitDesign {
                             folded[(n - k) % m] +=
                                 Complex64::new(s2.re * hr - d2.im * hi, -(s2.im * hr + d2.re * hi));
                         }
-                        None => {
-                            let value = (u[k] * h_r + v[k] * h_r.conj()) * g;
-                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
-                        }
-                        Some(h_l) => {
-                            let value = u[k] * h_r + v[k] * h_l;
-                            let (t_k, t_mirror) = turns[k];
-                            if nyquist_or_dc {
-                                folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
-                            } else {
-                                folded[k % m] += value * t_k;
-                                folded[(n - k) % m] += value.conj() * t_mirror;
-                            }
-                        }
+                        continue;
+                    }
+                    let value = u[k] * h_r + v[k] * h_l;
+                    let (t_k, t_mirror) = turns[k];
+                    if nyquist_or_dc {
+                        folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
+                    } else {
+                        folded[k % m] += value * t_k;
+                        folded[(n - k) % m] += value.conj() * t_mirror;
                     }
                 }
                 inverse.process(&mut folded);
@@ -429,6 +545,115 @@ impl TransitDesign {
                     .collect()
             })
             .collect()
+    }
+}
+
+/// The bins 1..half of [`TransitDesign::stretch_history`]'s `inside` terms and of one cell's
+/// phase factor z, as separate real arrays (index k), so that the loop over bins of a point
+/// inside the bar streams plain slices the compiler can vectorise.
+struct InteriorBins {
+    /// Re and Im of the four terms of `inside`: sum·t_k, difference·t_k, sum·conj(t_mirror),
+    /// difference·conj(t_mirror).
+    terms: [[Vec<f64>; 2]; 4],
+    /// Re and Im of z.
+    z: [Vec<f64>; 2],
+}
+
+impl InteriorBins {
+    fn new(inside: &[[Complex64; 4]], z: &[Complex64], half: usize) -> InteriorBins {
+        let part = |f: &dyn Fn(usize) -> f64| (0..half).map(f).collect::<Vec<f64>>();
+        InteriorBins {
+            terms: std::array::from_fn(|j| {
+                [part(&|k| inside[k][j].re), part(&|k| inside[k][j].im)]
+            }),
+            z: [part(&|k| z[k].re), part(&|k| z[k].im)],
+        }
+    }
+}
+
+/// The folded spectrum of one point inside the bar, as two accumulators indexed by k mod m:
+/// `forward` collects the bins' own slots k mod m, `mirror` the slots (n − k) mod m of their
+/// conjugate mirrors (n a multiple of m), so that each pass over a block of m bins writes
+/// consecutive slots.
+struct FoldSums {
+    forward: [Vec<f64>; 2],
+    mirror: [Vec<f64>; 2],
+}
+
+impl FoldSums {
+    fn new(m: usize) -> FoldSums {
+        FoldSums {
+            forward: [vec![0.0; m], vec![0.0; m]],
+            mirror: [vec![0.0; m], vec![0.0; m]],
+        }
+    }
+
+    /// Accumulates the bins 1..half of a point whose stretch is `w0` of element e plus `w1` of
+    /// element e + 1: h = z^e (w0 + w1 z), with z^e in `pw` advanced first by `step` (z^stride)
+    /// when given; the value at bin k is g (u h + v conj h) with its two phase turns
+    /// (`InteriorBins::terms`).
+    fn interior(
+        &mut self,
+        bins: &InteriorBins,
+        pw: &mut [Complex64],
+        step: Option<&[Complex64]>,
+        (w0, w1): (f64, f64),
+        m: usize,
+    ) {
+        for a in self.forward.iter_mut().chain(self.mirror.iter_mut()) {
+            a.fill(0.0);
+        }
+        let half = bins.z[0].len();
+        let [[s1r, s1i], [d1r, d1i], [s2r, s2i], [d2r, d2i]] = &bins.terms;
+        let [zr, zi] = &bins.z;
+        let [fr, fi] = &mut self.forward;
+        let [mr, mi] = &mut self.mirror;
+        let mut start = 1;
+        while start < half {
+            // The block of bins k in [start, end) sharing the slots k − base.
+            let base = start - start % m;
+            let end = (base + m).min(half);
+            let (k, slots) = (start..end, start - base..end - base);
+            let pw = &mut pw[k.clone()];
+            if let Some(step) = step {
+                for (c, s) in pw.iter_mut().zip(&step[k.clone()]) {
+                    *c *= s;
+                }
+            }
+            let iter = pw
+                .iter()
+                .zip(&zr[k.clone()])
+                .zip(&zi[k.clone()])
+                .zip(s1r[k.clone()].iter().zip(&s1i[k.clone()]))
+                .zip(d1r[k.clone()].iter().zip(&d1i[k.clone()]))
+                .zip(s2r[k.clone()].iter().zip(&s2i[k.clone()]))
+                .zip(d2r[k.clone()].iter().zip(&d2i[k.clone()]))
+                .zip(fr[slots.clone()].iter_mut().zip(&mut fi[slots.clone()]))
+                .zip(mr[slots.clone()].iter_mut().zip(&mut mi[slots]));
+            for ((((((((c, zr), zi), s1), d1), s2), d2), f), mm) in iter {
+                let (qr, qi) = (w0 + w1 * zr, w1 * zi);
+                let (hr, hi) = (c.re * qr - c.im * qi, c.re * qi + c.im * qr);
+                *f.0 += s1.0 * hr - d1.1 * hi;
+                *f.1 += s1.1 * hr + d1.0 * hi;
+                *mm.0 += s2.0 * hr - d2.1 * hi;
+                *mm.1 -= s2.1 * hr + d2.0 * hi;
+            }
+            start = end;
+        }
+        // DC and Nyquist (summed by the caller) advance too.
+        if let Some(step) = step {
+            pw[0] *= step[0];
+            pw[half] *= step[half];
+        }
+    }
+
+    /// Adds the accumulators into `folded`: forward slot s to s, mirror slot s to (m − s) mod m.
+    fn add_to(&self, folded: &mut [Complex64]) {
+        let m = folded.len();
+        for s in 0..m {
+            folded[s] += Complex64::new(self.forward[0][s], self.forward[1][s]);
+            folded[(m - s) % m] += Complex64::new(self.mirror[0][s], self.mirror[1][s]);
+        }
     }
 }
 
@@ -580,6 +805,34 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A shared design is one per key and gives a fresh design's filters bit for bit, with the
+    /// same power gain; another grid gets another design.
+    #[test]
+    fn shared_designs_equal_fresh_ones() {
+        let m = TransitModel::PochhammerChree;
+        let a = shared_design(m, 0.29, 9.525e-3, 1e-3, 300);
+        let b = shared_design(m, 0.29, 9.525e-3, 1e-3, 300);
+        assert!(Arc::ptr_eq(&a, &b));
+        let fresh = TransitDesign::new(m, 0.29, 9.525e-3, 1e-3, 300);
+        for cells in [1, 17, 299] {
+            let shared = a.shared_filter(cells);
+            let f = fresh.filter(cells);
+            assert_eq!(shared.filter, f);
+            assert!(Arc::ptr_eq(&shared, &a.shared_filter(cells)));
+            assert_eq!(shared.max_power_gain(), max_power_gain(&f.taps));
+        }
+        assert!(!Arc::ptr_eq(
+            &a,
+            &shared_design(m, 0.29, 9.525e-3, 0.5e-3, 300)
+        ));
+        // The relation alone evaluates the same phase.
+        let w = 0.7;
+        assert_eq!(
+            TransitDesign::relation(m, 0.29, 9.525e-3, 1e-3).phase_and_gain(w),
+            fresh.phase_and_gain(w)
+        );
+    }
 
     /// A filter's DFT is exp(−i d φ) in its band (at the design's bins), and its taps sum to one.
     #[test]
