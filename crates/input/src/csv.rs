@@ -102,25 +102,32 @@ impl CsvTable {
         }
         let mut columns = vec![Vec::new(); names.len()];
         for (line, row) in lines {
-            let cells: Vec<&str> = row.split(',').collect();
-            if cells.len() != names.len() {
+            // The cells are counted first (the count is checked before any value) and then
+            // parsed straight from the row, without collecting them.
+            let count = row.bytes().filter(|&b| b == b',').count() + 1;
+            if count != names.len() {
                 return Err(input(
                     line,
                     "row",
-                    format!(
-                        "{} values where the header has {}",
-                        cells.len(),
-                        names.len()
-                    ),
+                    format!("{count} values where the header has {}", names.len()),
                     "one value per header column",
                 ));
             }
-            for (k, cell) in cells.iter().enumerate() {
-                let v = f64::from_str(cell.trim()).map_err(|_| {
+            let mut rest = row;
+            for k in 0..count {
+                // A byte scan for the comma (an ASCII byte, so a char boundary): quicker than a
+                // char pattern on cells this short.
+                let (cell, tail) = match rest.bytes().position(|b| b == b',') {
+                    Some(i) => (&rest[..i], &rest[i + 1..]),
+                    None => (rest, ""),
+                };
+                rest = tail;
+                let cell = cell.trim();
+                let v = f64::from_str(cell).map_err(|_| {
                     input(
                         line,
                         &names[k],
-                        format!("`{}` is not a number", cell.trim()),
+                        format!("`{cell}` is not a number"),
                         "a finite decimal number",
                     )
                 })?;
