@@ -335,15 +335,28 @@ pub enum Unloading {
     Static,
     /// As the authors' `f_contact.m`: Fmax the largest force reached, Rp with the static σy and Fy.
     Authors,
+    /// The energy [`Unloading::Dynamic`] returns, on a Thornton curve that starts from the force
+    /// at the turn (the static loading curve at δmax, which the rate-dependent loading force
+    /// reaches as the approach rate vanishes) instead of the largest force reached: the force is
+    /// continuous at the turning point and restitution is the dynamic rule's (docs/physics.md §3,
+    /// "A continuous turn").
+    DynamicContinuous,
 }
 
 impl Unloading {
     /// All rules with their scene names.
-    pub const ALL: [(&'static str, Unloading); 3] = [
+    pub const ALL: [(&'static str, Unloading); 4] = [
         ("dynamic", Unloading::Dynamic),
         ("static", Unloading::Static),
         ("authors", Unloading::Authors),
+        ("dynamic-continuous", Unloading::DynamicContinuous),
     ];
+
+    /// Whether the rule unloads from the rate-hardened state with the vibration loss
+    /// ([`Unloading::Dynamic`] and [`Unloading::DynamicContinuous`]).
+    pub fn is_dynamic(self) -> bool {
+        matches!(self, Unloading::Dynamic | Unloading::DynamicContinuous)
+    }
 }
 
 /// Coefficient k of the energy an impact leaves in elastic vibrations of the spheres,
@@ -675,7 +688,7 @@ impl BurgoyneDaraio {
     /// Energy left in elastic vibrations by a loading that did `loading_work_j` at approach speeds up
     /// to `speed_m_s`: k (u/c0)^{3/5} W_load ([`VIBRATION_LOSS_COEFFICIENT`]), J.
     pub fn vibration_loss_j(&self, speed_m_s: f64, loading_work_j: f64) -> f64 {
-        if self.unloading != Unloading::Dynamic || speed_m_s <= 0.0 || loading_work_j <= 0.0 {
+        if !self.unloading.is_dynamic() || speed_m_s <= 0.0 || loading_work_j <= 0.0 {
             return 0.0;
         }
         VIBRATION_LOSS_COEFFICIENT
@@ -743,11 +756,11 @@ impl BurgoyneDaraio {
                     return;
                 }
             }
-            Unloading::Authors | Unloading::Dynamic => {
+            Unloading::Authors | Unloading::Dynamic | Unloading::DynamicContinuous => {
                 // The largest force reached (never below the force at δmax: both are set
                 // together while loading).
                 let f = h.peak_force_n;
-                let sy = if self.unloading == Unloading::Dynamic {
+                let sy = if self.unloading.is_dynamic() {
                     let s = self.state_yield_stress(h.delta_max_m, f);
                     h.yielded = self.curve_at_stress(s).region(h.delta_max_m) != Region::Hertz;
                     s
@@ -780,7 +793,13 @@ impl BurgoyneDaraio {
         } else {
             elastic
         };
-        let recovery = returned / (0.4 * fmax);
+        // The continuous rule returns that energy from the force at the turn, over a longer
+        // recovery (at most δmax: beyond, less comes back).
+        let fmax = match self.unloading {
+            Unloading::DynamicContinuous => self.static_curve.force(h.delta_max_m).min(fmax),
+            _ => fmax,
+        };
+        let recovery = (returned / (0.4 * fmax)).min(h.delta_max_m);
         // Keep a curve (a vanishing recovery would be a vertical drop of the force).
         let recovery = recovery.max(1e-6 * h.delta_max_m);
         h.force_max_n = fmax;
@@ -1201,6 +1220,70 @@ mod tests {
                 - e(LawKind::RateIndependent, Unloading::Static);
             assert!(old < 0.0, "{speed} m/s: static rule rise {old}");
         }
+    }
+
+    /// `dynamic-continuous` returns the dynamic rule's energy, so its restitution is the dynamic
+    /// rule's (the collision steps the same loading; the unloading curves differ only in how
+    /// they give the energy back), while its force at the turn is the static loading curve's at
+    /// δmax (continuous with the rate-dependent loading force as the rate vanishes) where the
+    /// dynamic rule jumps to the largest force reached.
+    #[test]
+    fn the_continuous_turn_keeps_the_dynamic_restitution_without_the_jump() {
+        let pair = fem_steel();
+        let p = pair.contact_properties();
+        let e = |rule, speed| {
+            collide(
+                &pair,
+                LawKind::BurgoyneDaraio
+                    .build_options(p, Region2Form::Smooth, rule)
+                    .as_ref(),
+                speed,
+            )
+            .0
+        };
+        for speed in [10.0, 50.0, 100.0] {
+            let (dynamic, continuous) = (
+                e(Unloading::Dynamic, speed),
+                e(Unloading::DynamicContinuous, speed),
+            );
+            // The unloading curves are integrated over steps: the returned energies agree to the
+            // quadrature's second order, far below the 0.03 of the restitution checks.
+            assert!(
+                (continuous - dynamic).abs() < 2e-3,
+                "{speed} m/s: e = {continuous} against {dynamic}"
+            );
+        }
+        // Just above yield the longer recovery would pass δmax: capped there, less comes back.
+        let (dynamic, continuous) = (
+            e(Unloading::Dynamic, 1.0),
+            e(Unloading::DynamicContinuous, 1.0),
+        );
+        assert!(
+            continuous < dynamic,
+            "1 m/s: {continuous} against {dynamic}"
+        );
+        // At a turn the continuous rule's curve starts at the static curve's force at δmax,
+        // below the largest force reached.
+        let law = BurgoyneDaraio::with_options(
+            p,
+            true,
+            Region2Form::Smooth,
+            Unloading::DynamicContinuous,
+        );
+        let mut h = ContactHistory::default();
+        let delta = 20.0 * law.static_curve.delta_y_m;
+        let mut peak: f64 = 0.0;
+        let steps = 200;
+        for i in 1..=steps {
+            // Loading at an approach speed falling to zero.
+            let d = delta * (i as f64 / steps as f64).sqrt();
+            let speed = 10.0 * (1.0 - i as f64 / steps as f64) + 1e-9;
+            peak = peak.max(law.evaluate(&mut h, d, speed).force_n);
+        }
+        let after = law.evaluate(&mut h, delta * (1.0 - 1e-12), -1e-3).force_n;
+        let at_turn = law.static_curve.force(delta);
+        assert_relative_eq!(after, at_turn, max_relative = 1e-6);
+        assert!(after < peak, "{after} against the peak {peak}");
     }
 
     /// A material drawn by the passivity property tests.

@@ -78,7 +78,7 @@ impl SceneFile for Params {
                         v.error(
                             "unloading",
                             format!("unknown rule `{value}`"),
-                            "dynamic, static, authors",
+                            Unloading::ALL.map(|(n, _)| n).join(", "),
                         )
                     })?
             }

@@ -364,6 +364,7 @@ enum UnloadingToml {
     Dynamic,
     Static,
     Authors,
+    DynamicContinuous,
 }
 
 /// `region2 = "..."`: the scene names of [`Region2Form`].
