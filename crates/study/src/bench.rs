@@ -256,6 +256,10 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
             "shaper.enabled = false",
             vec![("shaper.enabled", shpb_input::scene::Value::Boolean(false))],
         ),
+        (
+            "unloading = dynamic-continuous",
+            vec![("unloading", s("dynamic-continuous"))],
+        ),
     ] {
         progress(label);
         let p = load(Fidelity::Standard, &extra)?;
