@@ -1640,13 +1640,14 @@ the simulated ratio is the ideal test's lower bound.\n",
     let quiet = min_max(rows.iter().map(|r| r.timing.record.between_pulses * 100.0));
     let _ = writeln!(
         w,
-        "\nOne candidate excluded: an AC-coupled amplifier would let the incident channel droop after \
+        "\nTwo candidates excluded. An AC-coupled amplifier would let the incident channel droop after \
          the long compressive incident pulse, so that the reflected pulse rides on a tensile offset \
          and F_front reads low by that offset, the same share of the incident wave on every record. \
          Between the two pulses (the 25 µs ending 5 µs before each reflected foot) the records' \
          incident channel sits at {:+.1} to {:+.1} % of its incident peak (compression positive): the \
          incident pulse's own slow tail, of the other sign and an order of magnitude smaller than the {:+.1} to {:+.1} % the \
-         imbalance would need.",
+         imbalance would need. Nor attenuation, by its sign: over its longer path the reflected \
+         pulse would arrive smaller at the gauge and F_front read high, not low.",
         quiet.0, quiet.1, all_share.0, all_share.1,
     );
 }
