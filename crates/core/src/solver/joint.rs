@@ -192,7 +192,10 @@ impl JointPrediction {
 /// [0, law(0)], by bisection to 1e-12 relative. Kept for the sphere contacts: a rate-dependent
 /// law switches branch where the closure rate reaches zero and can cross F = law(F) more than
 /// once there; bisection's choice among those crossings is the one the shipped results hold
-/// (an Illinois iteration picks another at the peak of the ss440c test, 5 % off in force).
+/// (an Illinois iteration picks another at the peak of the ss440c test, 5 % off in force). The
+/// several crossings are the default `dynamic` unloading's: its curve starts above the loading
+/// force once the rate has fallen, so turning early is self-consistent; under
+/// `dynamic-continuous` only the rate's zero turns (docs/physics.md §3, "A continuous turn").
 fn solve_force(law: impl Fn(f64) -> f64) -> f64 {
     let f_hi = law(0.0);
     if f_hi <= 0.0 {
