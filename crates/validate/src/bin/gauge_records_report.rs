@@ -1540,14 +1540,14 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
          so record and simulation are aligned alike). Sensitivity: d[(F_front − F_back)/F_3wave at \
          peak]/d(reflected window delay) around the stated geometry, per µs (±1 µs). Simulated: the \
          reduction `shpb run` applies to the virtual test's digitised records (same reduce.rs, \
-         2 µs smoothing, windows from the set-up's own geometry), with (a) the shipped set-up and (c) \
-         the effective path.\n"
+         2 µs smoothing, windows from the set-up's own geometry), with (a) the shipped set-up, (b) \
+         the 1/4\" inserts of bar steel and (c) the effective path.\n"
     );
     let _ = writeln!(
         w,
-        "| sample | specimen | record, stated geometry | reflected on its foot | effective path | both windows on the feet | sensitivity (per µs) | misalignment that would explain it (µs) | F_front − F_back at peak, of the incident peak force (%) | simulated (a) shipped | simulated (c) effective path |"
+        "| sample | specimen | record, stated geometry | reflected on its foot | effective path | both windows on the feet | sensitivity (per µs) | misalignment that would explain it (µs) | F_front − F_back at peak, of the incident peak force (%) | simulated (a) shipped | simulated (b) inserts | simulated (c) effective path |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     let ratio =
         |r: &Option<Reduction>| r.as_ref().map_or(f64::NAN, |x| x.equilibrium_ratio_at_peak);
     let ea = app.material.youngs_modulus_pa * app.incident.area_m2();
@@ -1555,7 +1555,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
         let t = &r.timing;
         let _ = writeln!(
             w,
-            "| {} | {} {} psi | {:.2} | {:.2} | {:.2} | {:.2} | {:+.3} | {:.0} | {:+.1} | {:.3} | {:.3} |",
+            "| {} | {} {} psi | {:.2} | {:.2} | {:.2} | {:.2} | {:+.3} | {:.0} | {:+.1} | {:.3} | {:.3} | {:.3} |",
             r.n,
             r.material,
             r.psi,
@@ -1569,6 +1569,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
                 .as_ref()
                 .map_or(f64::NAN, |x| imbalance_of_incident(x, ea) * 100.0),
             t.shipped.reduction.equilibrium_ratio_at_peak,
+            t.inserts.reduction.equilibrium_ratio_at_peak,
             eff(r).reduction.equilibrium_ratio_at_peak,
         );
     }
@@ -1648,6 +1649,14 @@ the simulated ratio is the ideal test's lower bound.\n",
         sensitivity.0, sensitivity.1, all_share.0, all_share.1,
     );
     let quiet = min_max(rows.iter().map(|r| r.timing.record.between_pulses * 100.0));
+    let inserts_ratio = min_max(
+        rows.iter()
+            .map(|r| r.timing.inserts.reduction.equilibrium_ratio_at_peak),
+    );
+    let inserts_share = min_max(
+        rows.iter()
+            .map(|r| imbalance_of_incident(&r.timing.inserts.reduction, ea) * 100.0),
+    );
     let uncorrected = min_max(rows.iter().map(|r| {
         r.timing
             .record_on_feet_uncorrected
@@ -1665,8 +1674,11 @@ the simulated ratio is the ideal test's lower bound.\n",
          imbalance would need. Nor attenuation, by its sign: over its longer path the reflected \
          pulse would arrive smaller at the gauge and F_front read high, not low. Nor the dispersion \
          correction: with both windows on the feet and no correction the share is {:+.1} to {:+.1} % \
-         (with the Bancroft correction {:+.1} to {:+.1} %). What is left is the incident-bar end and \
-         insert interfaces and contact misalignment, which the records cannot separate.",
+         (with the Bancroft correction {:+.1} to {:+.1} %). Inserts as the model has them, bar steel \
+         pressed flat on both sides ((b)), leave the simulated tests balanced (ratio at peak \
+         {:.3}–{:.3}, F_front − F_back {:+.1} to {:+.1} % of the incident peak force). What is left is \
+         what the model leaves out at the incident-bar end and the inserts (their material, faces and \
+         seating) and contact misalignment, which the records cannot separate.",
         quiet.0,
         quiet.1,
         all_share.0,
@@ -1675,5 +1687,9 @@ the simulated ratio is the ideal test's lower bound.\n",
         uncorrected.1,
         all_share.0,
         all_share.1,
+        inserts_ratio.0,
+        inserts_ratio.1,
+        inserts_share.0,
+        inserts_share.1,
     );
 }
