@@ -85,7 +85,7 @@
 //! run (`solver::chain::CHECK_INTERVAL_STEPS`).
 
 use crate::error::{Error, Named, Result};
-use crate::transit::{BlockConvolver, StretchPoint, TransitDesign, TransitFilter, TransitModel};
+use crate::transit::{BlockConvolver, SharedFilter, StretchPoint, TransitDesign, TransitModel};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -620,8 +620,8 @@ struct Waves {
 struct Transit {
     /// The design, shared with every bar like this one ([`crate::transit::shared_design`]).
     design: Arc<TransitDesign>,
-    /// The end-to-end filter (N − 1 cells), taps oldest first.
-    ends: ReversedFilter,
+    /// The end-to-end filter (N − 1 cells).
+    ends: Arc<SharedFilter>,
     /// Right-going increments A[m] injected at the left end at step m, at index m + offset
     /// (m ≥ −N: the initial field, older: its last value repeated), m.
     injected_right: Vec<f64>,
@@ -635,8 +635,6 @@ struct Transit {
     step: usize,
     /// [D at element N − 1, E at element 0] at the current level: the waves arriving at the ends.
     arrival: [f64; 2],
-    /// Filters over fewer cells, for reads inside the bar, by cells.
-    interior: std::cell::RefCell<std::collections::HashMap<usize, std::sync::Arc<ReversedFilter>>>,
     /// Σ of the squared increments injected (the initial field included) and delivered at the
     /// ends: k times each is the wave energy into and out of the transit, m².
     injected_sq: f64,
@@ -650,41 +648,16 @@ struct Transit {
     lag: usize,
 }
 
-/// A transit filter with its taps oldest first (for a dot product with a history slice).
-#[derive(Debug, Clone)]
-struct ReversedFilter {
-    lead: usize,
-    taps: Vec<f64>,
-}
-
-impl ReversedFilter {
-    fn new(f: TransitFilter) -> ReversedFilter {
-        let mut taps = f.taps;
-        taps.reverse();
-        ReversedFilter { lead: f.lead, taps }
-    }
-
-    /// Σ_j h_j s[newest − j + lead] over the history `s` (index of the pure-delay sample
-    /// `newest`; the lead never reaches past the last sample injected).
-    #[inline]
-    fn apply(&self, s: &[f64], newest: usize) -> f64 {
-        let lo = newest + self.lead + 1 - self.taps.len();
-        crate::transit::dot(&self.taps, &s[lo..=newest + self.lead])
-    }
-}
-
 impl Transit {
     /// The transit of a delay line of `n` elements at rest ([`Transit::restart`] takes its field).
     fn new(design: Arc<TransitDesign>, n: usize) -> Transit {
-        let shared = design.shared_filter(n - 1);
-        let ends_gain_excess = (shared.max_power_gain() - 1.0).max(0.0);
-        let filter = shared.filter.clone();
-        let lag = n - filter.lead;
-        let blocks = BlockConvolver::new(&filter.taps, lag).map(|c| Box::new([c.clone(), c]));
-        let ends = ReversedFilter::new(filter);
+        let ends = design.shared_filter(n - 1);
+        let ends_gain_excess = (ends.max_power_gain() - 1.0).max(0.0);
+        let lag = n - ends.filter.lead;
+        let blocks = BlockConvolver::new(&ends.filter.taps, lag).map(|c| Box::new([c.clone(), c]));
         // Room for the longest filter behind the oldest pure-delay read (interior filters,
         // over fewer cells, are shorter; the slack covers their rounding).
-        let offset = n + 2 * ends.taps.len() + 16;
+        let offset = n + 2 * ends.filter.taps.len() + 16;
         Transit {
             design,
             ends,
@@ -694,7 +667,6 @@ impl Transit {
             elements: n,
             step: 0,
             arrival: [0.0; 2],
-            interior: Default::default(),
             injected_sq: 0.0,
             delivered_sq: 0.0,
             ends_gain_excess,
@@ -772,30 +744,16 @@ impl Transit {
         self.update_arrivals();
     }
 
-    /// The filter over `cells` cells (built once).
-    fn interior(&self, cells: usize) -> std::sync::Arc<ReversedFilter> {
-        if let Some(f) = self.interior.borrow().get(&cells) {
-            return std::sync::Arc::clone(f);
-        }
-        let f = Arc::new(ReversedFilter::new(
-            self.design.shared_filter(cells).filter.clone(),
-        ));
-        self.interior
-            .borrow_mut()
-            .insert(cells, std::sync::Arc::clone(&f));
-        f
-    }
-
     /// Right-going increment at element e (0 < e < N − 1): A[n − e − 1] carried over e cells.
     fn right_at(&self, e: usize) -> f64 {
-        let f = self.interior(e);
+        let f = self.design.shared_filter(e);
         f.apply(&self.injected_right, self.step + self.offset - e - 1)
     }
 
     /// Left-going increment at element e (0 < e < N − 1): B[n − (N − e)] carried over N − 1 − e cells.
     fn left_at(&self, e: usize) -> f64 {
         let n = self.elements;
-        let f = self.interior(n - 1 - e);
+        let f = self.design.shared_filter(n - 1 - e);
         f.apply(&self.injected_left, self.step + self.offset - (n - e))
     }
 }
@@ -1456,10 +1414,9 @@ impl Bar {
     /// end velocities' changes and the end springs' forces, plus half the coming step's.
     pub fn momentum_kg_m_s(&self) -> f64 {
         let last = self.mass.len() - 1;
-        match &self.waves {
-            Some(w) if w.transit.is_some() => {
-                let coming = self.dt_s
-                    * (self.k[last - 1] * w.stretch(last - 1) - self.k[0] * w.stretch(0))
+        match self.transit_interior_impulse() {
+            Some(interior) => {
+                let coming = interior
                     + [0, last]
                         .iter()
                         .map(|&i| {
@@ -1474,6 +1431,15 @@ impl Bar {
                 .map(|i| self.node_mass_kg(i) * self.velocity_m_s(i))
                 .sum(),
         }
+    }
+
+    /// The impulse the coming step gives the interior nodes of a dispersive delay line,
+    /// Δt (k s_{N−1} − k s_0) (every spring force between them cancels), N·s; `None` for any
+    /// other bar.
+    fn transit_interior_impulse(&self) -> Option<f64> {
+        let w = self.waves.as_ref().filter(|w| w.transit.is_some())?;
+        let last = self.mass.len() - 1;
+        Some(self.dt_s * (self.k[last - 1] * w.stretch(last - 1) - self.k[0] * w.stretch(0)))
     }
 
     /// Sets the whole bar moving rigidly at `v_m_s` (a striker): v^{−1/2} = v, fixed end nodes stay at rest.
@@ -1520,14 +1486,7 @@ impl Bar {
             },
         ];
         let v_before = [self.v[0], self.v[last]];
-        // A dispersive delay line's momentum: the interior nodes change by the springs at the
-        // ends, Δt (k s_{N−1} − k s_0) (every spring force between them cancels).
-        let interior_impulse = match &self.waves {
-            Some(w) if w.transit.is_some() => {
-                dt * (self.k[last - 1] * w.stretch(last - 1) - self.k[0] * w.stretch(0))
-            }
-            _ => 0.0,
-        };
+        let interior_impulse = self.transit_interior_impulse().unwrap_or(0.0);
         match &self.love {
             None => {
                 self.w[0] += self.inv_a[0] * f[0];

@@ -65,15 +65,27 @@ pub struct TransitDesign {
     filters: Mutex<HashMap<usize, Arc<SharedFilter>>>,
 }
 
-/// A transit filter kept by its design, with its largest power gain worked out once.
+/// A transit filter kept by its design, with its taps also oldest first (for a dot product with
+/// a history slice) and its largest power gain worked out once.
 #[derive(Debug)]
 pub struct SharedFilter {
     /// The filter.
     pub filter: TransitFilter,
+    /// `filter.taps` reversed.
+    oldest_first: Vec<f64>,
     power_gain: OnceLock<f64>,
 }
 
 impl SharedFilter {
+    /// Σ_j h_j s[newest − j + lead] over the history `s` (index of the pure-delay sample
+    /// `newest`; the lead never reaches past the last sample injected).
+    #[inline]
+    pub fn apply(&self, s: &[f64], newest: usize) -> f64 {
+        let lead = self.filter.lead;
+        let lo = newest + lead + 1 - self.oldest_first.len();
+        dot(&self.oldest_first, &s[lo..=newest + lead])
+    }
+
     /// max |H|² of the filter as truncated ([`max_power_gain`]).
     pub fn max_power_gain(&self) -> f64 {
         *self
@@ -98,11 +110,10 @@ pub fn shared_design(
 ) -> Arc<TransitDesign> {
     type Key = (TransitModel, u64, u64, usize);
     static DESIGNS: OnceLock<Mutex<HashMap<Key, Arc<TransitDesign>>>> = OnceLock::new();
-    let relation = TransitDesign::relation(model, poisson_ratio, radius_m, cell_m);
     let key = (
         model,
         poisson_ratio.to_bits(),
-        relation.radius_cells.to_bits(),
+        (radius_m / cell_m).to_bits(),
         TransitDesign::fft_length(model, poisson_ratio, radius_m, cell_m, max_cells),
     );
     let designs = DESIGNS.get_or_init(|| Mutex::new(HashMap::new()));
@@ -305,8 +316,10 @@ impl TransitDesign {
         {
             return Arc::clone(f);
         }
+        let filter = self.filter(cells);
         let f = Arc::new(SharedFilter {
-            filter: self.filter(cells),
+            oldest_first: filter.taps.iter().rev().copied().collect(),
+            filter,
             power_gain: OnceLock::new(),
         });
         self.filters
@@ -415,24 +428,8 @@ impl TransitDesign {
             |k: usize| Complex64::from_polar(1.0, 2.0 * PI * ((k * offset) % n) as f64 / n as f64);
         let turns: Vec<(Complex64, Complex64)> =
             (0..=half).map(|k| (turn(k), turn(n - k))).collect();
-        // Inside the bar (both waves weighted by the band, real weights) the value at bin k is
-        // g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h), h the right-going sum: with
-        // its two phase turns folded in, four real products a turn.
-        let inside: Vec<[Complex64; 4]> = (0..=half)
-            .map(|k| {
-                let (sum, difference) = ((u[k] + v[k]) * gain[k], (u[k] - v[k]) * gain[k]);
-                let (t_k, t_mirror) = turns[k];
-                [
-                    sum * t_k,
-                    difference * t_k,
-                    sum * t_mirror.conj(),
-                    difference * t_mirror.conj(),
-                ]
-            })
-            .collect();
-        // The same, as separate real arrays over the bins 1..half (neither DC nor Nyquist) for
-        // the usual point inside the bar ([`InteriorBins`]).
-        let interior = InteriorBins::new(&inside, &z, half);
+        // The usual point inside the bar, in separate real arrays ([`InteriorBins`]).
+        let interior = InteriorBins::new(&u, &v, &gain, &turns, &z, half);
         let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
@@ -491,7 +488,8 @@ impl TransitDesign {
                 }
                 for k in 0..=half {
                     let g = gain[k];
-                    // The right-going sum h_r and, at the ends, the left-going one h_l.
+                    // The right- and left-going sums h_r and h_l (each term's wave undispersed
+                    // over its first cell).
                     let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
                     let mut h_l = h_r;
                     let mut at = e0;
@@ -503,34 +501,14 @@ impl TransitDesign {
                         }
                         // R_e: dispersion over e cells (none for e = 0); L_e: over
                         // N − 1 − e (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
-                        if ends {
-                            let gr = if e == 0 { 1.0 } else { g };
-                            let gl = if e == last { 1.0 } else { g };
-                            h_r += zr * (gr * weight);
-                            h_l += zr.conj() * (gl * weight);
-                        } else {
-                            h_r += zr * weight;
-                        }
-                    }
-                    let nyquist_or_dc = k == 0 || 2 * k == n;
-                    if !ends {
-                        // Inside the bar, see `inside`: value·t_k and conj(value·conj(t_mirror)).
-                        if nyquist_or_dc {
-                            let value = (u[k] * h_r + v[k] * h_r.conj()) * g;
-                            folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
-                        } else {
-                            let [s1, d1, s2, d2] = inside[k];
-                            let (hr, hi) = (h_r.re, h_r.im);
-                            folded[k % m] +=
-                                Complex64::new(s1.re * hr - d1.im * hi, s1.im * hr + d1.re * hi);
-                            folded[(n - k) % m] +=
-                                Complex64::new(s2.re * hr - d2.im * hi, -(s2.im * hr + d2.re * hi));
-                        }
-                        continue;
+                        let gr = if e == 0 { 1.0 } else { g };
+                        let gl = if e == last { 1.0 } else { g };
+                        h_r += zr * (gr * weight);
+                        h_l += zr.conj() * (gl * weight);
                     }
                     let value = u[k] * h_r + v[k] * h_l;
                     let (t_k, t_mirror) = turns[k];
-                    if nyquist_or_dc {
+                    if k == 0 || 2 * k == n {
                         folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
                     } else {
                         folded[k % m] += value * t_k;
@@ -548,11 +526,11 @@ impl TransitDesign {
     }
 }
 
-/// The bins 1..half of [`TransitDesign::stretch_history`]'s `inside` terms and of one cell's
-/// phase factor z, as separate real arrays (index k), so that the loop over bins of a point
-/// inside the bar streams plain slices the compiler can vectorise.
+/// The bins 0..half of [`TransitDesign::stretch_history`]'s terms for the usual point inside the
+/// bar ([`InteriorBins::new`]) and of one cell's phase factor z, as separate real arrays (index
+/// k), so that the loop over its bins streams plain slices the compiler can vectorise.
 struct InteriorBins {
-    /// Re and Im of the four terms of `inside`: sum·t_k, difference·t_k, sum·conj(t_mirror),
+    /// Re and Im of the four terms: sum·t_k, difference·t_k, sum·conj(t_mirror),
     /// difference·conj(t_mirror).
     terms: [[Vec<f64>; 2]; 4],
     /// Re and Im of z.
@@ -560,7 +538,31 @@ struct InteriorBins {
 }
 
 impl InteriorBins {
-    fn new(inside: &[[Complex64; 4]], z: &[Complex64], half: usize) -> InteriorBins {
+    /// From the history spectra `u`, `v` (with their delays), the band's weights, the phase
+    /// turns of each bin and its mirror, and z, over the bins 0..`half`.
+    fn new(
+        u: &[Complex64],
+        v: &[Complex64],
+        gain: &[f64],
+        turns: &[(Complex64, Complex64)],
+        z: &[Complex64],
+        half: usize,
+    ) -> InteriorBins {
+        // Inside the bar (both waves weighted by the band, real weights) the value at bin k is
+        // g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h), h the right-going sum: with
+        // its two phase turns folded in, four real products a turn.
+        let inside: Vec<[Complex64; 4]> = (0..half)
+            .map(|k| {
+                let (sum, difference) = ((u[k] + v[k]) * gain[k], (u[k] - v[k]) * gain[k]);
+                let (t_k, t_mirror) = turns[k];
+                [
+                    sum * t_k,
+                    difference * t_k,
+                    sum * t_mirror.conj(),
+                    difference * t_mirror.conj(),
+                ]
+            })
+            .collect();
         let part = |f: &dyn Fn(usize) -> f64| (0..half).map(f).collect::<Vec<f64>>();
         InteriorBins {
             terms: std::array::from_fn(|j| {
