@@ -438,8 +438,11 @@ def test_ctrl_c_stops_a_long_run_cleanly():
     sender.start()
     try:
         with pytest.raises(KeyboardInterrupt, match="interrupted at step"):
-            # The reference preset takes several seconds: stopped long before its end.
-            shpb.run("scenes/shpb-ss440c-10psi.toml", fidelity="reference")
+            # The Love-rod chain at 0.125 mm takes several seconds: stopped long before its end.
+            shpb.run(
+                "scenes/shpb-ss440c-10psi.toml",
+                set={"dispersion": "love-rod", "cell_size_m": "0.125mm"},
+            )
     finally:
         stopped.set()
         sender.join()

@@ -23,8 +23,8 @@ fn scene(path: &str) -> Params {
 
 fn benches(c: &mut Criterion) {
     let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
-    // The reference preset (Love rod, 0.125 mm cells) takes seconds per run: `shpb bench` times it.
-    for f in [Fidelity::Fast, Fidelity::Standard] {
+    // Every preset: `reference` (exact first mode on delay lines at 1 mm) costs ≈ 3× `standard`.
+    for f in Fidelity::ALL {
         let test = Params::from_file_with(&root.join("scenes/shpb-ss440c-10psi.toml"), Some(f))
             .expect("shipped scene");
         c.bench_function(

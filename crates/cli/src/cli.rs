@@ -125,7 +125,8 @@ pub enum FidelityArg {
     Fast,
     /// The default: converged to better than 0.1 % in peak force and displacement at peak.
     Standard,
-    /// Fine grids and the Love-rod bars: the yardstick.
+    /// Exact first-mode dispersion on delay lines at 1 mm (the Love-rod chain at 0.125 mm where
+    /// the bars cannot be delay lines): the yardstick.
     Reference,
 }
 

@@ -61,6 +61,74 @@ fn presets_set_the_knobs_and_explicit_keys_win() {
     );
 }
 
+fn bar_knobs_of(p: &Params) -> (f64, shpb::bar::Dispersion) {
+    match &p.params {
+        SceneParams::Pulse { options, .. } => (options.cell_size_m, options.dispersion),
+        _ => unreachable!("a shpb scene"),
+    }
+}
+
+/// `reference` runs the exact first mode on delay lines at 1 mm where the bars allow it; a set-up
+/// with inserts (not whole cells), or bars no cell ≤ 1 mm divides, falls back to the Love-rod
+/// chain at 0.125 mm; a dispersion chosen in the scene is never replaced.
+#[test]
+fn reference_falls_back_to_the_love_rod_chain_where_delay_lines_cannot_run() {
+    use shpb::bar::Dispersion;
+    let dir = tempfile::TempDir::new().unwrap();
+    let setup = std::fs::read_to_string(repo("bars/authors.toml"))
+        .unwrap()
+        .replace(
+            "gauges = \"gauges-authors.toml\"",
+            &format!(
+                "gauges = \"{}\"",
+                repo("bars/gauges-authors.toml").to_str().unwrap()
+            ),
+        );
+    let scene = |name: &str, setup_text: String, extra: &str| {
+        let bars = dir.path().join(format!("{name}-bars.toml"));
+        std::fs::write(&bars, setup_text).unwrap();
+        let path = dir.path().join(format!("{name}.toml"));
+        std::fs::write(
+            &path,
+            format!(
+                "kind = \"shpb\"\nbars = \"{}\"\npressure = \"10psi\"\nfidelity = \"reference\"\n{extra}[specimen]\npair = \"ss440c\"\n",
+                bars.display()
+            ),
+        )
+        .unwrap();
+        bar_knobs_of(&Params::from_file(&path).unwrap())
+    };
+    let fallback = Fidelity::Reference.fallback_bar_knobs().unwrap();
+    assert_eq!(
+        scene("plain", setup.clone(), ""),
+        (1e-3, Dispersion::PochhammerChree)
+    );
+    let with_inserts = format!(
+        "{setup}\n[inserts.incident]\nlength_m = 0.00635\n[inserts.transmission]\nlength_m = 0.00635\n"
+    );
+    assert_eq!(
+        scene("inserts", with_inserts.clone(), ""),
+        (fallback.cell_size_m, Dispersion::LoveRod)
+    );
+    // A 1.23456 m incident bar: the largest cell dividing it and the 1.02 and 0.10 m bars is
+    // 0.16 mm, beyond the 4× refinement of 1 mm that the preset tries.
+    let odd = setup.replacen("length_m = 1.21", "length_m = 1.23456", 1);
+    assert_eq!(
+        scene("odd", odd, ""),
+        (fallback.cell_size_m, Dispersion::LoveRod)
+    );
+    // An explicit cell that does not divide the bars gets the fallback theory at that cell.
+    assert_eq!(
+        scene("explicit-cell", setup.clone(), "cell_size_m = 0.3e-3\n"),
+        (0.3e-3, Dispersion::LoveRod)
+    );
+    // A dispersion the scene chooses wins over the preset and its fallback.
+    assert_eq!(
+        scene("explicit", with_inserts, "dispersion = \"none\"\n"),
+        (1e-3, Dispersion::None)
+    );
+}
+
 /// `fast` (4 mm cells) and `standard` (1 mm) agree within 0.1 % in peak force and approach at
 /// peak: the bars are exact at Courant 1, so only the joints' O(Δt²) error differs
 /// (validation/perf/REPORT.md measures both against `reference`).

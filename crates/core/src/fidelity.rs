@@ -18,7 +18,8 @@ pub enum Fidelity {
     /// The default: converged to better than 0.1 % in peak force and displacement at peak.
     #[default]
     Standard,
-    /// Fine grids and the Love-rod bars: the yardstick the other presets are measured against.
+    /// Dispersive bars: the exact first Pochhammer–Chree mode on delay lines at 1 mm where every
+    /// bar can be one, else the Love-rod chain at 0.125 mm; the yardstick of the other presets.
     Reference,
 }
 
@@ -65,10 +66,26 @@ impl Fidelity {
                 snapshot_interval_s: 2e-6,
             },
             Fidelity::Reference => BarKnobs {
+                cell_size_m: 1e-3,
+                dispersion: Dispersion::PochhammerChree,
+                snapshot_interval_s: 1e-6,
+            },
+        }
+    }
+
+    /// The knobs a preset falls back to where its own cannot run: `reference`'s delay lines need
+    /// uniform bars a whole number of cells long (docs/physics.md §6.2.1), so a set-up with
+    /// inserts, a cylindrical specimen or bar lengths no cell ≤ 1 mm divides gets the Love-rod
+    /// chain at 0.125 mm (finite differences on any bar; the `reference` of 2026 before the delay
+    /// lines). `None` for presets that run everywhere.
+    pub fn fallback_bar_knobs(self) -> Option<BarKnobs> {
+        match self {
+            Fidelity::Reference => Some(BarKnobs {
                 cell_size_m: 0.125e-3,
                 dispersion: Dispersion::LoveRod,
                 snapshot_interval_s: 1e-6,
-            },
+            }),
+            Fidelity::Fast | Fidelity::Standard => None,
         }
     }
 

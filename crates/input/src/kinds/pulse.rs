@@ -69,7 +69,7 @@ pub(super) const SHAPER: Key = Key {
 pub(super) const CELL_SIZE: Key = Key {
     key: "cell_size_m",
     unit: "m",
-    default: "fidelity: 4e-3, 1e-3, 1.25e-4",
+    default: "fidelity: 4e-3, 1e-3, 1e-3 (reference falls back to 1.25e-4)",
     meaning: "cell size of the bar grid (Δt = Δx/c0, Courant 1), 1e-5 to 0.05",
 };
 
@@ -77,7 +77,7 @@ pub(super) const CELL_SIZE: Key = Key {
 pub(super) const DISPERSION: Key = Key {
     key: "dispersion",
     unit: "",
-    default: "fidelity: none, none, love-rod",
+    default: "fidelity: none, none, pochhammer-chree (reference falls back to love-rod)",
     meaning: "bar theory: none (elementary), love-rod (lateral inertia, finite differences), rayleigh-love or pochhammer-chree (that relation carried by the travelling waves of a delay line: uniform bars a whole number of cells long)",
 };
 
@@ -225,7 +225,28 @@ pub(super) fn parse_bars(
             ));
         }
     };
-    let knobs = fidelity.bar_knobs();
+    // A preset's knobs, or its fallback where its delay lines cannot run (no dispersion chosen in
+    // the scene, and inserts, a cylinder, or bars no cell of at most the preset's divides).
+    let knobs = match fidelity.fallback_bar_knobs() {
+        Some(fallback) if f.dispersion.is_none() => {
+            let preset = fidelity.bar_knobs();
+            let cell = f.cell_size_m.unwrap_or(preset.cell_size_m);
+            let whole = shpb_core::bar::delay_line_cell_m(
+                &[
+                    apparatus.incident.length_m,
+                    apparatus.striker.length_m,
+                    apparatus.transmission.length_m,
+                ],
+                cell,
+            )
+            .is_some_and(|c| f.cell_size_m.is_none() || (c - cell).abs() <= 1e-9 * cell);
+            let plain = apparatus.inserts.incident.is_none()
+                && apparatus.inserts.transmission.is_none()
+                && cylinder.is_none();
+            if whole && plain { preset } else { fallback }
+        }
+        _ => fidelity.bar_knobs(),
+    };
     let dispersion = match f.dispersion.as_deref() {
         None => knobs.dispersion,
         Some(name) => Dispersion::parse(name).ok_or_else(|| {
@@ -355,10 +376,24 @@ pub(super) fn check_bar_key_docs() {
         (format!("{:e}", k.cell_size_m), k.dispersion.name())
     };
     let (cells, dispersions): (Vec<String>, Vec<&str>) = Fidelity::ALL.map(fmt).into_iter().unzip();
-    assert_eq!(CELL_SIZE.default, format!("fidelity: {}", cells.join(", ")));
+    let fallback = Fidelity::Reference
+        .fallback_bar_knobs()
+        .expect("reference has a fallback");
+    assert_eq!(
+        CELL_SIZE.default,
+        format!(
+            "fidelity: {} (reference falls back to {:e})",
+            cells.join(", "),
+            fallback.cell_size_m
+        )
+    );
     assert_eq!(
         DISPERSION.default,
-        format!("fidelity: {}", dispersions.join(", "))
+        format!(
+            "fidelity: {} (reference falls back to {})",
+            dispersions.join(", "),
+            fallback.dispersion.name()
+        )
     );
     assert_eq!(
         GAUGE_LENGTH.default,
