@@ -171,6 +171,11 @@ fn cli_fidelity_flag_and_convergence_errors() {
         .unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
+    // The header names the bars the preset chose.
+    assert!(
+        text.contains("fidelity fast: elementary bars, 4 mm cells"),
+        "{text}"
+    );
     let dt: f64 = text
         .lines()
         .find(|l| l.trim_start().starts_with("time_step "))

@@ -92,12 +92,33 @@ fn load(scene: &Path, fidelity: Option<Fidelity>) -> Result<(Params, Provenance)
 
 /// Prints the run summary; a closed pipe (`shpb run … | head`) is not an error.
 fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
+    // The bars a preset chose (`reference` falls back to the Love-rod chain where its delay
+    // lines cannot run, docs/physics.md §6.2.1): the user sees which ran.
+    let bars = match &params.params {
+        SceneParams::Pulse { options, .. } => format!(
+            ", fidelity {}: {} bars, {} mm cells",
+            params.fidelity.name(),
+            match options.dispersion {
+                shpb_core::bar::Dispersion::None => "elementary",
+                d => d.name(),
+            },
+            options.cell_size_m * 1e3
+        ),
+        _ => String::new(),
+    };
+    let bar_knobs = match &params.params {
+        SceneParams::Pulse { options, .. } => serde_json::json!({
+            "dispersion": options.dispersion.name(),
+            "cell_size_m": options.cell_size_m,
+        }),
+        _ => serde_json::Value::Null,
+    };
     let mut text = if matches!(&params.params, SceneParams::Pulse { options, .. } if options.specimen.is_none())
     {
-        format!("scene: {} (kind {})\n", params.source, params.kind)
+        format!("scene: {} (kind {}{bars})\n", params.source, params.kind)
     } else {
         format!(
-            "scene: {} (kind {}, law {})\n",
+            "scene: {} (kind {}, law {}{bars})\n",
             params.source,
             params.kind,
             params.contact_law().name()
@@ -146,6 +167,7 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             "kind": params.kind,
             "law": params.contact_law().name(),
             "fidelity": params.fidelity.name(),
+            "bars": bar_knobs,
             "summary": summary,
             "result": comparison,
             "warnings": out.warnings,
