@@ -289,7 +289,7 @@ pub fn simulate_chain_with(
         .joints
         .iter()
         .position(|j| j.law.is_some())
-        .map(|k| ContactRecorder::new(k, setup.record_every, cap));
+        .map(|k| ContactRecorder::new(k, setup.record_every, setup.dt_s, cap));
     let mut snapshots = setup
         .snapshot_every
         .map(|k| SnapshotRecorder::new(&chain.bodies, k, setup.snapshot_spacing_m));

@@ -148,23 +148,30 @@ impl Recorder for EnergyRecorder {
     }
 }
 
-/// The history of one sphere contact (approach, force, σy*, strain rate) every `every` steps.
+/// The history of one sphere contact (approach, force, σy*, strain rate) every `every` steps,
+/// each sample at the time of the level it belongs to: the step from level n to n + 1 solves the
+/// joint at level n (Newmark-average closure and centred rate, [`super::joint`]), so the joint
+/// read after that step is stamped t_n, not t_{n+1} (the gauges, read from the bodies, are at
+/// t_{n+1}).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactRecorder {
     /// Index of the joint recorded.
     pub joint: usize,
     /// Sampling interval in steps.
     pub every: usize,
+    /// Time step, s.
+    pub dt_s: f64,
     /// The series.
     pub series: ContactSeries,
 }
 
 impl ContactRecorder {
-    /// A recorder of joint `joint` every `every` steps, with room for `capacity` samples.
-    pub fn new(joint: usize, every: usize, capacity: usize) -> ContactRecorder {
+    /// A recorder of joint `joint` every `every` steps of `dt_s`, with room for `capacity` samples.
+    pub fn new(joint: usize, every: usize, dt_s: f64, capacity: usize) -> ContactRecorder {
         ContactRecorder {
             joint,
             every,
+            dt_s,
             series: ContactSeries {
                 time_s: Some(Vec::with_capacity(capacity)),
                 yield_stress_pa: Some(Vec::with_capacity(capacity)),
@@ -177,9 +184,11 @@ impl ContactRecorder {
 
 impl Recorder for ContactRecorder {
     fn record(&mut self, step: usize, time_s: f64, _bodies: &[Body], joints: &[JointState]) {
-        if step.is_multiple_of(self.every) {
+        // After step k the joint holds level k − 1 (nothing before the first step).
+        if step >= 1 && (step - 1).is_multiple_of(self.every) {
             let j = &joints[self.joint];
-            self.series.push(time_s, j.approach_m, &j.contact);
+            self.series
+                .push((time_s - self.dt_s).max(0.0), j.approach_m, &j.contact);
         }
     }
 }
