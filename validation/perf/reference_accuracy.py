@@ -9,7 +9,7 @@ each under the default `dynamic` unloading, and the `pochhammer-chree` ladder ag
 the next finer one (docs/physics.md §3, "A continuous turn"; validation/perf/REPORT.md).
 
 Metrics, each relative: peak contact force and the approach at it (parabola through the three
-samples around the largest force), and the RMS differences of the transmission-gauge strain, the
+samples around the largest force before the largest approach), and the RMS differences of the transmission-gauge strain, the
 incident-gauge strain and the contact force over the run, each over its series' largest magnitude
 (signals interpolated linearly onto the finer run's samples).
 
@@ -59,9 +59,11 @@ def run(shpb, work, dispersion, unloading, cell_mm):
 
 
 def peak(r):
-    """Peak force and approach at it, by a parabola through the three samples around it."""
+    """Peak force of the loading and approach at it, by a parabola through the three samples
+    around it. The loading ends at the largest approach: under the `dynamic` unloading the force
+    jumps back to the largest one reached there, which must not be taken for the peak."""
     f, d = r["force"], r["delta"]
-    k = int(np.argmax(f))
+    k = int(np.argmax(f[: int(np.argmax(d)) + 1]))
     k = min(max(k, 1), len(f) - 2)
     a, b, c = f[k - 1], f[k], f[k + 1]
     denom = a - 2 * b + c

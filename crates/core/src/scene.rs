@@ -424,7 +424,11 @@ fn run_pulse(
     // stays as it was: `/contact` holds its one contact).
     let spheres = options.specimen.as_ref().map_or(0, |sp| sp.spheres.len());
     let mut spheres_rec = (spheres >= 3).then(|| {
-        crate::solver::record::SphereChainRecorder::new(&chain.joints, chain.record_every)
+        crate::solver::record::SphereChainRecorder::new(
+            &chain.joints,
+            chain.record_every,
+            chain.dt_s,
+        )
     });
     let mut recorders: Vec<&mut dyn crate::solver::Recorder> = vec![&mut report];
     if let Some(rec) = spheres_rec.as_mut() {

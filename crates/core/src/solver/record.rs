@@ -5,6 +5,7 @@
 use super::body::Body;
 use super::joint::JointState;
 use crate::bar::Bar;
+use crate::contact::ContactEval;
 use crate::solver::ContactSeries;
 
 /// Something that samples a chain while it runs.
@@ -184,11 +185,20 @@ impl ContactRecorder {
 
 impl Recorder for ContactRecorder {
     fn record(&mut self, step: usize, time_s: f64, _bodies: &[Body], joints: &[JointState]) {
-        // After step k the joint holds level k − 1 (nothing before the first step).
+        // After step k the joint holds level k − 1 (nothing before the first step). The force
+        // is the one the joint applied to the bodies (what the gauges see): it equals the law's
+        // value at the committed approach to the solve's 1e-12, except where the solve stops on
+        // the law's jump at a turning point (the `dynamic` unloading starts from the largest
+        // force reached, so at δ = δmax the law holds any force between the loading and that
+        // one; joint.rs), where the law's value alone would read the largest force again.
         if step >= 1 && (step - 1).is_multiple_of(self.every) {
             let j = &joints[self.joint];
+            let applied = ContactEval {
+                force_n: j.force_n,
+                ..j.contact
+            };
             self.series
-                .push((time_s - self.dt_s).max(0.0), j.approach_m, &j.contact);
+                .push((time_s - self.dt_s).max(0.0), j.approach_m, &applied);
         }
     }
 }
@@ -218,19 +228,23 @@ pub struct ChainSeries {
 pub struct SphereChainRecorder {
     /// Sampling interval in steps.
     pub every: usize,
+    /// Time step, s.
+    pub dt_s: f64,
     /// Indices of the sphere-contact joints, in order along the chain.
     pub joints: Vec<usize>,
     /// Each sphere as (body index, end of that body it sits at: `Some(right)` for a bar's end
     /// node, `None` for a rigid mass).
     pub spheres: Vec<(usize, Option<bool>)>,
-    /// The series (velocities are at the half step, as the bodies keep them; the final
-    /// velocities are filled in by [`SphereChainRecorder::into_series`]).
+    /// The series, on the times of the levels the contacts were solved at, as
+    /// [`ContactRecorder`]'s (velocities are the bodies' half-step ones, v^{n+1/2} on the sample
+    /// at t_n; the final velocities are filled in by [`SphereChainRecorder::into_series`]).
     pub series: ChainSeries,
 }
 
 impl SphereChainRecorder {
-    /// A recorder of the sphere contacts of `joints` (the chain's joints), every `every` steps.
-    pub fn new(joints: &[super::joint::Joint], every: usize) -> SphereChainRecorder {
+    /// A recorder of the sphere contacts of `joints` (the chain's joints), every `every` steps
+    /// of `dt_s`.
+    pub fn new(joints: &[super::joint::Joint], every: usize, dt_s: f64) -> SphereChainRecorder {
         let contacts: Vec<usize> = joints
             .iter()
             .enumerate()
@@ -246,6 +260,7 @@ impl SphereChainRecorder {
         }
         SphereChainRecorder {
             every,
+            dt_s,
             series: ChainSeries {
                 time_s: Vec::new(),
                 contact_force_n: vec![Vec::new(); contacts.len()],
@@ -275,12 +290,14 @@ impl SphereChainRecorder {
 
 impl Recorder for SphereChainRecorder {
     fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]) {
-        if !step.is_multiple_of(self.every) {
+        // After step k the joints hold level k − 1 ([`ContactRecorder`]).
+        if step == 0 || !(step - 1).is_multiple_of(self.every) {
             return;
         }
-        self.series.time_s.push(time_s);
+        self.series.time_s.push((time_s - self.dt_s).max(0.0));
         for (k, &j) in self.joints.iter().enumerate() {
-            self.series.contact_force_n[k].push(joints[j].contact.force_n);
+            // The force applied to the bodies, as `ContactRecorder` records it.
+            self.series.contact_force_n[k].push(joints[j].force_n);
             self.series.contact_approach_m[k].push(joints[j].approach_m);
         }
         for (k, &(b, end)) in self.spheres.iter().enumerate() {
