@@ -18,11 +18,8 @@ fn run(text: &str) -> RunOutput {
 }
 
 fn summary(out: &RunOutput, key: &str) -> f64 {
-    out.summary
-        .iter()
-        .find(|i| i.key == key)
+    out.summary_value(key)
         .unwrap_or_else(|| panic!("no summary item {key}"))
-        .value
 }
 
 /// Largest |a − b| over the common length, relative to the largest |b|.

@@ -37,11 +37,7 @@ fn cylinder_of(params: &Params) -> CylinderSpecimen {
 }
 
 fn summary(out: &shpb::run::RunOutput, key: &str) -> f64 {
-    out.summary
-        .iter()
-        .find(|i| i.key == key)
-        .unwrap_or_else(|| panic!("no {key}"))
-        .value
+    out.summary_value(key).unwrap_or_else(|| panic!("no {key}"))
 }
 
 /// Simulates `scene`, reduces its gauge strains back through the library

@@ -328,7 +328,7 @@ fn a_dispersive_test_runs_at_every_preset() {
             .unwrap()
             .run()
             .unwrap();
-        let get = |key: &str| out.summary.iter().find(|i| i.key == key).unwrap().value;
+        let get = |key: &str| out.summary_value(key).unwrap();
         assert!(
             (get("time_step") * c0 / cell - 1.0).abs() < 1e-12,
             "{fidelity}"

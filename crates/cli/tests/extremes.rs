@@ -793,20 +793,12 @@ fn a_10_ms_shpb_test_stays_finite_and_conserves_energy() {
     // The contact is sampled at the levels its joint is solved at: every one but the last, so
     // its series ends one time step before the run does.
     let c = out.contact.as_ref().unwrap();
-    let dt = out
-        .summary
-        .iter()
-        .find(|i| i.key == "time_step")
-        .unwrap()
-        .value;
+    let dt = out.summary_value("time_step").unwrap();
     assert!(*c.time_s.as_ref().unwrap().last().unwrap() >= 10e-3 - dt * (1.0 + 1e-9));
     summary_finite(&out, "10 ms SHPB");
     let err = out
-        .summary
-        .iter()
-        .find(|i| i.key == "energy_balance_max_relative_error")
-        .unwrap()
-        .value;
+        .summary_value("energy_balance_max_relative_error")
+        .unwrap();
     assert!(err < 1e-9, "energy balance error {err:e}");
     for g in &out.gauges {
         assert!(g.strain.iter().all(|x| x.is_finite()), "gauge {}", g.name);

@@ -160,12 +160,7 @@ fn the_contact_series_is_on_the_time_of_its_level() {
             .unwrap()
             .run()
             .unwrap();
-        let dt = out
-            .summary
-            .iter()
-            .find(|i| i.key == "time_step")
-            .unwrap()
-            .value;
+        let dt = out.summary_value("time_step").unwrap();
         let c = out.contact.unwrap();
         let t = c.time_s.unwrap();
         // Sampled every step: consecutive samples one step apart, the first at t = 0.

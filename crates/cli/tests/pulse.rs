@@ -99,8 +99,7 @@ fn copper_shaper_ramps_the_pulse_and_the_energy_balances() {
     let shaped = pulse_scene("pressure = \"12.5psi\"\n");
     let plain = pulse_scene("pressure = \"12.5psi\"\n[shaper]\nenabled = false\n");
     let (a, b) = (shaped.run().unwrap(), plain.run().unwrap());
-    let get =
-        |o: &shpb::run::RunOutput, k: &str| o.summary.iter().find(|i| i.key == k).unwrap().value;
+    let get = |o: &shpb::run::RunOutput, k: &str| o.summary_value(k).unwrap();
     // The shaper lowers the peak, slows the rise (from one cell to tens of µs) and lengthens the pulse.
     assert!(get(&a, "incident_peak_stress") < 0.8 * get(&b, "incident_peak_stress"));
     assert!(get(&a, "incident_rise_10_90") > 20e-6 && get(&b, "incident_rise_10_90") < 1e-6);
@@ -129,11 +128,7 @@ fn pulse_converges_with_cell_size() {
         ))
         .run()
         .unwrap();
-        o.summary
-            .iter()
-            .find(|i| i.key == "incident_peak_stress")
-            .unwrap()
-            .value
+        o.summary_value("incident_peak_stress").unwrap()
     };
     let (a, b) = (peak("1e-3"), peak("0.25e-3"));
     assert!(rel(a, b) < 5e-3, "{a:e} vs {b:e}");

@@ -102,6 +102,11 @@ pub struct PeakComparison {
 }
 
 impl RunOutput {
+    /// The value of the summary item `key` (`shpb run`'s summary lines), if the run has it.
+    pub fn summary_value(&self, key: &str) -> Option<f64> {
+        self.summary.iter().find(|i| i.key == key).map(|i| i.value)
+    }
+
     /// The true and the reduced peak force of a full test over the same window (the reduction's
     /// window, [`PeakComparison`]); None without a reduction or a timed contact history.
     pub fn peak_comparison(&self) -> Option<PeakComparison> {
