@@ -810,8 +810,6 @@ pub fn bands(traces: &[&Trace]) -> Option<(Vec<f64>, [Vec<f64>; 3])> {
 mod tests {
     use super::*;
 
-    /// Standard normal CDF by the complementary error function's series-free bound check:
-    /// Φ(Φ⁻¹(p)) = p is tested against known quantiles instead.
     #[test]
     fn the_stream_is_xoshiro256_starstar_seeded_by_splitmix64() {
         // The reference algorithms written out (Blackman & Vigna; Steele, Lea & Flood): the
@@ -847,6 +845,8 @@ mod tests {
         }
     }
 
+    /// Standard normal CDF by the complementary error function's series-free bound check:
+    /// Φ(Φ⁻¹(p)) = p is tested against known quantiles instead.
     #[test]
     fn the_normal_quantile_matches_tabulated_values() {
         // Φ⁻¹ at 0.5, 0.975, 0.95, 0.001 (tables; Acklam's relative error < 1.15e-9).

@@ -94,24 +94,23 @@ fn load(scene: &Path, fidelity: Option<Fidelity>) -> Result<(Params, Provenance)
 fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
     // The bars a preset chose (`reference` falls back to the Love-rod chain where its delay
     // lines cannot run, docs/physics.md §6.2.1): the user sees which ran.
-    let bars = match &params.params {
-        SceneParams::Pulse { options, .. } => format!(
-            ", fidelity {}: {} bars, {} mm cells",
-            params.fidelity.name(),
-            match options.dispersion {
-                shpb_core::bar::Dispersion::None => "elementary",
-                d => d.name(),
-            },
-            options.cell_size_m * 1e3
+    let (bars, bar_knobs) = match &params.params {
+        SceneParams::Pulse { options, .. } => (
+            format!(
+                ", fidelity {}: {} bars, {} mm cells",
+                params.fidelity.name(),
+                match options.dispersion {
+                    shpb_core::bar::Dispersion::None => "elementary",
+                    d => d.name(),
+                },
+                options.cell_size_m * 1e3
+            ),
+            serde_json::json!({
+                "dispersion": options.dispersion.name(),
+                "cell_size_m": options.cell_size_m,
+            }),
         ),
-        _ => String::new(),
-    };
-    let bar_knobs = match &params.params {
-        SceneParams::Pulse { options, .. } => serde_json::json!({
-            "dispersion": options.dispersion.name(),
-            "cell_size_m": options.cell_size_m,
-        }),
-        _ => serde_json::Value::Null,
+        _ => (String::new(), serde_json::Value::Null),
     };
     let mut text = if matches!(&params.params, SceneParams::Pulse { options, .. } if options.specimen.is_none())
     {

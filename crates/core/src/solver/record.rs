@@ -183,22 +183,28 @@ impl ContactRecorder {
     }
 }
 
+/// The time of the level whose joint solves the chain holds after step `step`, if a sample of
+/// every `every` levels is due: the step from level n to n + 1 solves the joints at level n, so
+/// after step k they hold level k − 1, at t = (k − 1) Δt (`None` before the first step).
+fn joint_level_time(step: usize, every: usize, dt_s: f64) -> Option<f64> {
+    let level = step.checked_sub(1)?;
+    level.is_multiple_of(every).then_some(level as f64 * dt_s)
+}
+
 impl Recorder for ContactRecorder {
-    fn record(&mut self, step: usize, time_s: f64, _bodies: &[Body], joints: &[JointState]) {
-        // After step k the joint holds level k − 1 (nothing before the first step). The force
-        // is the one the joint applied to the bodies (what the gauges see): it equals the law's
-        // value at the committed approach to the solve's 1e-12, except where the solve stops on
-        // the law's jump at a turning point (the `dynamic` unloading starts from the largest
-        // force reached, so at δ = δmax the law holds any force between the loading and that
-        // one; joint.rs), where the law's value alone would read the largest force again.
-        if step >= 1 && (step - 1).is_multiple_of(self.every) {
+    fn record(&mut self, step: usize, _time_s: f64, _bodies: &[Body], joints: &[JointState]) {
+        // The force is the one the joint applied to the bodies (what the gauges see): it equals
+        // the law's value at the committed approach to the solve's 1e-12, except where the solve
+        // stops on the law's jump at a turning point (the `dynamic` unloading starts from the
+        // largest force reached, so at δ = δmax the law holds any force between the loading and
+        // that one; joint.rs), where the law's value alone would read the largest force again.
+        if let Some(t) = joint_level_time(step, self.every, self.dt_s) {
             let j = &joints[self.joint];
             let applied = ContactEval {
                 force_n: j.force_n,
                 ..j.contact
             };
-            self.series
-                .push((time_s - self.dt_s).max(0.0), j.approach_m, &applied);
+            self.series.push(t, j.approach_m, &applied);
         }
     }
 }
@@ -289,12 +295,11 @@ impl SphereChainRecorder {
 }
 
 impl Recorder for SphereChainRecorder {
-    fn record(&mut self, step: usize, time_s: f64, bodies: &[Body], joints: &[JointState]) {
-        // After step k the joints hold level k − 1 ([`ContactRecorder`]).
-        if step == 0 || !(step - 1).is_multiple_of(self.every) {
+    fn record(&mut self, step: usize, _time_s: f64, bodies: &[Body], joints: &[JointState]) {
+        let Some(t) = joint_level_time(step, self.every, self.dt_s) else {
             return;
-        }
-        self.series.time_s.push((time_s - self.dt_s).max(0.0));
+        };
+        self.series.time_s.push(t);
         for (k, &j) in self.joints.iter().enumerate() {
             // The force applied to the bodies, as `ContactRecorder` records it.
             self.series.contact_force_n[k].push(joints[j].force_n);

@@ -227,19 +227,17 @@ pub(super) fn parse_bars(
     };
     // A preset's knobs, or its fallback where its delay lines cannot run (no dispersion chosen in
     // the scene, and inserts, a cylinder, or bars no cell of at most the preset's divides).
+    let bar_lengths_m = [
+        apparatus.incident.length_m,
+        apparatus.striker.length_m,
+        apparatus.transmission.length_m,
+    ];
     let knobs = match fidelity.fallback_bar_knobs() {
         Some(fallback) if f.dispersion.is_none() => {
             let preset = fidelity.bar_knobs();
             let cell = f.cell_size_m.unwrap_or(preset.cell_size_m);
-            let whole = shpb_core::bar::delay_line_cell_m(
-                &[
-                    apparatus.incident.length_m,
-                    apparatus.striker.length_m,
-                    apparatus.transmission.length_m,
-                ],
-                cell,
-            )
-            .is_some_and(|c| f.cell_size_m.is_none() || (c - cell).abs() <= 1e-9 * cell);
+            let whole = shpb_core::bar::delay_line_cell_m(&bar_lengths_m, cell)
+                .is_some_and(|c| f.cell_size_m.is_none() || (c - cell).abs() <= 1e-9 * cell);
             let plain = apparatus.inserts.incident.is_none()
                 && apparatus.inserts.transmission.is_none()
                 && cylinder.is_none();
@@ -266,15 +264,9 @@ pub(super) fn parse_bars(
     // the preset's cell is refined to the largest that divides every bar (10/3 mm for the
     // authors' bars at `fast`); an explicit cell that does not is refused by the bars.
     let default_cell = match dispersion.transit_model() {
-        Some(_) => shpb_core::bar::delay_line_cell_m(
-            &[
-                apparatus.incident.length_m,
-                apparatus.striker.length_m,
-                apparatus.transmission.length_m,
-            ],
-            default_cell,
-        )
-        .unwrap_or(default_cell),
+        Some(_) => {
+            shpb_core::bar::delay_line_cell_m(&bar_lengths_m, default_cell).unwrap_or(default_cell)
+        }
         None => default_cell,
     };
     let cell = v.in_range(

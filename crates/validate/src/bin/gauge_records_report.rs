@@ -1760,45 +1760,67 @@ fn mass_between_faces_section(w: &mut String, rows: &[Row], z: f64, ea: f64) {
         w,
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
+    /// One record's fits (m kg, R²): the record with the stated geometry and on its feet, and its
+    /// virtual tests (a) shipped, (b) bar-steel inserts, (d) heavy inserts.
+    struct Fits {
+        stated: (f64, f64),
+        feet: (f64, f64),
+        shipped: (f64, f64),
+        inserts: (f64, f64),
+        heavy: (f64, f64),
+    }
     let g = |r: &Reduction| mass_between_faces(r, z);
     let feet = |r: &Row, f: &dyn Fn(&Reduction) -> f64| {
         r.timing.record_on_feet.as_ref().map_or(f64::NAN, f)
     };
-    for r in rows {
+    let fits: Vec<Fits> = rows
+        .iter()
+        .map(|r| Fits {
+            stated: g(&r.ours),
+            feet: r
+                .timing
+                .record_on_feet
+                .as_ref()
+                .map_or((f64::NAN, f64::NAN), g),
+            shipped: g(&r.timing.shipped.reduction),
+            inserts: g(&r.timing.inserts.reduction),
+            heavy: g(&r.timing.heavy.reduction),
+        })
+        .collect();
+    for (r, m) in rows.iter().zip(&fits) {
         let t = &r.timing;
-        let (m_rec, r2_rec) = g(&r.ours);
-        let (m_heavy, r2_heavy) = g(&t.heavy.reduction);
         let _ = writeln!(
             w,
             "| {} | {} {} psi | {:+.1} | {:.3} | {:+.1} | {:.3} | {:+.1} | {:+.1} | {:+.1} | {:.3} | {:.3} | {:.3} | {:+.1} | {:+.1} |",
             r.n,
             r.material,
             r.psi,
-            m_rec * 1e3,
-            r2_rec,
-            feet(r, &|x| g(x).0 * 1e3),
-            feet(r, &|x| g(x).1),
-            g(&t.shipped.reduction).0 * 1e3,
-            g(&t.inserts.reduction).0 * 1e3,
-            m_heavy * 1e3,
-            r2_heavy,
+            m.stated.0 * 1e3,
+            m.stated.1,
+            m.feet.0 * 1e3,
+            m.feet.1,
+            m.shipped.0 * 1e3,
+            m.inserts.0 * 1e3,
+            m.heavy.0 * 1e3,
+            m.heavy.1,
             t.heavy.reduction.equilibrium_ratio_at_peak,
             feet(r, &|x| x.equilibrium_ratio_at_peak),
             imbalance_of_incident(&t.heavy.reduction, ea) * 100.0,
             feet(r, &|x| imbalance_of_incident(x, ea) * 100.0),
         );
     }
-    let range = |f: &dyn Fn(&Row) -> f64| min_max(rows.iter().map(f));
-    let m_rec = range(&|r| g(&r.ours).0 * 1e3);
-    let r2_rec = range(&|r| g(&r.ours).1);
-    let m_feet = range(&|r| feet(r, &|x| g(x).0 * 1e3));
-    let r2_feet = range(&|r| feet(r, &|x| g(x).1));
-    let m_heavy = range(&|r| g(&r.timing.heavy.reduction).0 * 1e3);
-    let r2_heavy = range(&|r| g(&r.timing.heavy.reduction).1);
-    let m_shipped = range(&|r| g(&r.timing.shipped.reduction).0 * 1e3);
-    let share_heavy = range(&|r| imbalance_of_incident(&r.timing.heavy.reduction, ea) * 100.0);
-    let share_feet = range(&|r| feet(r, &|x| imbalance_of_incident(x, ea) * 100.0));
-    let factor = range(&|r| {
+    let range =
+        |f: &dyn Fn(&Row, &Fits) -> f64| min_max(rows.iter().zip(&fits).map(|(r, m)| f(r, m)));
+    let m_rec = range(&|_, m| m.stated.0 * 1e3);
+    let r2_rec = range(&|_, m| m.stated.1);
+    let m_feet = range(&|_, m| m.feet.0 * 1e3);
+    let r2_feet = range(&|_, m| m.feet.1);
+    let m_heavy = range(&|_, m| m.heavy.0 * 1e3);
+    let r2_heavy = range(&|_, m| m.heavy.1);
+    let m_shipped = range(&|_, m| m.shipped.0 * 1e3);
+    let share_heavy = range(&|r, _| imbalance_of_incident(&r.timing.heavy.reduction, ea) * 100.0);
+    let share_feet = range(&|r, _| feet(r, &|x| imbalance_of_incident(x, ea) * 100.0));
+    let factor = range(&|r, _| {
         let (a, b) = (
             r.timing.heavy.reduction.equilibrium_ratio_at_peak,
             feet(r, &|x| x.equilibrium_ratio_at_peak),
