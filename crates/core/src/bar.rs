@@ -620,7 +620,7 @@ struct Waves {
 struct Transit {
     /// The design, shared with every bar like this one ([`crate::transit::shared_design`]).
     design: Arc<TransitDesign>,
-    /// The end-to-end filter (N − 1 cells).
+    /// The end-to-end filter (N cells: end node to end node).
     ends: Arc<SharedFilter>,
     /// Right-going increments A[m] injected at the left end at step m, at index m + offset
     /// (m ≥ −N: the initial field, older: its last value repeated), m.
@@ -651,7 +651,7 @@ struct Transit {
 impl Transit {
     /// The transit of a delay line of `n` elements at rest ([`Transit::restart`] takes its field).
     fn new(design: Arc<TransitDesign>, n: usize) -> Transit {
-        let ends = design.shared_filter(n - 1);
+        let ends = design.shared_filter(2 * n);
         let ends_gain_excess = (ends.max_power_gain() - 1.0).max(0.0);
         let lag = n - ends.filter.lead;
         let blocks = BlockConvolver::new(&ends.filter.taps, lag).map(|c| Box::new([c.clone(), c]));
@@ -744,16 +744,17 @@ impl Transit {
         self.update_arrivals();
     }
 
-    /// Right-going increment at element e (0 < e < N − 1): A[n − e − 1] carried over e cells.
+    /// Right-going increment at element e (0 < e < N − 1): A[n − e − 1] carried over e + ½ cells.
     fn right_at(&self, e: usize) -> f64 {
-        let f = self.design.shared_filter(e);
+        let f = self.design.shared_filter(2 * e + 1);
         f.apply(&self.injected_right, self.step + self.offset - e - 1)
     }
 
-    /// Left-going increment at element e (0 < e < N − 1): B[n − (N − e)] carried over N − 1 − e cells.
+    /// Left-going increment at element e (0 < e < N − 1): B[n − (N − e)] carried over N − e − ½
+    /// cells.
     fn left_at(&self, e: usize) -> f64 {
         let n = self.elements;
-        let f = self.design.shared_filter(n - 1 - e);
+        let f = self.design.shared_filter(2 * (n - e) - 1);
         f.apply(&self.injected_left, self.step + self.offset - (n - e))
     }
 }
@@ -786,7 +787,8 @@ impl Waves {
     }
 
     /// Right-going increment at element e at the current level: D_{e−n}, or with dispersion the
-    /// wave injected e + 1 steps ago carried over e cells, m.
+    /// wave injected e + 1 steps ago carried over e + ½ cells (at element N − 1 the arrival at
+    /// the end node, over N), m.
     #[inline]
     fn d(&self, e: usize) -> f64 {
         match &self.transit {
@@ -802,7 +804,8 @@ impl Waves {
     }
 
     /// Left-going increment at element e at the current level: E_{e+n}, or with dispersion the
-    /// wave injected N − e steps ago carried over N − 1 − e cells, m.
+    /// wave injected N − e steps ago carried over N − e − ½ cells (at element 0 the arrival at
+    /// the end node, over N), m.
     #[inline]
     fn e(&self, e: usize) -> f64 {
         match &self.transit {

@@ -14,11 +14,15 @@
 //! ```
 //!
 //! The transit filter over d cells is the all-pass response `H_d(Ω) = exp(−i d φ(Ω))` (the whole
-//! delay is d steps of the delay line plus H_d). Its impulse response is computed once per
-//! distance on an FFT grid, shifted by `lead` samples so that its small acausal precursor (the
-//! first mode alone is not exactly causal) sits at non-negative indices, and truncated where the
-//! energy left out on either side is below [`TAIL_ENERGY`] of the whole; the taps are then
-//! scaled so that they sum to one (a static strain passes unchanged).
+//! delay is d steps of the delay line plus H_d). A wave is born at its end node half a step after
+//! the step that injects it, so element e (counted from that end, from 0) holds it after e + ½
+//! cells and the far end node of a bar of N cells receives it after N: those are the distances
+//! its filters carry (only the element it is injected into reads it undispersed). Each impulse
+//! response is computed once per distance on an FFT grid, shifted by `lead` samples so that its
+//! small acausal precursor (the first mode alone is not exactly causal) sits at non-negative
+//! indices, and truncated where the energy left out on either side is below [`TAIL_ENERGY`] of
+//! the whole; the taps are then scaled so that they sum to one (a static strain passes
+//! unchanged).
 //!
 //! Rayleigh–Love: `ω = c0 k/√(1 + βk²)`, β = ν²a²/2 (docs/physics.md §6.3), so
 //! `kΔx = Ω/√(1 − βΩ²/Δx²)` and `φ = kΔx − Ω` below the cut-off `Ω_c = Δx/√β`; above it the
@@ -61,7 +65,7 @@ pub struct TransitDesign {
     /// Weight of each bin in one transit: 1 in the pass band, a smooth step to 0 across the
     /// taper (module docs, "Band").
     gain: Vec<f64>,
-    /// Filters designed so far, by cells ([`TransitDesign::shared_filter`]).
+    /// Filters designed so far, by half cells ([`TransitDesign::shared_filter`]).
     filters: Mutex<HashMap<usize, Arc<SharedFilter>>>,
 }
 
@@ -136,7 +140,7 @@ pub fn shared_design(
 }
 
 /// The impulse response of the transit over some cells: `taps[j]` weighs the wave injected
-/// `j − lead` steps before the pure delay would deliver it (`lead` ≤ the cells: module docs,
+/// `j − lead` steps before the pure delay would deliver it (`lead` < the cells: module docs,
 /// "Causality").
 #[derive(Debug, Clone, PartialEq)]
 pub struct TransitFilter {
@@ -255,16 +259,18 @@ impl TransitDesign {
         Complex64::from_polar(self.gain[k], -cells * self.phase[k])
     }
 
-    /// The transit filter over `cells` cells (module docs).
-    pub fn filter(&self, cells: usize) -> TransitFilter {
-        if cells == 0 {
+    /// The transit filter over `half_cells`/2 cells (module docs): a wave read at an element's
+    /// centre has crossed a whole number of cells and a half, one read at the far end node a
+    /// whole number.
+    pub fn filter(&self, half_cells: usize) -> TransitFilter {
+        if half_cells == 0 {
             return TransitFilter {
                 lead: 0,
                 taps: vec![1.0],
             };
         }
         let n = self.n_fft;
-        let d = cells as f64;
+        let d = 0.5 * half_cells as f64;
         let mut spectrum: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
         for k in 0..=n / 2 {
             let h = self.response(k, d);
@@ -292,9 +298,10 @@ impl TransitDesign {
             ahead += h[n - lead] * h[n - lead];
             lead -= 1;
         }
-        // Causality: a wave read d cells from where it entered was injected at least d steps
-        // before the pure delay delivers it, so at most d samples of precursor can be known.
-        let lead = lead.min(cells);
+        // Causality: a wave read d cells from where it entered was injected ⌈d⌉ steps before
+        // the pure delay delivers it (born half a step after its injection step), so at most
+        // ⌈d⌉ − 1 samples of precursor can be known.
+        let lead = lead.min(half_cells.div_ceil(2) - 1);
         let mut taps: Vec<f64> = (1..=lead).rev().map(|t| h[n - t]).collect();
         taps.extend_from_slice(&h[..len]);
         let sum: f64 = taps.iter().sum();
@@ -306,17 +313,17 @@ impl TransitDesign {
         TransitFilter { lead, taps }
     }
 
-    /// [`TransitDesign::filter`] over `cells` cells, designed once per design.
-    pub fn shared_filter(&self, cells: usize) -> Arc<SharedFilter> {
+    /// [`TransitDesign::filter`] over `half_cells`/2 cells, designed once per design.
+    pub fn shared_filter(&self, half_cells: usize) -> Arc<SharedFilter> {
         if let Some(f) = self
             .filters
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .get(&cells)
+            .get(&half_cells)
         {
             return Arc::clone(f);
         }
-        let filter = self.filter(cells);
+        let filter = self.filter(half_cells);
         let f = Arc::new(SharedFilter {
             oldest_first: filter.taps.iter().rev().copied().collect(),
             filter,
@@ -325,7 +332,7 @@ impl TransitDesign {
         self.filters
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .insert(cells, Arc::clone(&f));
+            .insert(half_cells, Arc::clone(&f));
         f
     }
 }
@@ -350,9 +357,9 @@ impl TransitDesign {
     /// indices `times`, from its whole histories (module docs, "After the run"): `right[i]` and
     /// `left[i]` are the increments injected at index i (i from the start of the histories,
     /// whose first value stands for all earlier ones). The element fields are
-    /// `R_e(t) = (h_e ⊛ right)(t − e − 1)` and `L_e(t) = (h_{N−1−e} ⊛ left)(t − N + e)`, with the
-    /// exact responses h_c (not truncated, precursor included) and the first cell of each wave
-    /// undispersed, as the delay line reads them step by step. Returns one row per point.
+    /// `R_e(t) = (h_{e+½} ⊛ right)(t − e − 1)` and `L_e(t) = (h_{N−e−½} ⊛ left)(t − N + e)`, with
+    /// the exact responses h_d (not truncated, precursor included) and the first cell of each
+    /// wave undispersed, as the delay line reads them step by step. Returns one row per point.
     ///
     /// One FFT of each history, then per point its spectrum (z^e by recurrence from the previous
     /// point, |z| = 1) and one inverse FFT; when the times are a progression of stride K (x–t
@@ -402,10 +409,12 @@ impl TransitDesign {
         let (fa, fb) = (spectrum(right, a0), spectrum(left, b0));
         let half = n / 2;
         let last = elements - 1;
-        // Per bin k = 0..=n/2: z = e^{−i(Ω + φ)} (one cell), the band's weight, and the history
-        // spectra times the one-step delay (the left one carried over the whole bar, z^{N−1}).
+        // Per bin k = 0..=n/2: z = e^{−i(Ω + φ)} (one cell), the band's weight times the
+        // dispersion of the half cell between an element's centre and its end of the bar, and
+        // the history spectra times the one-step delay (the left one carried over the whole
+        // bar, z^{N−1}).
         let mut z = Vec::with_capacity(half + 1);
-        let mut gain = Vec::with_capacity(half + 1);
+        let mut carry = Vec::with_capacity(half + 1);
         let mut u = Vec::with_capacity(half + 1);
         let mut v = Vec::with_capacity(half + 1);
         for k in 0..=half {
@@ -414,7 +423,7 @@ impl TransitDesign {
             let zk = Complex64::from_polar(1.0, -(w + phi));
             let delay = Complex64::from_polar(1.0, -w);
             z.push(zk);
-            gain.push(g);
+            carry.push(Complex64::from_polar(g, -0.5 * phi));
             u.push(fa[k] * delay);
             v.push(fb[k] * delay * zk.powu(last as u32));
         }
@@ -429,7 +438,7 @@ impl TransitDesign {
         let turns: Vec<(Complex64, Complex64)> =
             (0..=half).map(|k| (turn(k), turn(n - k))).collect();
         // The usual point inside the bar, in separate real arrays ([`InteriorBins`]).
-        let interior = InteriorBins::new(&u, &v, &gain, &turns, &z, half);
+        let interior = InteriorBins::new(&u, &v, &carry, &turns, &z, half);
         let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
@@ -471,7 +480,7 @@ impl TransitDesign {
                     sums.add_to(&mut folded);
                     for k in [0, half] {
                         let h_r = pw[k] * Complex64::new(w0 + w1 * z[k].re, w1 * z[k].im);
-                        let value = (u[k] * h_r + v[k] * h_r.conj()) * gain[k];
+                        let value = (u[k] * h_r + v[k] * h_r.conj()) * carry[k];
                         folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
                     }
                     inverse.process(&mut folded);
@@ -487,7 +496,7 @@ impl TransitDesign {
                     }
                 }
                 for k in 0..=half {
-                    let g = gain[k];
+                    let g = carry[k];
                     // The right- and left-going sums h_r and h_l (each term's wave undispersed
                     // over its first cell).
                     let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
@@ -499,12 +508,14 @@ impl TransitDesign {
                             zr *= z[k];
                             at += 1;
                         }
-                        // R_e: dispersion over e cells (none for e = 0); L_e: over
-                        // N − 1 − e (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e).
-                        let gr = if e == 0 { 1.0 } else { g };
-                        let gl = if e == last { 1.0 } else { g };
-                        h_r += zr * (gr * weight);
-                        h_l += zr.conj() * (gl * weight);
+                        // R_e: dispersion over e + ½ cells (none for e = 0); L_e: over
+                        // N − e − ½ (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e), the
+                        // half cell in g.
+                        let one = Complex64::new(1.0, 0.0);
+                        let gr = if e == 0 { one } else { g };
+                        let gl = if e == last { one } else { g };
+                        h_r += zr * gr * weight;
+                        h_l += zr.conj() * gl * weight;
                     }
                     let value = u[k] * h_r + v[k] * h_l;
                     let (t_k, t_mirror) = turns[k];
@@ -538,22 +549,23 @@ struct InteriorBins {
 }
 
 impl InteriorBins {
-    /// From the history spectra `u`, `v` (with their delays), the band's weights, the phase
-    /// turns of each bin and its mirror, and z, over the bins 0..`half`.
+    /// From the history spectra `u`, `v` (with their delays), the band's weights with the half
+    /// cell's dispersion, the phase turns of each bin and its mirror, and z, over the bins
+    /// 0..`half`.
     fn new(
         u: &[Complex64],
         v: &[Complex64],
-        gain: &[f64],
+        carry: &[Complex64],
         turns: &[(Complex64, Complex64)],
         z: &[Complex64],
         half: usize,
     ) -> InteriorBins {
-        // Inside the bar (both waves weighted by the band, real weights) the value at bin k is
-        // g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h), h the right-going sum: with
-        // its two phase turns folded in, four real products a turn.
+        // Inside the bar (both waves weighted by the band and carried the half cell, one complex
+        // weight g) the value at bin k is g (u h + v conj h) = g ((u + v) Re h + i (u − v) Im h),
+        // h the right-going sum: with its two phase turns folded in, four real products a turn.
         let inside: Vec<[Complex64; 4]> = (0..half)
             .map(|k| {
-                let (sum, difference) = ((u[k] + v[k]) * gain[k], (u[k] - v[k]) * gain[k]);
+                let (sum, difference) = ((u[k] + v[k]) * carry[k], (u[k] - v[k]) * carry[k]);
                 let (t_k, t_mirror) = turns[k];
                 [
                     sum * t_k,
@@ -817,11 +829,11 @@ mod tests {
         let b = shared_design(m, 0.29, 9.525e-3, 1e-3, 300);
         assert!(Arc::ptr_eq(&a, &b));
         let fresh = TransitDesign::new(m, 0.29, 9.525e-3, 1e-3, 300);
-        for cells in [1, 17, 299] {
-            let shared = a.shared_filter(cells);
-            let f = fresh.filter(cells);
+        for half_cells in [1, 17, 299, 600] {
+            let shared = a.shared_filter(half_cells);
+            let f = fresh.filter(half_cells);
             assert_eq!(shared.filter, f);
-            assert!(Arc::ptr_eq(&shared, &a.shared_filter(cells)));
+            assert!(Arc::ptr_eq(&shared, &a.shared_filter(half_cells)));
             assert_eq!(shared.max_power_gain(), max_power_gain(&f.taps));
         }
         assert!(!Arc::ptr_eq(
@@ -841,7 +853,7 @@ mod tests {
     fn filters_are_the_all_pass_transit_of_each_model() {
         for model in [TransitModel::PochhammerChree, TransitModel::RayleighLove] {
             let design = TransitDesign::new(model, 0.31, 9.525e-3, 1e-3, 400);
-            let f = design.filter(400);
+            let f = design.filter(800);
             assert!((f.taps.iter().sum::<f64>() - 1.0).abs() < 1e-12);
             assert!(
                 f.taps.len() < design.n_fft / 2,
