@@ -242,9 +242,12 @@ pub struct SphereChainRecorder {
     /// node, `None` for a rigid mass).
     pub spheres: Vec<(usize, Option<bool>)>,
     /// The series, on the times of the levels the contacts were solved at, as
-    /// [`ContactRecorder`]'s (velocities are the bodies' half-step ones, v^{n+1/2} on the sample
-    /// at t_n; the final velocities are filled in by [`SphereChainRecorder::into_series`]).
+    /// [`ContactRecorder`]'s (velocities at those levels: the mean of the two half-step ones
+    /// around each, (v^{n−1/2} + v^{n+1/2})/2; the final velocities are filled in by
+    /// [`SphereChainRecorder::into_series`]).
     pub series: ChainSeries,
+    /// Each sphere's half-step velocity after the previous step, m/s.
+    half_step_m_s: Vec<f64>,
 }
 
 impl SphereChainRecorder {
@@ -275,6 +278,7 @@ impl SphereChainRecorder {
                 final_velocity_m_s: Vec::new(),
                 extra: Vec::new(),
             },
+            half_step_m_s: vec![0.0; spheres.len()],
             joints: contacts,
             spheres,
         }
@@ -296,18 +300,26 @@ impl SphereChainRecorder {
 
 impl Recorder for SphereChainRecorder {
     fn record(&mut self, step: usize, _time_s: f64, bodies: &[Body], joints: &[JointState]) {
-        let Some(t) = joint_level_time(step, self.every, self.dt_s) else {
-            return;
-        };
-        self.series.time_s.push(t);
-        for (k, &j) in self.joints.iter().enumerate() {
-            // The force applied to the bodies, as `ContactRecorder` records it.
-            self.series.contact_force_n[k].push(joints[j].force_n);
-            self.series.contact_approach_m[k].push(joints[j].approach_m);
+        // After step k the bodies hold v^{k−1/2}, the half step after the level k − 1 the joints
+        // were solved at; with v^{k−3/2}, kept from the step before (at step 0 the initial
+        // v^{−1/2}), their mean is the velocity at that level, on the forces' time: a sphere's
+        // velocity is then its initial one plus the trapezoidal integral of the recorded net
+        // force over its mass.
+        let due = joint_level_time(step, self.every, self.dt_s);
+        if let Some(t) = due {
+            self.series.time_s.push(t);
+            for (k, &j) in self.joints.iter().enumerate() {
+                // The force applied to the bodies, as `ContactRecorder` records it.
+                self.series.contact_force_n[k].push(joints[j].force_n);
+                self.series.contact_approach_m[k].push(joints[j].approach_m);
+            }
         }
         for (k, &(b, end)) in self.spheres.iter().enumerate() {
             let v = bodies[b].end_half_step_velocity_m_s(end.unwrap_or(true));
-            self.series.velocity_m_s[k].push(v);
+            if due.is_some() {
+                self.series.velocity_m_s[k].push(0.5 * (self.half_step_m_s[k] + v));
+            }
+            self.half_step_m_s[k] = v;
         }
     }
 }
