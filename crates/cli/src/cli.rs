@@ -209,7 +209,7 @@ pub enum Command {
         /// A `shpb` scene file.
         #[arg(default_value = "scenes/shpb-ss440c-10psi.toml")]
         scene: PathBuf,
-        /// Runs per timing (median reported; `reference` runs once).
+        /// Runs per timing (median reported).
         #[arg(long, default_value_t = 5, allow_hyphen_values = true)]
         repeats: usize,
         /// Also write the tables as markdown to this file.

@@ -31,7 +31,7 @@
 //! process and interpolated (8-point Lagrange; within 1e-10 of the root, unit test).
 
 use crate::dispersion::{ModeTable, mode_table};
-use rustfft::FftPlanner;
+use crate::numeric::fft_plan;
 use rustfft::num_complex::Complex64;
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -279,9 +279,7 @@ impl TransitDesign {
                 spectrum[n - k] = h.conj();
             }
         }
-        FftPlanner::<f64>::new()
-            .plan_fft_inverse(n)
-            .process(&mut spectrum);
+        fft_plan(n, true).process(&mut spectrum);
         let h: Vec<f64> = spectrum.iter().map(|c| c.re / n as f64).collect();
         let total: f64 = h.iter().map(|x| x * x).sum();
         let cut = TAIL_ENERGY * total;
@@ -386,18 +384,22 @@ impl TransitDesign {
             .saturating_sub(2 * elements)
             .min(times.iter().copied().min().unwrap_or(0));
         let span = last_time.max(right.len()) - start;
-        // Zero padding beyond the longest transit's tail (group delay beyond c0: 1.6 steps a
-        // cell at most for Pochhammer–Chree, 2.5 for the Rayleigh–Love band) and its precursor
-        // keeps the circular convolution linear over the times asked for.
+        // Zero padding beyond the longest transit — a whole bar of pure delay plus the group
+        // delay beyond c0 (1.6 steps a cell at most for Pochhammer–Chree, 2.5 for the
+        // Rayleigh–Love band) — and the band's tails and the precursor (1024 steps; their
+        // amplitude there is below 1e-10) keeps the circular convolution linear over the times
+        // asked for: the last injections' responses do not wrap onto them. (Until 2026-11-24 the
+        // pure delay was left out and a power-of-two length made up for it by chance: within
+        // 2.4e-11 of a 40 000-step padding on the SS440c `reference` run, 6e-7 without it.)
         let tail = match self.model {
             TransitModel::PochhammerChree => 1.7,
             TransitModel::RayleighLove => 2.6,
         };
-        let need = span + (tail * elements as f64) as usize + 256;
+        let need = span + ((1.0 + tail) * elements as f64) as usize + 1024;
         let fold = progression(times).map_or(1, |(_, k)| k);
-        let n = fold * need.div_ceil(fold).next_power_of_two();
-        let mut planner = FftPlanner::<f64>::new();
-        let forward = planner.plan_fft_forward(n);
+        // An even length of small prime factors (bins 0 and n/2 are the real ones below).
+        let n = fold * 2 * crate::numeric::fast_fft_length(need.div_ceil(fold).div_ceil(2));
+        let forward = fft_plan(n, false);
         let spectrum = |s: &[f64], base: f64| {
             let mut v: Vec<Complex64> = vec![Complex64::new(0.0, 0.0); n];
             for (c, &x) in v.iter_mut().zip(&s[start.min(s.len())..]) {
@@ -430,7 +432,9 @@ impl TransitDesign {
         // Times relative to the transform's start; sampled every `fold` from `offset`.
         let local: Vec<usize> = times.iter().map(|&t| t - start).collect();
         let (offset, m) = (local[0] % fold, n / fold);
-        let inverse = planner.plan_fft_inverse(m);
+        let inverse = fft_plan(m, true);
+        // One scratch for every point's inverse transform (`process` would allocate it each time).
+        let mut scratch = vec![Complex64::new(0.0, 0.0); inverse.get_inplace_scratch_len()];
         // y(offset + fold·q) = (1/n) Σ_k Y_k e^{2πik·offset/n} e^{2πikq/m}, over each k ≤ n/2
         // and its mirror n − k (Y_{n−k} = conj Y_k): the two phase turns and folded slots.
         let turn =
@@ -471,25 +475,26 @@ impl TransitDesign {
                     }
                 }
                 pw_element = e0;
-                folded.fill(Complex64::new(0.0, 0.0));
                 if let Some((w0, w1)) = pair {
                     // Bins 1..half in one pass (advancing z^e by the stride on the way), then DC
                     // and Nyquist.
                     let step = stride.map(|_| z_stride.1.as_slice());
                     sums.interior(&interior, &mut pw, step, (w0, w1), m);
-                    sums.add_to(&mut folded);
+                    sums.write_to(&mut folded);
                     for k in [0, half] {
                         let h_r = pw[k] * Complex64::new(w0 + w1 * z[k].re, w1 * z[k].im);
                         let value = (u[k] * h_r + v[k] * h_r.conj()) * carry[k];
                         folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
                     }
-                    inverse.process(&mut folded);
+                    hermitian_completion(&mut folded);
+                    inverse.process_with_scratch(&mut folded, &mut scratch);
                     let dc: f64 = (a0 + b0) * (w0 + w1);
                     return local
                         .iter()
                         .map(|&t| folded[(t - offset) / fold].re / n as f64 + dc)
                         .collect();
                 }
+                folded.fill(Complex64::new(0.0, 0.0));
                 if stride.is_some() {
                     for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
                         *c *= zk;
@@ -526,7 +531,7 @@ impl TransitDesign {
                         folded[(n - k) % m] += value.conj() * t_mirror;
                     }
                 }
-                inverse.process(&mut folded);
+                inverse.process_with_scratch(&mut folded, &mut scratch);
                 let dc: f64 = (a0 + b0) * p.iter().map(|&(_, w)| w).sum::<f64>();
                 local
                     .iter()
@@ -605,52 +610,57 @@ impl FoldSums {
     /// Accumulates the bins 1..half of a point whose stretch is `w0` of element e plus `w1` of
     /// element e + 1: h = z^e (w0 + w1 z), with z^e in `pw` advanced first by `step` (z^stride)
     /// when given; the value at bin k is g (u h + v conj h) with its two phase turns
-    /// (`InteriorBins::terms`).
+    /// (`InteriorBins::terms`). Only the terms that reach the folded slots 0..=m/2 are summed:
+    /// the folded spectrum of a real series is Hermitian, so [`hermitian_completion`] fills the
+    /// rest (a bin's own term reaches slot k mod m, its mirror's slot (m − k mod m) mod m, and
+    /// inside a block of m bins all but slots 0 and m/2 need one of the two).
     fn interior(
         &mut self,
         bins: &InteriorBins,
         pw: &mut [Complex64],
         step: Option<&[Complex64]>,
-        (w0, w1): (f64, f64),
+        weights: (f64, f64),
         m: usize,
     ) {
-        for a in self.forward.iter_mut().chain(self.mirror.iter_mut()) {
-            a.fill(0.0);
+        // Zero the slots the pass writes and write_to reads (no others).
+        let hm = m / 2;
+        for a in &mut self.forward {
+            a[..=hm].fill(0.0);
+        }
+        for a in &mut self.mirror {
+            a[0] = 0.0;
+            a[m - hm..].fill(0.0);
         }
         let half = bins.z[0].len();
-        let [[s1r, s1i], [d1r, d1i], [s2r, s2i], [d2r, d2i]] = &bins.terms;
-        let [zr, zi] = &bins.z;
-        let [fr, fi] = &mut self.forward;
-        let [mr, mi] = &mut self.mirror;
         let mut start = 1;
         while start < half {
             // The block of bins k in [start, end) sharing the slots k − base.
             let base = start - start % m;
             let end = (base + m).min(half);
-            let (k, slots) = (start..end, start - base..end - base);
-            let pw = &mut pw[k.clone()];
             if let Some(step) = step {
-                for (c, s) in pw.iter_mut().zip(&step[k.clone()]) {
+                for (c, s) in pw[start..end].iter_mut().zip(&step[start..end]) {
                     *c *= s;
                 }
             }
-            let iter = pw
-                .iter()
-                .zip(&zr[k.clone()])
-                .zip(&zi[k.clone()])
-                .zip(s1r[k.clone()].iter().zip(&s1i[k.clone()]))
-                .zip(d1r[k.clone()].iter().zip(&d1i[k.clone()]))
-                .zip(s2r[k.clone()].iter().zip(&s2i[k.clone()]))
-                .zip(d2r[k.clone()].iter().zip(&d2i[k.clone()]))
-                .zip(fr[slots.clone()].iter_mut().zip(&mut fi[slots.clone()]))
-                .zip(mr[slots.clone()].iter_mut().zip(&mut mi[slots]));
-            for ((((((((c, zr), zi), s1), d1), s2), d2), f), mm) in iter {
-                let (qr, qi) = (w0 + w1 * zr, w1 * zi);
-                let (hr, hi) = (c.re * qr - c.im * qi, c.re * qi + c.im * qr);
-                *f.0 += s1.0 * hr - d1.1 * hi;
-                *f.1 += s1.1 * hr + d1.0 * hi;
-                *mm.0 += s2.0 * hr - d2.1 * hi;
-                *mm.1 -= s2.1 * hr + d2.0 * hi;
+            // Slots [lo, hi): 0 takes both terms, then own terms up to m − hm (exclusive), both
+            // at hm when m is even, mirror terms from hm + 1.
+            let (lo, hi) = (start - base, end - base);
+            let segment = |a: usize, b: usize| (a.max(lo), b.min(hi));
+            let parts = [
+                (segment(0, 1), true, true),
+                (segment(1, m - hm), true, false),
+                (segment(m - hm, hm + 1), true, true),
+                (segment(hm + 1, m), false, true),
+            ];
+            for ((a, b), own, mirror) in parts {
+                if a < b {
+                    let k = base + a..base + b;
+                    match (own, mirror) {
+                        (true, true) => self.pass::<true, true>(bins, pw, weights, k, a),
+                        (true, false) => self.pass::<true, false>(bins, pw, weights, k, a),
+                        _ => self.pass::<false, true>(bins, pw, weights, k, a),
+                    }
+                }
             }
             start = end;
         }
@@ -661,13 +671,69 @@ impl FoldSums {
         }
     }
 
-    /// Adds the accumulators into `folded`: forward slot s to s, mirror slot s to (m − s) mod m.
-    fn add_to(&self, folded: &mut [Complex64]) {
-        let m = folded.len();
-        for s in 0..m {
-            folded[s] += Complex64::new(self.forward[0][s], self.forward[1][s]);
-            folded[(m - s) % m] += Complex64::new(self.mirror[0][s], self.mirror[1][s]);
+    /// [`FoldSums::interior`] over the bins `k`, whose slots start at `slot`: the own terms
+    /// (`OWN`) and/or the mirror terms (`MIRROR`).
+    #[inline(always)]
+    fn pass<const OWN: bool, const MIRROR: bool>(
+        &mut self,
+        bins: &InteriorBins,
+        pw: &[Complex64],
+        (w0, w1): (f64, f64),
+        k: std::ops::Range<usize>,
+        slot: usize,
+    ) {
+        let len = k.len();
+        let [[s1r, s1i], [d1r, d1i], [s2r, s2i], [d2r, d2i]] = &bins.terms;
+        let (zr, zi, pw) = (&bins.z[0][k.clone()], &bins.z[1][k.clone()], &pw[k.clone()]);
+        let (s1r, s1i, d1r, d1i) = (
+            &s1r[k.clone()],
+            &s1i[k.clone()],
+            &d1r[k.clone()],
+            &d1i[k.clone()],
+        );
+        let (s2r, s2i, d2r, d2i) = (&s2r[k.clone()], &s2i[k.clone()], &d2r[k.clone()], &d2i[k]);
+        let [fr, fi] = &mut self.forward;
+        let [mr, mi] = &mut self.mirror;
+        let (fr, fi) = (&mut fr[slot..slot + len], &mut fi[slot..slot + len]);
+        let (mr, mi) = (&mut mr[slot..slot + len], &mut mi[slot..slot + len]);
+        for j in 0..len {
+            let c = pw[j];
+            let (qr, qi) = (w0 + w1 * zr[j], w1 * zi[j]);
+            let (hr, hi) = (c.re * qr - c.im * qi, c.re * qi + c.im * qr);
+            if OWN {
+                fr[j] += s1r[j] * hr - d1i[j] * hi;
+                fi[j] += s1i[j] * hr + d1r[j] * hi;
+            }
+            if MIRROR {
+                mr[j] += s2r[j] * hr - d2i[j] * hi;
+                mi[j] -= s2i[j] * hr + d2r[j] * hi;
+            }
         }
+    }
+
+    /// Sets the folded slots 0..=m/2 of `folded` from the accumulators (own slot s to s, mirror
+    /// slot s to (m − s) mod m), for the caller's DC and Nyquist terms to join before
+    /// [`hermitian_completion`] fills the slots above m/2.
+    fn write_to(&self, folded: &mut [Complex64]) {
+        let m = folded.len();
+        let hm = m / 2;
+        let [re, im] = &self.forward;
+        for ((f, &r), &i) in folded[..=hm].iter_mut().zip(re).zip(im) {
+            *f = Complex64::new(r, i);
+        }
+        folded[0] += Complex64::new(self.mirror[0][0], self.mirror[1][0]);
+        for s in m - hm..m {
+            folded[m - s] += Complex64::new(self.mirror[0][s], self.mirror[1][s]);
+        }
+    }
+}
+
+/// The slots above m/2 of a folded spectrum of a real series from those below: F[m − s] =
+/// conj F[s].
+fn hermitian_completion(folded: &mut [Complex64]) {
+    let m = folded.len();
+    for s in m / 2 + 1..m {
+        folded[s] = folded[m - s].conj();
     }
 }
 
@@ -712,9 +778,8 @@ impl BlockConvolver {
             return None;
         }
         let block = 1usize << (usize::BITS - 1 - cap.leading_zeros());
-        let mut planner = FftPlanner::<f64>::new();
-        let forward = planner.plan_fft_forward(2 * block);
-        let inverse = planner.plan_fft_inverse(2 * block);
+        let forward = fft_plan(2 * block, false);
+        let inverse = fft_plan(2 * block, true);
         let parts: Vec<Vec<Complex64>> = taps
             .chunks(block)
             .map(|c| {
@@ -793,7 +858,7 @@ pub fn max_power_gain(taps: &[f64]) -> f64 {
     for (c, &t) in v.iter_mut().zip(taps) {
         c.re = t;
     }
-    FftPlanner::<f64>::new().plan_fft_forward(n).process(&mut v);
+    fft_plan(n, false).process(&mut v);
     v.iter().map(|c| c.norm_sqr()).fold(0.0, f64::max)
 }
 
