@@ -313,6 +313,16 @@ impl Apparatus {
             ));
             // Inserts: a body each between the bar and the specimen (or the other bar), joined to
             // its bar by a butt joint; a bar segment, or a rigid mass when shorter than a cell.
+            // Under dispersion carried by delay lines an insert stays elementary: a transit
+            // filter needs about a hundred cells of path before its precursor is whole
+            // (docs/physics.md §6.2.1, "Causality") and an insert is a few cells long, over which
+            // the first mode lags c0 by 13 ns at 50 kHz for 1/4" (docs/physics.md §6.8). (A Love
+            // rod there would meet the delay line's elementary end with another impedance at
+            // high frequency.)
+            let insert_dispersion = match dispersion.transit_model() {
+                Some(_) => Dispersion::None,
+                None => dispersion,
+            };
             let insert_body = |name: &str, i: &Insert| -> crate::solver::BodySpec {
                 if i.is_rigid_at(dt) {
                     crate::solver::BodySpec::Mass(crate::solver::MassSpec {
@@ -325,7 +335,7 @@ impl Apparatus {
                         segments: vec![i.segment()],
                         left_end: EndCondition::Free,
                         right_end: EndCondition::Free,
-                        dispersion,
+                        dispersion: insert_dispersion,
                     })
                 }
             };

@@ -74,10 +74,11 @@ impl Fidelity {
     }
 
     /// The knobs a preset falls back to where its own cannot run: `reference`'s delay lines need
-    /// uniform bars a whole number of cells long (docs/physics.md §6.2.1), so a set-up with
-    /// inserts, a cylindrical specimen or bar lengths no cell ≤ 1 mm divides gets the Love-rod
-    /// chain at 0.125 mm (finite differences on any bar; the `reference` of 2026 before the delay
-    /// lines). `None` for presets that run everywhere.
+    /// uniform bars a whole number of cells long (docs/physics.md §6.2.1), so a set-up whose bar
+    /// lengths no cell ≤ 1 mm divides gets the Love-rod chain at 0.125 mm (finite differences on
+    /// any bar; the `reference` of 2026 before the delay lines). Inserts (elementary beside the
+    /// delay lines, §6.8) and a cylindrical specimen (always elementary, §6.9) do not need it.
+    /// `None` for presets that run everywhere.
     pub fn fallback_bar_knobs(self) -> Option<BarKnobs> {
         match self {
             Fidelity::Reference => Some(BarKnobs {

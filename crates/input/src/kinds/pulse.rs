@@ -226,7 +226,9 @@ pub(super) fn parse_bars(
         }
     };
     // A preset's knobs, or its fallback where its delay lines cannot run (no dispersion chosen in
-    // the scene, and inserts, a cylinder, or bars no cell of at most the preset's divides).
+    // the scene, and bars no cell of at most the preset's divides). Inserts run as Love rods
+    // beside dispersive delay lines and a cylinder is elementary (docs/physics.md §6.8, §6.9),
+    // so neither needs the fallback.
     let bar_lengths_m = [
         apparatus.incident.length_m,
         apparatus.striker.length_m,
@@ -238,10 +240,7 @@ pub(super) fn parse_bars(
             let cell = f.cell_size_m.unwrap_or(preset.cell_size_m);
             let whole = shpb_core::bar::delay_line_cell_m(&bar_lengths_m, cell)
                 .is_some_and(|c| f.cell_size_m.is_none() || (c - cell).abs() <= 1e-9 * cell);
-            let plain = apparatus.inserts.incident.is_none()
-                && apparatus.inserts.transmission.is_none()
-                && cylinder.is_none();
-            if whole && plain { preset } else { fallback }
+            if whole { preset } else { fallback }
         }
         _ => fidelity.bar_knobs(),
     };
