@@ -414,26 +414,49 @@ pub fn pulse_edges(time_s: &[f64], signal: &[f64], sign: f64) -> Option<PulseEdg
     if p <= 0.0 {
         return None;
     }
-    // Time where y crosses `level` between samples i and i + 1.
-    let cross = |i: usize, level: f64| {
-        time_s[i] + (level - y[i]) * (time_s[i + 1] - time_s[i]) / (y[i + 1] - y[i])
-    };
-    let rising = |level: f64| {
-        (0..k)
-            .rev()
-            .find(|&i| y[i] < level)
-            .map(|i| cross(i, level))
-    };
     let fall_10_s = (k + 1..y.len())
         .find(|&j| y[j] < 0.1 * p)
-        .map(|j| cross(j - 1, 0.1 * p));
+        .map(|j| crossing_s(time_s, &y, j - 1, 0.1 * p));
     Some(PulseEdges {
         peak_index: k,
         peak: p,
-        start_10_s: rising(0.1 * p)?,
-        rise_90_s: rising(0.9 * p)?,
+        start_10_s: rising_crossing_s(time_s, &y, k, 0.1 * p)?,
+        rise_90_s: rising_crossing_s(time_s, &y, k, 0.9 * p)?,
         fall_10_s,
     })
+}
+
+/// Time where `y` crosses `level` between samples i and i + 1 (linear interpolation), s.
+fn crossing_s(time_s: &[f64], y: &[f64], i: usize, level: f64) -> f64 {
+    time_s[i] + (level - y[i]) * (time_s[i + 1] - time_s[i]) / (y[i + 1] - y[i])
+}
+
+/// The last crossing of `level` by `y` rising to its peak at index `k`, s; None if `y` is above
+/// it from the start.
+fn rising_crossing_s(time_s: &[f64], y: &[f64], k: usize, level: f64) -> Option<f64> {
+    (0..k)
+        .rev()
+        .find(|&i| y[i] < level)
+        .map(|i| crossing_s(time_s, y, i, level))
+}
+
+impl PulseEdges {
+    /// The rising crossing of `fraction` of the peak of `sign · signal` (the signal these edges
+    /// were found on), by the rule of the 10 % and 90 % crossings, s; None if the signal is above
+    /// that level from its start to the peak.
+    pub fn rising_s(
+        &self,
+        time_s: &[f64],
+        signal: &[f64],
+        sign: f64,
+        fraction: f64,
+    ) -> Option<f64> {
+        let y: Vec<f64> = signal[..=self.peak_index]
+            .iter()
+            .map(|s| sign * s)
+            .collect();
+        rising_crossing_s(time_s, &y, self.peak_index, fraction * self.peak)
+    }
 }
 
 /// Foot of the first pulse of a signal (positive pulse), the arrival feature of the reduction's
@@ -533,6 +556,18 @@ mod tests {
         assert_relative_eq!(m.start_10_s, 11e-6, max_relative = 1e-9);
         assert_relative_eq!(m.rise_10_90_s, 8e-6, max_relative = 1e-9);
         assert_relative_eq!(m.duration_10_s, 48e-6, max_relative = 1e-9);
+        // Any level of the rise by the same rule: 30 % at 13 µs, 70 % at 17 µs.
+        let e = pulse_edges(&t, &y, -1.0).unwrap();
+        assert_relative_eq!(
+            e.rising_s(&t, &y, -1.0, 0.3).unwrap(),
+            13e-6,
+            max_relative = 1e-9
+        );
+        assert_relative_eq!(
+            e.rising_s(&t, &y, -1.0, 0.7).unwrap(),
+            17e-6,
+            max_relative = 1e-9
+        );
         // No tensile pulse in it; a pulse cut off by the record's end has no metrics.
         assert!(pulse_metrics(&t, &y, false).is_none());
         assert!(pulse_metrics(&t[..300], &y[..300], true).is_none());
