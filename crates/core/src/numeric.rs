@@ -1,6 +1,7 @@
 //! The numeric helpers every part of shpb shares, one copy each: argmax, linear resampling,
-//! moving average, cumulative trapezoid, bisection, linear least squares (nalgebra's SVD) and the
-//! FFT phase shift (docs/physics.md §7 for where the reduction uses them).
+//! moving average, cumulative trapezoid, bisection, Illinois root bracketing, linear least squares
+//! (nalgebra's SVD), the FFT phase shift (docs/physics.md §7 for where the reduction uses them),
+//! the process's FFT plans and fast FFT lengths.
 
 use nalgebra::{DMatrix, DVector, SVD};
 use rustfft::FftPlanner;
