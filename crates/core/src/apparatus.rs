@@ -316,7 +316,7 @@ impl Apparatus {
             // Under dispersion carried by delay lines an insert stays elementary: a transit
             // filter needs about a hundred cells of path before its precursor is whole
             // (docs/physics.md §6.2.1, "Causality") and an insert is a few cells long, over which
-            // the first mode lags c0 by 13 ns at 50 kHz for 1/4" (docs/physics.md §6.8). (A Love
+            // the first mode lags c0 by 13 ns at 50 kHz for 1/4" (§6.2.1, "Where it applies"). (A Love
             // rod there would meet the delay line's elementary end with another impedance at
             // high frequency.)
             let insert_dispersion = match dispersion.transit_model() {

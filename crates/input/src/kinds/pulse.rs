@@ -226,8 +226,8 @@ pub(super) fn parse_bars(
         }
     };
     // A preset's knobs, or its fallback where its delay lines cannot run (no dispersion chosen in
-    // the scene, and bars no cell of at most the preset's divides). Inserts run as Love rods
-    // beside dispersive delay lines and a cylinder is elementary (docs/physics.md §6.8, §6.9),
+    // the scene, and bars no cell of at most the preset's divides). Inserts stay elementary
+    // beside dispersive delay lines and a cylinder is elementary (docs/physics.md §6.2.1, §6.9),
     // so neither needs the fallback.
     let bar_lengths_m = [
         apparatus.incident.length_m,

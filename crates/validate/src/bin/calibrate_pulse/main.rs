@@ -1285,14 +1285,19 @@ fn rise_segments(w: &mut String, records: &[Record], sims: &[Simulated], m: &Mod
          their mean) and in the shipped calibration.\n\n\
          | psi | v (m/s) | segment | records (µs) | records' mean (µs) | simulated (µs) | sim. vs mean |\n|---|---|---|---|---|---|---|"
     );
+    // Each record's segments, once: (record, durations, s).
+    let measured: Vec<(&Record, [f64; 4])> = records
+        .iter()
+        .filter_map(|r| Some((r, rise_segment_durations_s(&r.time_s, &r.stress_pa)?)))
+        .collect();
     // Per pressure: the records' mean and the simulated duration of each segment, s.
     let mut means = [[f64::NAN; 4]; 3];
     let mut simulated = [[f64::NAN; 4]; 3];
     for (i, &psi) in PRESSURES_PSI.iter().enumerate() {
-        let group: Vec<[f64; 4]> = records
+        let group: Vec<[f64; 4]> = measured
             .iter()
-            .filter(|r| r.psi == psi)
-            .filter_map(|r| rise_segment_durations_s(&r.time_s, &r.stress_pa))
+            .filter(|(r, _)| r.psi == psi)
+            .map(|&(_, g)| g)
             .collect();
         let Some(sim) = rise_segment_durations_s(&sims[i].time_s, &sims[i].stress_pa) else {
             continue;
@@ -1344,23 +1349,20 @@ fn rise_segments(w: &mut String, records: &[Record], sims: &[Simulated], m: &Mod
     let lower_exponent = |d: &[[f64; 4]; 3]| (lower(d, 0) / lower(d, 2)).ln() / speed;
     // The 10→30 % segment of each record against the mean of the other records at its pressure.
     let mut long_toes = Vec::new();
-    for r in records {
-        let others: Vec<f64> = records
+    for (r, g) in &measured {
+        let others: Vec<f64> = measured
             .iter()
-            .filter(|o| o.psi == r.psi && o.sample != r.sample)
-            .filter_map(|o| rise_segment_durations_s(&o.time_s, &o.stress_pa))
-            .map(|g| g[0])
+            .filter(|(o, _)| o.psi == r.psi && o.sample != r.sample)
+            .map(|(_, o)| o[0])
             .collect();
-        if let Some(g) = rise_segment_durations_s(&r.time_s, &r.stress_pa) {
-            let others_mean = others.iter().sum::<f64>() / others.len() as f64;
-            if g[0] > 1.4 * others_mean {
-                long_toes.push(format!(
-                    "{} ({} psi, +{:.1} µs)",
-                    r.sample,
-                    r.psi,
-                    (g[0] - others_mean) * 1e6
-                ));
-            }
+        let others_mean = others.iter().sum::<f64>() / others.len() as f64;
+        if g[0] > 1.4 * others_mean {
+            long_toes.push(format!(
+                "{} ({} psi, +{:.1} µs)",
+                r.sample,
+                r.psi,
+                (g[0] - others_mean) * 1e6
+            ));
         }
     }
     let _ = writeln!(
