@@ -244,38 +244,23 @@ impl PulseShaper {
             return elastic;
         }
         // Plastic: g(p) = spring(p) − flow(p) falls from > 0 at p0 to < 0 at the closure (or at
-        // the thinnest disc); Illinois regula falsi on it.
+        // the thinnest disc); the safeguarded Illinois method on it.
         let g = |p: f64| spring(p) - self.crushed_flow_force_n(d, p, (p - p0) / dt_s);
         let p_max = closure_m.min((1.0 - MIN_THICKNESS_RATIO) * self.thickness_m);
-        let (mut a, mut b) = (p0, p_max);
-        let (mut ga, mut gb) = (g(a), g(b));
+        let (ga, gb) = (g(p0), g(p_max));
         if gb >= 0.0 {
-            state.plastic_closure_m = b;
-            return spring(b);
+            state.plastic_closure_m = p_max;
+            return spring(p_max);
         }
-        let mut side = 0;
-        for _ in 0..200 {
-            let x = (a * gb - b * ga) / (gb - ga);
-            let gx = g(x);
-            if gx > 0.0 {
-                a = x;
-                ga = gx;
-                if side == 1 {
-                    gb *= 0.5;
-                }
-                side = 1;
-            } else {
-                b = x;
-                gb = gx;
-                if side == -1 {
-                    ga *= 0.5;
-                }
-                side = -1;
-            }
-            if (b - a).abs() <= 1e-15 * self.thickness_m || gx == 0.0 {
-                break;
-            }
-        }
+        let (a, b) = crate::numeric::illinois(
+            p0,
+            p_max,
+            ga,
+            gb,
+            200,
+            |lo, hi| hi - lo <= 1e-15 * self.thickness_m,
+            g,
+        );
         let p = 0.5 * (a + b);
         state.plastic_closure_m = p;
         spring(p)
