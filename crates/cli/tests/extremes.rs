@@ -589,6 +589,7 @@ fn bar_time_step_at_0_99_runs_and_at_1_01_is_refused() {
         end_masses: vec![],
         snapshot_every: None,
         snapshot_spacing_m: 1e-3,
+        drive_force_n: Vec::new(),
     };
     let (key, problem, _) = input_error(simulate_chain(&chain).unwrap_err());
     assert_eq!(key, "time_step_s");
@@ -646,6 +647,7 @@ fn bars_from_1_to_50_nodes_per_mm_carry_the_elementary_pulse() {
                 end_masses: vec![],
                 snapshot_every: None,
                 snapshot_spacing_m: 1e-3,
+                drive_force_n: Vec::new(),
             };
             let out = simulate_chain(&setup).unwrap();
             let what = format!("{nodes_per_mm} nodes/mm, {dispersion:?}");
@@ -959,6 +961,7 @@ fn non_finite_input_and_over_limit_drives_stop_with_unstable_errors() {
         end_masses: vec![],
         snapshot_every: None,
         snapshot_spacing_m: 1e-3,
+        drive_force_n: Vec::new(),
     };
     let step = assert_unstable(simulate_chain(&chain).unwrap_err(), dt, "bar striker");
     assert_eq!(step, 1);

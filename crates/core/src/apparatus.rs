@@ -261,6 +261,86 @@ pub struct PulseOptions {
     /// (scene key `smooth_s`; `crate::gauge::DEFAULT_SMOOTHING_S` unless set), as
     /// `shpb reduce --smooth` applies it to any record.
     pub reduction_smoothing_s: f64,
+    /// A measured incident wave driving the incident bar's impact end in place of gun, striker
+    /// and shaper (docs/physics.md §6.10); None: the striker.
+    pub incident_drive: Option<IncidentDrive>,
+}
+
+/// A prescribed incident wave (docs/physics.md §6.10): the compressive stress on the incident
+/// bar's impact end, sampled every `dt_s` from t = 0, Pa. On elementary bars the incident
+/// gauge then reads it unchanged, delayed by the gauge's distance from that end over c0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IncidentDrive {
+    /// Sample interval, s.
+    pub dt_s: f64,
+    /// Time of the incident wave's foot in the drive (2 % of its peak), s: where a striker's
+    /// impact would be.
+    pub foot_s: f64,
+    /// Compressive stress at the impact end, Pa.
+    pub stress_pa: Vec<f64>,
+}
+
+/// Margin kept between the end of a recorded incident wave taken as a drive and the foot of the
+/// reflected wave on the same channel ([`IncidentDrive::from_incident_gauge`]), s.
+pub const DRIVE_MARGIN_S: f64 = 10e-6;
+
+impl IncidentDrive {
+    /// The incident wave of an incident-gauge record (docs/physics.md §6.10): its compressive
+    /// stress −E ε (`strain` tension positive, baseline removed, on the uniform times `time_s`)
+    /// from the first sample up to [`DRIVE_MARGIN_S`] before the reflected wave's foot — the
+    /// first tensile excursion through 2 % of the incident peak after it (2 µs moving average,
+    /// as [`crate::gauge::pulse_foot`] reads feet) — or the whole record if it has none. None
+    /// if the record has no compressive pulse or fewer than two samples.
+    pub fn from_incident_gauge(
+        time_s: &[f64],
+        strain: &[f64],
+        youngs_modulus_pa: f64,
+    ) -> Option<IncidentDrive> {
+        let dt_s = time_s.get(1)? - time_s[0];
+        if dt_s.is_nan() || dt_s <= 0.0 {
+            return None;
+        }
+        let half = (0.5 * crate::gauge::FOOT_SMOOTHING_S / dt_s).round() as usize;
+        let compression: Vec<f64> = crate::numeric::moving_average(strain, half)
+            .iter()
+            .map(|e| -e)
+            .collect();
+        let foot = crate::gauge::pulse_foot(&compression, crate::gauge::FOOT_FRACTION)?;
+        let level = -crate::gauge::FOOT_FRACTION * compression[foot.peak_index];
+        let margin = (DRIVE_MARGIN_S / dt_s).round() as usize;
+        let end = (foot.peak_index..compression.len())
+            .find(|&k| compression[k] < level)
+            .map_or(strain.len(), |k| {
+                k.saturating_sub(margin).max(foot.peak_index)
+            });
+        Some(IncidentDrive {
+            dt_s,
+            foot_s: foot.time_s(time_s) - time_s[0],
+            stress_pa: strain[..end]
+                .iter()
+                .map(|e| -youngs_modulus_pa * e)
+                .collect(),
+        })
+    }
+
+    /// Duration of the drive, s.
+    pub fn duration_s(&self) -> f64 {
+        self.stress_pa.len() as f64 * self.dt_s
+    }
+
+    /// The stress at time `t_s`, linearly interpolated (0 outside the samples), Pa.
+    pub fn stress_at_pa(&self, t_s: f64) -> f64 {
+        let x = t_s / self.dt_s;
+        if x.is_nan() || x < 0.0 {
+            return 0.0;
+        }
+        let k = x.floor() as usize;
+        match (self.stress_pa.get(k), self.stress_pa.get(k + 1)) {
+            (Some(&a), Some(&b)) => a + (x - k as f64) * (b - a),
+            (Some(&a), None) if x == k as f64 => a,
+            _ => 0.0,
+        }
+    }
 }
 
 impl Apparatus {
@@ -275,28 +355,33 @@ impl Apparatus {
             _ => EndCondition::Free,
         };
         let with_transmission = matches!(end, IncidentEnd::Transmission | IncidentEnd::Specimen);
-        let mut bars = vec![
-            self.bar_spec(
+        // A drive replaces the striker and its joint: the incident bar is then the first body.
+        let driven = o.incident_drive.is_some();
+        let mut bars = Vec::new();
+        let mut joints = Vec::new();
+        if !driven {
+            bars.push(self.bar_spec(
                 "striker",
                 self.striker,
                 EndCondition::Free,
                 EndCondition::Free,
                 dispersion,
-            ),
-            self.bar_spec(
-                "incident",
-                self.incident,
-                EndCondition::Free,
-                incident_right,
-                dispersion,
-            ),
-        ];
-        let mut joints = vec![match shaper {
-            Some(s) => Joint::Shaper(s),
-            None => Joint::Butt,
-        }];
+            ));
+            joints.push(match shaper {
+                Some(s) => Joint::Shaper(s),
+                None => Joint::Butt,
+            });
+        }
+        let incident_index = bars.len();
+        bars.push(self.bar_spec(
+            "incident",
+            self.incident,
+            EndCondition::Free,
+            incident_right,
+            dispersion,
+        ));
         let mut end_masses = Vec::new();
-        let mut transmission_index = 2;
+        let mut transmission_index = incident_index + 1;
         let mut chain_bodies = None;
         if with_transmission {
             let far = if self.transmission_absorbing {
@@ -411,7 +496,10 @@ impl Apparatus {
         let mut gauges = Vec::new();
         for ch in &self.gauges.channels {
             let (bar, x) = match ch.bar.as_str() {
-                "incident" => (1, self.incident.length_m - ch.distance_from_specimen_m),
+                "incident" => (
+                    incident_index,
+                    self.incident.length_m - ch.distance_from_specimen_m,
+                ),
                 "transmission" if with_transmission => {
                     (transmission_index, ch.distance_from_specimen_m)
                 }
@@ -428,7 +516,7 @@ impl Apparatus {
         ChainSetup {
             bodies: chain_bodies.unwrap_or_else(|| bars.into_iter().map(Into::into).collect()),
             joints,
-            striker_velocity_m_s: o.striker_velocity_m_s,
+            striker_velocity_m_s: if driven { 0.0 } else { o.striker_velocity_m_s },
             dt_s: dt,
             end_time_s: o.end_time_s,
             gauges,
@@ -438,6 +526,17 @@ impl Apparatus {
                 .snapshot_interval_s
                 .map(|i| ((i / dt).round() as usize).max(1)),
             snapshot_spacing_m: 5e-3,
+            drive_force_n: o
+                .incident_drive
+                .as_ref()
+                .map(|d| {
+                    let area = self.incident.area_m2();
+                    let steps = (d.stress_pa.len() as f64 * d.dt_s / dt).ceil() as usize;
+                    (0..=steps)
+                        .map(|n| area * d.stress_at_pa(n as f64 * dt))
+                        .collect()
+                })
+                .unwrap_or_default(),
         }
     }
 }
@@ -484,6 +583,7 @@ impl Apparatus {
             gauge_length_m,
             snapshot_interval_s: None,
             reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
+            incident_drive: None,
         });
         let k = setup
             .gauges

@@ -486,6 +486,16 @@ impl PulseFoot {
     }
 }
 
+/// Fraction of each pulse's own peak that marks its foot, the arrival feature of records and
+/// simulations alike (docs/physics.md §7.5; the reduction's incident-start rule, reduce.rs).
+pub const FOOT_FRACTION: f64 = 0.02;
+
+/// Width of the centred moving average applied to records and simulated strains before their
+/// feet are measured, s (docs/physics.md §7.5: 2 µs cuts the records' 0.16 mV noise, which
+/// would otherwise cross 2 % of a pulse early; it moves the foot of a pulse rising in ≥ 40 µs by
+/// well under 1 µs, the same on both).
+pub const FOOT_SMOOTHING_S: f64 = 2e-6;
+
 /// The foot of the first pulse of `y` at `fraction` of its peak (see [`PulseFoot`];
 /// docs/physics.md §7.5); None if `y` has no positive value.
 pub fn pulse_foot(y: &[f64], fraction: f64) -> Option<PulseFoot> {

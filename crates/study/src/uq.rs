@@ -350,11 +350,13 @@ pub fn study_inputs(scene: &Path, gun_scatter: bool) -> Result<Vec<StudyInput>> 
             .map(|u| (u.key.clone(), u.value(u.distribution.central())))
             .collect();
         let params = Params::from_file_overridden(scene, &central)?;
+        // A test driven by a recorded incident wave has no gun to scatter (docs/physics.md §6.10).
         if let SceneParams::Pulse {
             apparatus,
             pressure_pa,
-            ..
+            options,
         } = &params.params
+            && options.incident_drive.is_none()
             && let Some(scatter) = apparatus.gun_velocity_scatter
             && scatter > 0.0
         {

@@ -97,17 +97,24 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
     let (bars, bar_knobs) = match &params.params {
         SceneParams::Pulse { options, .. } => (
             format!(
-                ", fidelity {}: {} bars, {} mm cells",
+                ", fidelity {}: {} bars, {} mm cells{}",
                 params.fidelity.name(),
                 match options.dispersion {
                     shpb_core::bar::Dispersion::None => "elementary",
                     d => d.name(),
                 },
-                options.cell_size_m * 1e3
+                options.cell_size_m * 1e3,
+                // docs/physics.md §6.10: no gun, striker or shaper in a driven test.
+                if options.incident_drive.is_some() {
+                    "; incident wave: [incident_record]"
+                } else {
+                    ""
+                }
             ),
             serde_json::json!({
                 "dispersion": options.dispersion.name(),
                 "cell_size_m": options.cell_size_m,
+                "incident_record": options.incident_drive.is_some(),
             }),
         ),
         _ => (String::new(), serde_json::Value::Null),

@@ -60,6 +60,10 @@ pub struct ChainSetup {
     pub snapshot_every: Option<usize>,
     /// Spacing of the snapshot points along the bars, m.
     pub snapshot_spacing_m: f64,
+    /// A prescribed force (N, toward +x) on the first body's left end at levels n = 0, 1, …
+    /// (none beyond the series; empty: a free end): a measured incident wave driving the
+    /// incident bar in place of striker and shaper (docs/physics.md §6.10).
+    pub drive_force_n: Vec<f64>,
 }
 
 /// A chain in its time-stepping state.
@@ -72,6 +76,7 @@ pub struct Chain {
     step_index: usize,
     forces: Vec<f64>,
     coupled: bool,
+    drive_force_n: Vec<f64>,
 }
 
 impl Chain {
@@ -128,6 +133,7 @@ impl Chain {
             step_index: 0,
             forces: vec![0.0; setup.joints.len()],
             coupled,
+            drive_force_n: setup.drive_force_n.clone(),
         })
     }
 
@@ -141,10 +147,23 @@ impl Chain {
         self.step_index
     }
 
+    /// The prescribed force on the first body's left end at the current level (0 without a
+    /// drive or after its end), N toward +x.
+    pub fn drive_force_n(&self) -> f64 {
+        self.drive_force_n
+            .get(self.step_index)
+            .copied()
+            .unwrap_or(0.0)
+    }
+
     /// Prediction of joint `k` given the current estimates of the other joints' forces.
     fn predict(&self, k: usize) -> JointPrediction {
         // Forces toward +x on the far ends of the joint's two bodies.
-        let left_other = if k > 0 { self.forces[k - 1] } else { 0.0 };
+        let left_other = if k > 0 {
+            self.forces[k - 1]
+        } else {
+            self.drive_force_n()
+        };
         let right_other = if k + 1 < self.forces.len() {
             -self.forces[k + 1]
         } else {
@@ -189,8 +208,9 @@ impl Chain {
             }
         }
         let n = self.bodies.len();
+        let drive = self.drive_force_n();
         for (k, body) in self.bodies.iter_mut().enumerate() {
-            let left = if k > 0 { self.forces[k - 1] } else { 0.0 };
+            let left = if k > 0 { self.forces[k - 1] } else { drive };
             let right = if k + 1 < n { -self.forces[k] } else { 0.0 };
             body.step(left, right);
             body.check_step()?;
@@ -258,8 +278,11 @@ pub struct ChainResult {
     pub contact: Option<crate::solver::ContactSeries>,
     /// Stress fields of the bars over time, if requested.
     pub snapshots: Vec<BarSnapshots>,
-    /// Initial kinetic energy of the striker, J.
+    /// Initial kinetic energy of the striker, J (0 when a drive replaces it).
     pub striker_energy_j: f64,
+    /// Work done on the first body by the prescribed drive so far, at the recording times, J
+    /// (empty without a drive).
+    pub drive_work_j: Vec<f64>,
     /// Velocity of the striker's centre of mass at the end, m/s.
     pub striker_final_velocity_m_s: f64,
     /// Steps taken.
@@ -293,8 +316,19 @@ pub fn simulate_chain_with(
     let mut snapshots = setup
         .snapshot_every
         .map(|k| SnapshotRecorder::new(&chain.bodies, k, setup.snapshot_spacing_m));
+    let mut drive = (!setup.drive_force_n.is_empty()).then(|| DriveRecorder {
+        force_n: &setup.drive_force_n,
+        every: setup.record_every,
+        dt_s: setup.dt_s,
+        last_velocity_m_s: 0.0,
+        work_j: 0.0,
+        series_j: Vec::with_capacity(cap),
+    });
     {
         let mut recorders: Vec<&mut dyn Recorder> = vec![&mut gauges, &mut energy];
+        if let Some(d) = drive.as_mut() {
+            recorders.push(d);
+        }
         if let Some(c) = contact.as_mut() {
             recorders.push(c);
         }
@@ -319,9 +353,35 @@ pub fn simulate_chain_with(
         contact: contact.map(|c| c.series),
         snapshots: snapshots.map(|s| s.snapshots).unwrap_or_default(),
         striker_energy_j,
+        drive_work_j: drive.map(|d| d.series_j).unwrap_or_default(),
         striker_final_velocity_m_s: striker.momentum_kg_m_s() / striker.mass_kg(),
         steps,
     })
+}
+
+/// Records the work a prescribed drive does on the first body's left end, with the bar's own
+/// end-work rule F^n (v^{n−1/2} + v^{n+1/2})/2 Δt ([`crate::bar::Bar::step`]).
+struct DriveRecorder<'a> {
+    force_n: &'a [f64],
+    every: usize,
+    dt_s: f64,
+    last_velocity_m_s: f64,
+    work_j: f64,
+    series_j: Vec<f64>,
+}
+
+impl Recorder for DriveRecorder<'_> {
+    fn record(&mut self, step: usize, _time_s: f64, bodies: &[Body], _joints: &[JointState]) {
+        let v = bodies[0].end_half_step_velocity_m_s(false);
+        if step > 0 {
+            let f = self.force_n.get(step - 1).copied().unwrap_or(0.0);
+            self.work_j += f * 0.5 * (self.last_velocity_m_s + v) * self.dt_s;
+        }
+        self.last_velocity_m_s = v;
+        if step.is_multiple_of(self.every) {
+            self.series_j.push(self.work_j);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -388,6 +448,7 @@ mod tests {
             end_masses: vec![],
             snapshot_every: None,
             snapshot_spacing_m: 1e-3,
+            drive_force_n: Vec::new(),
         };
         (setup, tc, pair.sphere1.mass_kg)
     }
@@ -432,7 +493,75 @@ mod tests {
             end_masses: vec![],
             snapshot_every: None,
             snapshot_spacing_m: 1e-3,
+            drive_force_n: Vec::new(),
         }
+    }
+
+    /// A force prescribed on a bar's free end (a measured incident wave driving the incident
+    /// bar, docs/physics.md §6.10) leaves as the travelling wave σ(x, t) = F(t − x/c0)/A: on a
+    /// uniform elementary bar at Courant 1 the scheme is exact for it (as for any wave), so a gauge
+    /// 0.5 m down reads the sampled force to rounding; the drive's recorded work is the energy the
+    /// bar then holds, and equals ∫F² dt/Z, whose trapezoid sum is exact for a raised cosine
+    /// sampled over its whole period.
+    #[test]
+    fn a_prescribed_end_force_travels_as_the_wave_it_prescribes() {
+        let mut setup = bar_pair(Dispersion::None);
+        let incident = setup.bodies.remove(1);
+        let BodySpec::Bar(mut bar) = incident else {
+            unreachable!("bar_pair's second body is a bar")
+        };
+        bar.segments.truncate(1);
+        let area = std::f64::consts::PI * 0.25 * 0.02 * 0.02;
+        let c0 = bar.segments[0].material.wave_speed_m_s();
+        let e = bar.segments[0].material.youngs_modulus_pa;
+        setup.bodies = vec![BodySpec::Bar(bar)];
+        setup.joints.clear();
+        setup.striker_velocity_m_s = 0.0;
+        setup.end_time_s = 200e-6;
+        setup.gauges = vec![crate::solver::GaugeProbe {
+            name: "g".into(),
+            bar: 0,
+            x_m: 0.5,
+            length_m: 0.0,
+        }];
+        // A raised-cosine pulse of 10 kN over 40 µs, starting at 10 µs.
+        let pulse = |t: f64| {
+            let s = (t - 10e-6) / 40e-6;
+            if (0.0..=1.0).contains(&s) {
+                5e3 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())
+            } else {
+                0.0
+            }
+        };
+        let steps = (setup.end_time_s / setup.dt_s).ceil() as usize;
+        setup.drive_force_n = (0..=steps).map(|n| pulse(n as f64 * setup.dt_s)).collect();
+        let r = simulate_chain(&setup).unwrap();
+        let worst = r
+            .time_s
+            .iter()
+            .zip(&r.strain[0])
+            .map(|(&t, &eps)| (-e * eps - pulse(t - 0.5 / c0) / area).abs())
+            .fold(0.0, f64::max);
+        let peak = 1e4 / area;
+        assert!(
+            worst <= 1e-12 * peak,
+            "gauge off by {:.2e} of the peak",
+            worst / peak
+        );
+        assert_eq!(r.striker_energy_j, 0.0);
+        let work = *r.drive_work_j.last().unwrap();
+        let held = r.bar_energy_j.last().unwrap() + r.absorbed_energy_j.last().unwrap();
+        assert!(
+            work > 0.0 && (work - held).abs() <= 1e-12 * work,
+            "{work} vs {held}"
+        );
+        // The work is the pulse's energy A/(ρ c0) ∫σ² dt = ∫F² dt/Z, Z = ρ c0 A = E A/c0.
+        let z = e / c0 * area;
+        let analytic = 5e3 * 5e3 * 1.5 * 40e-6 / z;
+        assert!(
+            (work - analytic).abs() <= 1e-12 * analytic,
+            "{work} vs {analytic}"
+        );
     }
 
     /// The O(1) ledgers carry the bars' energy through impact, transmission at a step in

@@ -90,6 +90,7 @@ pub fn hertz_chain(
         end_masses: vec![],
         snapshot_every: None,
         snapshot_spacing_m: 1e-3,
+        drive_force_n: Vec::new(),
     }
 }
 

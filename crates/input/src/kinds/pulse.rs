@@ -53,7 +53,7 @@ pub(super) const BARS: Key = Key {
 pub(super) const PRESSURE: Key = Key {
     key: "pressure",
     unit: "psi, Pa, kPa, MPa or bar",
-    default: "required",
+    default: "required (shpb: unless [incident_record])",
     meaning: "gas-gun gauge pressure with its unit, e.g. \"10psi\" (within the set-up gun's range)",
 };
 
@@ -97,6 +97,14 @@ pub(super) const GAUGE_LENGTH: Key = Key {
     meaning: "grid length of the strain gauges (they read the mean strain over it), 0 to 0.05",
 };
 
+/// `[incident_record]` (shpb only).
+pub(super) const INCIDENT_RECORD: Key = Key {
+    key: "incident_record",
+    unit: "",
+    default: "none: the gun, striker and shaper make the incident pulse",
+    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record in the `shpb reduce` layout (time_s, incident_V, transmission_V), relative to the scene file, read through the set-up's incident gauge channel; baseline_samples (default 900). Exclusive with pressure; elementary bars only (dispersion = none)",
+};
+
 /// `smooth_s` (shpb only).
 pub(super) const SMOOTH: Key = Key {
     key: "smooth_s",
@@ -120,7 +128,8 @@ struct PulseFile {
     #[serde(default, with = "UnloadingToml")]
     unloading: Unloading,
     bars: String,
-    pressure: String,
+    pressure: Option<String>,
+    incident_record: Option<IncidentRecordFile>,
     #[serde(default)]
     shaper: ShaperOverride,
     cell_size_m: Option<f64>,
@@ -131,6 +140,14 @@ struct PulseFile {
     #[serde(default = "default_gauge_length")]
     gauge_length_m: f64,
     smooth_s: Option<f64>,
+}
+
+/// `[incident_record]`: a gauge record whose incident wave drives the incident bar.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct IncidentRecordFile {
+    file: String,
+    baseline_samples: Option<usize>,
 }
 
 fn default_gauge_length() -> f64 {
@@ -203,10 +220,46 @@ pub(super) fn parse_bars(
         ));
     }
     let apparatus = Apparatus::resolve(&f.bars, base_dir)?;
-    let pressure_pa = crate::units::pressure_from_text(&f.pressure, v, "pressure")?;
-    let velocity = apparatus
-        .striker_velocity_m_s(pressure_pa)
-        .map_err(v.core("pressure"))?;
+    // The incident wave: the gun at a pressure, or a measured record (docs/physics.md §6.10).
+    let (pressure_pa, velocity, drive) = match (&f.pressure, &f.incident_record) {
+        (Some(p), None) => {
+            let pressure_pa = crate::units::pressure_from_text(p, v, "pressure")?;
+            let velocity = apparatus
+                .striker_velocity_m_s(pressure_pa)
+                .map_err(v.core("pressure"))?;
+            (pressure_pa, velocity, None)
+        }
+        (None, Some(r)) if is_test => (
+            f64::NAN,
+            0.0,
+            Some(incident_drive(r, &apparatus, base_dir, v)?),
+        ),
+        (None, Some(_)) => {
+            return Err(v.error(
+                "incident_record",
+                "given in a pulse scene, whose incident pulse is the gun's",
+                "[incident_record] only in shpb scenes (or pressure here)",
+            ));
+        }
+        (Some(_), Some(_)) => {
+            return Err(v.error(
+                "incident_record",
+                "given with pressure",
+                "either pressure (the gun fires the striker) or [incident_record] (a measured incident wave drives the bar)",
+            ));
+        }
+        (None, None) => {
+            return Err(v.error(
+                "pressure",
+                "missing",
+                if is_test {
+                    "a gas-gun gauge pressure with its unit, e.g. \"10psi\", or an [incident_record]"
+                } else {
+                    "a gas-gun gauge pressure with its unit, e.g. \"10psi\""
+                },
+            ));
+        }
+    };
     let face_modulus_pa =
         apparatus.material.youngs_modulus_pa / (1.0 - apparatus.material.poisson_ratio.powi(2));
     let shaper = f
@@ -245,6 +298,9 @@ pub(super) fn parse_bars(
         _ => fidelity.bar_knobs(),
     };
     let dispersion = match f.dispersion.as_deref() {
+        // A recorded wave is already dispersed over its path from the impact end to the gauge:
+        // a drive runs on elementary bars, whatever the preset's.
+        None if drive.is_some() => Dispersion::None,
         None => knobs.dispersion,
         Some(name) => Dispersion::parse(name).ok_or_else(|| {
             v.error(
@@ -254,6 +310,16 @@ pub(super) fn parse_bars(
             )
         })?,
     };
+    if drive.is_some() && dispersion != Dispersion::None {
+        return Err(v.error(
+            "dispersion",
+            format!(
+                "`{}` with [incident_record]: the recorded wave is already dispersed over its path from the impact end to the gauge",
+                dispersion.name()
+            ),
+            "none (or leave dispersion out: a driven test runs elementary bars)",
+        ));
+    }
     let c0 = apparatus.material.wave_speed_m_s();
     // A cylinder gets at least CYLINDER_MIN_CELLS cells (docs/physics.md §6.9): the default
     // cell is refined to it, an explicit one that cannot is refused.
@@ -299,6 +365,8 @@ pub(super) fn parse_bars(
     let default_end = (apparatus.incident.length_m + gauge_d) / c0
         + 4.0 * apparatus.striker.length_m / c0
         + 200e-6;
+    // A drive starts with the record's own lead before its incident wave's foot.
+    let default_end = default_end + drive.as_ref().map_or(0.0, |d| d.foot_s);
     let end_time_s = match f.end_time_s {
         Some(e) => v.positive("end_time_s", e, 0.1, "s")?,
         None => default_end,
@@ -327,6 +395,7 @@ pub(super) fn parse_bars(
         gauge_length_m,
         snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
         reduction_smoothing_s,
+        incident_drive: drive,
     };
     // Refuse a run too large for this machine before its bars are built (below), then a grid
     // the bars cannot run (time step over the stability limit) now, not mid-run.
@@ -360,6 +429,55 @@ pub(super) fn parse_bars(
 }
 
 /// Checks of the key documentation shared by pulse and shpb.
+/// Reads `[incident_record]`: the record (owning its file errors), its incident channel through
+/// the set-up's gauge file with the first `baseline_samples` samples' mean removed, and the
+/// incident wave cut before its reflection ([`IncidentDrive::from_incident_gauge`]).
+fn incident_drive(
+    r: &IncidentRecordFile,
+    apparatus: &Apparatus,
+    base_dir: &Path,
+    v: &Validator,
+) -> Result<shpb_core::apparatus::IncidentDrive> {
+    use crate::gauges::RawRecordFile as _;
+    let rv = v.table("incident_record");
+    let path = base_dir.join(&r.file);
+    if !crate::files::is_file(&path) {
+        return Err(rv.error(
+            "file",
+            format!("cannot read {}: no such file", path.display()),
+            "a gauge record (time_s, incident_V, transmission_V) relative to the scene file",
+        ));
+    }
+    let record = shpb_core::gauge::RawRecord::read(&path)?;
+    let baseline = match r.baseline_samples {
+        Some(n) => rv.in_range(
+            "baseline_samples",
+            n as f64,
+            1.0,
+            (record.time_s.len() / 2) as f64,
+            "samples",
+        )? as usize,
+        None => shpb_core::reduce::ReductionOptions::default().baseline_samples,
+    };
+    let input =
+        shpb_core::reduce::record_strains(&record, apparatus, baseline).map_err(rv.core("file"))?;
+    shpb_core::apparatus::IncidentDrive::from_incident_gauge(
+        &input.time_s,
+        &input.incident_strain,
+        apparatus.material.youngs_modulus_pa,
+    )
+    .ok_or_else(|| {
+        rv.error(
+            "file",
+            format!(
+                "{}: no compressive incident pulse in its incident channel",
+                path.display()
+            ),
+            "a record whose incident channel holds the incident pulse",
+        )
+    })
+}
+
 #[cfg(test)]
 pub(super) fn check_bar_key_docs() {
     let fmt = |f: Fidelity| {
@@ -401,11 +519,18 @@ mod tests {
 
     #[test]
     fn registry_entry() {
-        // A pulse scene accepts but refuses `specimen`, and has no use for `law`, `region2` and
-        // `unloading`.
+        // A pulse scene accepts but refuses `specimen`, `smooth_s` and `incident_record`, and
+        // has no use for `law`, `region2` and `unloading`.
         super::super::check_kind(
             &KIND,
-            &["specimen", "law", "region2", "unloading", "smooth_s"],
+            &[
+                "specimen",
+                "law",
+                "region2",
+                "unloading",
+                "smooth_s",
+                "incident_record",
+            ],
         );
         check_bar_key_docs();
         assert_eq!(KIND.keys[4].default, default_incident_end());

@@ -2,7 +2,8 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{
-    self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, PRESSURE, SHAPER, SMOOTH,
+    self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, INCIDENT_RECORD, PRESSURE, SHAPER,
+    SMOOTH,
 };
 use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
@@ -20,6 +21,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         UNLOADING,
         BARS,
         PRESSURE,
+        INCIDENT_RECORD,
         SHAPER,
         CELL_SIZE,
         DISPERSION,
