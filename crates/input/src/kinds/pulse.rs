@@ -102,7 +102,7 @@ pub(super) const INCIDENT_RECORD: Key = Key {
     key: "incident_record",
     unit: "",
     default: "none: the gun, striker and shaper make the incident pulse",
-    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record in the `shpb reduce` layout (time_s, incident_V, transmission_V), relative to the scene file, read through the set-up's incident gauge channel; baseline_samples (default 900). Exclusive with pressure; elementary bars only (dispersion = none)",
+    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record (time_s, incident_V, transmission_V, read through the set-up's incident gauge channel) relative to the scene file; layout = a record layout .toml for another file format, as `shpb reduce --layout`; baseline_samples (default 900). Exclusive with pressure; elementary bars only (dispersion = none)",
 };
 
 /// `smooth_s` (shpb only).
@@ -147,6 +147,7 @@ struct PulseFile {
 #[serde(deny_unknown_fields)]
 struct IncidentRecordFile {
     file: String,
+    layout: Option<String>,
     baseline_samples: Option<usize>,
 }
 
@@ -448,19 +449,47 @@ fn incident_drive(
             "a gauge record (time_s, incident_V, transmission_V) relative to the scene file",
         ));
     }
-    let record = shpb_core::gauge::RawRecord::read(&path)?;
+    // The record as bridge voltages (through the set-up's bridges) or, through a layout, as
+    // voltages or bar strains.
+    let record = match &r.layout {
+        None => crate::layout::LayoutRecord::Voltages(shpb_core::gauge::RawRecord::read(&path)?),
+        Some(l) => {
+            let layout_path = base_dir.join(l);
+            if !crate::files::is_file(&layout_path) {
+                return Err(rv.error(
+                    "layout",
+                    format!("cannot read {}: no such file", layout_path.display()),
+                    "a record layout .toml (README, *Record layouts*) relative to the scene file",
+                ));
+            }
+            crate::layout::RecordLayout::from_file(&layout_path)?.read(&path)?
+        }
+    };
+    let samples = match &record {
+        crate::layout::LayoutRecord::Voltages(r) => r.time_s.len(),
+        crate::layout::LayoutRecord::Strains(s) => s.time_s.len(),
+    };
     let baseline = match r.baseline_samples {
         Some(n) => rv.in_range(
             "baseline_samples",
             n as f64,
             1.0,
-            (record.time_s.len() / 2) as f64,
+            (samples / 2).max(1) as f64,
             "samples",
         )? as usize,
-        None => shpb_core::reduce::ReductionOptions::default().baseline_samples,
+        None => shpb_core::reduce::ReductionOptions::default()
+            .baseline_samples
+            .min(samples / 2),
     };
-    let input =
-        shpb_core::reduce::record_strains(&record, apparatus, baseline).map_err(rv.core("file"))?;
+    let input = match record {
+        crate::layout::LayoutRecord::Voltages(rec) => {
+            shpb_core::reduce::record_strains(&rec, apparatus, baseline).map_err(rv.core("file"))?
+        }
+        crate::layout::LayoutRecord::Strains(mut s) => {
+            s.incident_strain = shpb_core::gauge::remove_baseline(&s.incident_strain, baseline);
+            s
+        }
+    };
     shpb_core::apparatus::IncidentDrive::from_incident_gauge(
         &input.time_s,
         &input.incident_strain,
