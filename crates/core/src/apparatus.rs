@@ -266,9 +266,11 @@ pub struct PulseOptions {
     pub incident_drive: Option<IncidentDrive>,
 }
 
-/// A prescribed incident wave (docs/physics.md §6.10): the compressive stress on the incident
-/// bar's impact end, sampled every `dt_s` from t = 0, Pa. On elementary bars the incident
-/// gauge then reads it unchanged, delayed by the gauge's distance from that end over c0.
+/// A prescribed incident wave (docs/physics.md §6.10): the compressive stress the incident gauge
+/// recorded, sampled every `dt_s` from t = 0, Pa. The run pushes the incident bar's impact end
+/// with it ([`Apparatus::drive_at_impact_end`]: on dispersive bars with the dispersion over the
+/// gauge's distance taken back), so that the gauge reads it again, delayed by that distance over
+/// c0.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IncidentDrive {
     /// Sample interval, s.
@@ -276,7 +278,7 @@ pub struct IncidentDrive {
     /// Time of the incident wave's foot in the drive (2 % of its peak), s: where a striker's
     /// impact would be.
     pub foot_s: f64,
-    /// Compressive stress at the impact end, Pa.
+    /// Compressive stress at the incident gauge, Pa.
     pub stress_pa: Vec<f64>,
 }
 
@@ -530,6 +532,7 @@ impl Apparatus {
                 .incident_drive
                 .as_ref()
                 .map(|d| {
+                    let d = self.drive_at_impact_end(d, dispersion, dt);
                     let area = self.incident.area_m2();
                     let steps = (d.stress_pa.len() as f64 * d.dt_s / dt).ceil() as usize;
                     (0..=steps)
@@ -537,6 +540,50 @@ impl Apparatus {
                         .collect()
                 })
                 .unwrap_or_default(),
+        }
+    }
+}
+
+impl Apparatus {
+    /// The wave to push the incident bar's impact end with so that its incident gauge reads
+    /// `drive` (docs/physics.md §6.10), on the recorded time base shifted by the gauge's distance
+    /// x_g from that end over c0. Elementary bars: the recorded wave itself. Bars carrying the
+    /// exact first mode (`pochhammer-chree`, step `dt_s`): the recorded wave with the mode's
+    /// dispersion over x_g taken back, each component advanced by x_g (1/c(f) − 1/c0), and the
+    /// components above the bars' Nyquist frequency 1/(2 Δt) removed; the delay lines then
+    /// disperse it again on its way to the gauge.
+    pub fn drive_at_impact_end(
+        &self,
+        drive: &IncidentDrive,
+        dispersion: Dispersion,
+        dt_s: f64,
+    ) -> IncidentDrive {
+        let gauge = self.gauges.channel("incident");
+        let (Dispersion::PochhammerChree, Some(gauge)) = (dispersion, gauge) else {
+            return drive.clone();
+        };
+        let x_g = self.incident.length_m - gauge.distance_from_specimen_m;
+        let Ok(mode) = crate::dispersion::PochhammerChree::new(
+            self.material.poisson_ratio,
+            0.5 * self.incident.diameter_m,
+            self.material.wave_speed_m_s(),
+        ) else {
+            return drive.clone();
+        };
+        let nyquist_hz = 0.5 / dt_s;
+        let stress_pa = crate::numeric::spectral_filter(&drive.stress_pa, drive.dt_s, |bin| {
+            if bin.frequency_hz >= nyquist_hz {
+                (0.0, 0.0)
+            } else {
+                (
+                    -mode.delay_for_bin_s(bin.index, bin.length, drive.dt_s, x_g),
+                    1.0,
+                )
+            }
+        });
+        IncidentDrive {
+            stress_pa,
+            ..drive.clone()
         }
     }
 }

@@ -102,7 +102,7 @@ pub(super) const INCIDENT_RECORD: Key = Key {
     key: "incident_record",
     unit: "",
     default: "none: the gun, striker and shaper make the incident pulse",
-    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record (time_s, incident_V, transmission_V, read through the set-up's incident gauge channel) relative to the scene file; layout = a record layout .toml for another file format, as `shpb reduce --layout`; baseline_samples (default 900). Exclusive with pressure; elementary bars only (dispersion = none)",
+    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record (time_s, incident_V, transmission_V, read through the set-up's incident gauge channel) relative to the scene file; layout = a record layout .toml for another file format, as `shpb reduce --layout`; baseline_samples (default 900). Exclusive with pressure; bars: none or pochhammer-chree (which takes the recorded dispersion back)",
 };
 
 /// `smooth_s` (shpb only).
@@ -299,9 +299,13 @@ pub(super) fn parse_bars(
         _ => fidelity.bar_knobs(),
     };
     let dispersion = match f.dispersion.as_deref() {
-        // A recorded wave is already dispersed over its path from the impact end to the gauge:
-        // a drive runs on elementary bars, whatever the preset's.
-        None if drive.is_some() => Dispersion::None,
+        // A recorded wave is already dispersed over its path from the impact end to the gauge,
+        // which only the exact first mode can take back (docs/physics.md §6.10): a drive runs on
+        // those bars or on elementary ones, whatever the preset's fallback.
+        None if drive.is_some() => match knobs.dispersion {
+            Dispersion::PochhammerChree => Dispersion::PochhammerChree,
+            _ => Dispersion::None,
+        },
         None => knobs.dispersion,
         Some(name) => Dispersion::parse(name).ok_or_else(|| {
             v.error(
@@ -311,14 +315,14 @@ pub(super) fn parse_bars(
             )
         })?,
     };
-    if drive.is_some() && dispersion != Dispersion::None {
+    if drive.is_some() && !matches!(dispersion, Dispersion::None | Dispersion::PochhammerChree) {
         return Err(v.error(
             "dispersion",
             format!(
-                "`{}` with [incident_record]: the recorded wave is already dispersed over its path from the impact end to the gauge",
+                "`{}` with [incident_record]: the recorded wave is already dispersed over its path from the impact end to the gauge, and only the exact first mode can take that back",
                 dispersion.name()
             ),
-            "none (or leave dispersion out: a driven test runs elementary bars)",
+            "none or pochhammer-chree (or leave dispersion out)",
         ));
     }
     let c0 = apparatus.material.wave_speed_m_s();
