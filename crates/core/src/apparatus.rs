@@ -551,7 +551,8 @@ impl Apparatus {
     /// exact first mode (`pochhammer-chree`, step `dt_s`): the recorded wave with the mode's
     /// dispersion over x_g taken back, each component advanced by x_g (1/c(f) − 1/c0), and the
     /// components above the bars' Nyquist frequency 1/(2 Δt) removed; the delay lines then
-    /// disperse it again on its way to the gauge.
+    /// disperse it again on its way to the gauge. A set-up without an incident gauge channel
+    /// takes the wave as it is.
     pub fn drive_at_impact_end(
         &self,
         drive: &IncidentDrive,
@@ -652,5 +653,80 @@ impl Apparatus {
             stress_pa,
             chain,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record with a raised-cosine incident pulse (compression: negative strain) from 20 µs
+    /// to 70 µs and a tensile reflected pulse from 200 µs, at 0.1 µs.
+    fn record() -> (Vec<f64>, Vec<f64>) {
+        let bump = |t: f64, t0: f64, width: f64| {
+            let s = (t - t0) / width;
+            if (0.0..=1.0).contains(&s) {
+                0.5 * (1.0 - (2.0 * std::f64::consts::PI * s).cos())
+            } else {
+                0.0
+            }
+        };
+        let t: Vec<f64> = (0..3000).map(|k| k as f64 * 1e-7).collect();
+        let strain = t
+            .iter()
+            .map(|&t| -4e-4 * bump(t, 20e-6, 50e-6) + 3e-4 * bump(t, 200e-6, 50e-6))
+            .collect();
+        (t, strain)
+    }
+
+    /// The drive is the compressive stress −E ε from the first sample to DRIVE_MARGIN_S before
+    /// the reflected wave first passes 2 % of the incident peak in tension (on the 2 µs average),
+    /// its foot where the incident wave first passes 2 %; without a reflected wave, the whole
+    /// record.
+    #[test]
+    fn a_drive_is_the_incident_wave_cut_before_its_reflection() {
+        let (t, strain) = record();
+        let e = 200e9;
+        let d = IncidentDrive::from_incident_gauge(&t, &strain, e).unwrap();
+        assert_eq!(d.dt_s, 1e-7);
+        assert_eq!(d.stress_pa[300], -e * strain[300]);
+        // 2 % of a raised cosine of width w is reached at s = acos(1 − 0.04)/(2π) of it.
+        let s = (1.0f64 - 0.04).acos() / (2.0 * std::f64::consts::PI);
+        let foot = 20e-6 + s * 50e-6;
+        // The 2 µs moving average moves a crossing on this slope by well under 0.1 µs.
+        assert!((d.foot_s - foot).abs() < 0.1e-6, "{} vs {foot}", d.foot_s);
+        // Tension through 2 % of the incident peak (4e-4 · 0.02 = 8e-6): the reflected bump
+        // reaches 8e-6 of its 3e-4 at s' with 0.5 (1 − cos 2πs') = 8e-6/3e-4.
+        let s_r = (1.0f64 - 2.0 * 8e-6 / 3e-4).acos() / (2.0 * std::f64::consts::PI);
+        let reflected = 200e-6 + s_r * 50e-6;
+        assert!(
+            (d.duration_s() - (reflected - DRIVE_MARGIN_S)).abs() < 0.2e-6,
+            "{} vs {}",
+            d.duration_s(),
+            reflected - DRIVE_MARGIN_S
+        );
+        // No reflected wave: the whole record.
+        let only: Vec<f64> = strain.iter().map(|&x| x.min(0.0)).collect();
+        let whole = IncidentDrive::from_incident_gauge(&t, &only, e).unwrap();
+        assert_eq!(whole.stress_pa.len(), t.len());
+        // Nothing compressive: no drive.
+        let tensile: Vec<f64> = strain.iter().map(|&x| x.max(0.0)).collect();
+        assert!(IncidentDrive::from_incident_gauge(&t, &tensile, e).is_none());
+    }
+
+    /// Between samples the drive is linear; before its first sample and after its last, zero.
+    #[test]
+    fn a_drive_is_linear_between_its_samples_and_zero_outside() {
+        let d = IncidentDrive {
+            dt_s: 1e-6,
+            foot_s: 0.0,
+            stress_pa: vec![0.0, 10.0, 30.0],
+        };
+        assert_eq!(d.stress_at_pa(0.5e-6), 5.0);
+        assert!((d.stress_at_pa(1.25e-6) - 15.0).abs() < 1e-12);
+        assert_eq!(d.stress_at_pa(2e-6), 30.0);
+        assert_eq!(d.stress_at_pa(-1e-9), 0.0);
+        assert_eq!(d.stress_at_pa(2.5e-6), 0.0);
+        assert_eq!(d.stress_at_pa(f64::NAN), 0.0);
     }
 }
