@@ -88,6 +88,32 @@ fn a_recorded_incident_wave_drives_the_virtual_test() {
         );
     }
 
+    // After the drive has ended and before the reflected wave is back, the impact end is at
+    // rest: no two-step oscillation of the end node is left there (the drive is band-limited
+    // below the bars' Nyquist frequency, where such an oscillation would not travel away), to a
+    // tenth of the record's own noise (RMS of its pre-trigger stress).
+    let e_pa = apparatus.material.youngs_modulus_pa;
+    let noise_rms = (strains.incident_strain[..900]
+        .iter()
+        .map(|x| (e_pa * x).powi(2))
+        .sum::<f64>()
+        / 900.0)
+        .sqrt();
+    let bar = out.bars.iter().find(|b| b.name == "incident").unwrap();
+    // The drive's first sample, reflected at the specimen, is back at the impact end after 2 L/c0.
+    let back = 2.0 * apparatus.incident.length_m / c0;
+    let left = bar
+        .time_s
+        .iter()
+        .zip(&bar.stress_pa)
+        .filter(|(t, _)| **t > drive.duration_s() + 20e-6 && **t < back - 20e-6)
+        .map(|(_, row)| row[0].abs())
+        .fold(0.0, f64::max);
+    assert!(
+        left <= 0.1 * noise_rms,
+        "{left:e} Pa left at the impact end (noise RMS {noise_rms:e} Pa)"
+    );
+
     // The drive's work is the energy its samples carry, A/(ρ c0) ∫σ² dt (the same wave read
     // at the chain's steps: equal within the record's noise energy over the drive's window).
     let area = apparatus.incident.area_m2();
@@ -175,10 +201,10 @@ fn a_record_in_a_lab_layout_drives_the_test_as_the_raw_record() {
 /// impact end to the gauge, so the drive takes the mode's dispersion over that distance back
 /// first (`Apparatus::drive_at_impact_end`). Round trip: the incident gauge of a `reference`
 /// test (noise-free, point gauge) drives a second `reference` test, whose gauge reads it back
-/// within 1e-3 of the peak (5.0e-4), as close as elementary bars read it (4.6e-4: the
-/// resampling onto the bars' steps and back, all that is left there), while the dispersion the
-/// drive took back is twenty times larger (1.0e-2 of the peak) — without it the wave would
-/// reach the gauge dispersed twice.
+/// within 1e-3 of the peak (3.8e-4), as close as elementary bars read it (4.9e-4: the band
+/// limit and the resampling onto the bars' steps and back, all that is left there), while the
+/// dispersion the drive took back is larger by far (1.0e-2 of the peak) — without it the wave
+/// would reach the gauge dispersed twice.
 #[test]
 fn on_dispersive_bars_the_drive_takes_the_recorded_dispersion_back() {
     let scene = repo().join("scenes/shpb-ss440c-10psi.toml");

@@ -286,6 +286,10 @@ pub struct IncidentDrive {
 /// reflected wave on the same channel ([`IncidentDrive::from_incident_gauge`]), s.
 pub const DRIVE_MARGIN_S: f64 = 10e-6;
 
+/// Length over which a drive is brought to zero at its start and end before its band limit
+/// ([`Apparatus::drive_at_impact_end`]), s: a fraction of the margin before the reflected wave.
+pub const DRIVE_EDGE_S: f64 = 2e-6;
+
 impl IncidentDrive {
     /// The incident wave of an incident-gauge record (docs/physics.md §6.10): its compressive
     /// stress −E ε (`strain` tension positive, baseline removed, on the uniform times `time_s`)
@@ -547,40 +551,52 @@ impl Apparatus {
 impl Apparatus {
     /// The wave to push the incident bar's impact end with so that its incident gauge reads
     /// `drive` (docs/physics.md §6.10), on the recorded time base shifted by the gauge's distance
-    /// x_g from that end over c0. Elementary bars: the recorded wave itself. Bars carrying the
-    /// exact first mode (`pochhammer-chree`, step `dt_s`): the recorded wave with the mode's
-    /// dispersion over x_g taken back, each component advanced by x_g (1/c(f) − 1/c0), and the
-    /// components above the bars' Nyquist frequency 1/(2 Δt) removed; the delay lines then
-    /// disperse it again on its way to the gauge. A set-up without an incident gauge channel
-    /// takes the wave as it is.
+    /// x_g from that end over c0, for bars of step `dt_s`. Its spectrum is first limited to the
+    /// band the bars carry as waves, Ω = 2π f Δt ≤ π/2, with the delay lines' smooth step to 0 at
+    /// Ω = π: a drive with content at the bars' Nyquist frequency (a record's noise, or the steps
+    /// where the record is cut, which are first brought to zero over [`DRIVE_EDGE_S`]) would
+    /// excite the end node's two-step oscillation, which at Courant 1 does not travel. On bars carrying
+    /// the exact first mode (`pochhammer-chree`) each component is also advanced by
+    /// x_g (1/c(f) − 1/c0), taking back the dispersion the wave gathered on its way to the gauge,
+    /// which the delay lines then apply again. A set-up without an incident gauge channel takes
+    /// the wave as it is, band-limited.
     pub fn drive_at_impact_end(
         &self,
         drive: &IncidentDrive,
         dispersion: Dispersion,
         dt_s: f64,
     ) -> IncidentDrive {
+        use std::f64::consts::PI;
         let gauge = self.gauges.channel("incident");
-        let (Dispersion::PochhammerChree, Some(gauge)) = (dispersion, gauge) else {
-            return drive.clone();
+        let x_g = gauge.map_or(0.0, |g| self.incident.length_m - g.distance_from_specimen_m);
+        let mode = match dispersion {
+            Dispersion::PochhammerChree if x_g > 0.0 => crate::dispersion::PochhammerChree::new(
+                self.material.poisson_ratio,
+                0.5 * self.incident.diameter_m,
+                self.material.wave_speed_m_s(),
+            )
+            .ok(),
+            _ => None,
         };
-        let x_g = self.incident.length_m - gauge.distance_from_specimen_m;
-        let Ok(mode) = crate::dispersion::PochhammerChree::new(
-            self.material.poisson_ratio,
-            0.5 * self.incident.diameter_m,
-            self.material.wave_speed_m_s(),
-        ) else {
-            return drive.clone();
-        };
-        let nyquist_hz = 0.5 / dt_s;
-        let stress_pa = crate::numeric::spectral_filter(&drive.stress_pa, drive.dt_s, |bin| {
-            if bin.frequency_hz >= nyquist_hz {
-                (0.0, 0.0)
-            } else {
-                (
-                    -mode.delay_for_bin_s(bin.index, bin.length, drive.dt_s, x_g),
-                    1.0,
-                )
-            }
+        // The record starts and ends at its noise level or its tail, steps the band limit below
+        // would smear into a ringing across the cut: both ends are brought to zero over
+        // DRIVE_EDGE_S first, and the end is followed by zeros for the filtered wave to settle.
+        let edge = ((DRIVE_EDGE_S / drive.dt_s).ceil() as usize).min(drive.stress_pa.len() / 2);
+        let mut padded = drive.stress_pa.clone();
+        let n = padded.len();
+        for k in 0..edge {
+            let w = 0.5 * (1.0 - (PI * (k as f64 + 0.5) / edge as f64).cos());
+            padded[k] *= w;
+            padded[n - 1 - k] *= w;
+        }
+        padded.resize(n + 2 * edge, 0.0);
+        let stress_pa = crate::numeric::spectral_filter(&padded, drive.dt_s, |bin| {
+            let gain = crate::transit::taper(2.0 * PI * bin.frequency_hz * dt_s, 0.5 * PI, PI);
+            let advance = match (&mode, gain > 0.0) {
+                (Some(m), true) => m.delay_for_bin_s(bin.index, bin.length, drive.dt_s, x_g),
+                _ => 0.0,
+            };
+            (-advance, gain)
         });
         IncidentDrive {
             stress_pa,

@@ -152,7 +152,7 @@ pub struct TransitFilter {
 
 /// Smooth (C∞) step weight: 1 up to `a`, 0 from `b`, `S(x) = e^{−1/x}/(e^{−1/x} + e^{−1/(1−x)})`
 /// of x = (b − w)/(b − a) between, so the impulse response has no algebraic tail.
-fn taper(w: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn taper(w: f64, a: f64, b: f64) -> f64 {
     if w <= a {
         1.0
     } else if w >= b {
