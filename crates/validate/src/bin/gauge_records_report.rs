@@ -1416,11 +1416,10 @@ fn effective_path(rows: &[Row], app: &Apparatus) -> PathFit {
     let d_m = mean(each.iter().copied());
     let lo = each.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = each.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let var = each.iter().map(|x| (x - d_m).powi(2)).sum::<f64>() / (each.len().max(2) - 1) as f64;
     PathFit {
         d_m,
         half_spread_m: 0.5 * (hi - lo),
-        std_m: var.sqrt(),
+        std_m: sample_sd(&each, d_m),
     }
 }
 
@@ -1455,6 +1454,36 @@ fn mean(it: impl Iterator<Item = f64>) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
+/// Sample standard deviation (n − 1) about `m` (0 for fewer than two values).
+fn sample_sd(v: &[f64], m: f64) -> f64 {
+    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len().max(2) - 1) as f64).sqrt()
+}
+
+/// Arrival residuals (reflected, transmitted) of a virtual test against its record, s.
+fn residuals(x: &Simulated, r: &Row) -> (f64, f64) {
+    (
+        x.delays.reflected_s - r.timing.record.reflected_s,
+        x.delays.transmitted_s - r.timing.record.transmitted_s,
+    )
+}
+
+/// Transmitted residuals of one variant over the records: mean, sample sd and how many within
+/// the arrival acceptance, s.
+fn transmitted_stats(rows: &[Row], variant: &dyn Fn(&Row) -> &Simulated) -> (f64, f64, usize) {
+    let t: Vec<f64> = rows.iter().map(|r| residuals(variant(r), r).1).collect();
+    let m = mean(t.iter().copied());
+    (
+        m,
+        sample_sd(&t, m),
+        t.iter().filter(|x| within(**x)).count(),
+    )
+}
+
+/// "yes" or "no".
+fn yes(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
 /// The virtual test with the effective incident path (fitted before the report is written).
 fn eff(r: &Row) -> &Simulated {
     r.timing
@@ -1485,12 +1514,7 @@ fn scaled_paths_paragraph(w: &mut String, rows: &[Row], app: &Apparatus, fit: &P
     };
     let (d_i, d_t) = (distance("incident"), distance("transmission"));
     let s = fit.d_m / d_i;
-    let res = |x: &Simulated, r: &Row| {
-        (
-            x.delays.reflected_s - r.timing.record.reflected_s,
-            x.delays.transmitted_s - r.timing.record.transmitted_s,
-        )
-    };
+    let res = residuals;
     let _ = writeln!(
         w,
         "**(e) Both gauge paths scaled.** The same fitted constant read as a scale of both stated \
@@ -1511,7 +1535,6 @@ fn scaled_paths_paragraph(w: &mut String, rows: &[Row], app: &Apparatus, fit: &P
         "| sample | specimen | (e) Δ_R / Δ_T (µs) | residual R / T (µs) | within 3 µs R / T | residual T with (c) (µs) |"
     );
     let _ = writeln!(w, "|---|---|---|---|---|---|");
-    let yes = |b: bool| if b { "yes" } else { "no" };
     for r in rows {
         let (er, et) = res(scaled(r), r);
         let (_, ct) = res(eff(r), r);
@@ -1531,14 +1554,8 @@ fn scaled_paths_paragraph(w: &mut String, rows: &[Row], app: &Apparatus, fit: &P
         );
     }
     let n = rows.len();
-    let stats = |f: &dyn Fn(&Row) -> &Simulated| {
-        let t: Vec<f64> = rows.iter().map(|r| res(f(r), r).1).collect();
-        let m = mean(t.iter().copied());
-        let sd = (t.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n.max(2) - 1) as f64).sqrt();
-        (m, sd, t.iter().filter(|x| within(**x)).count())
-    };
-    let (em, esd, ek) = stats(&scaled);
-    let (cm, csd, ck) = stats(&eff);
+    let (em, esd, ek) = transmitted_stats(rows, &scaled);
+    let (cm, csd, ck) = transmitted_stats(rows, &eff);
     let both = rows
         .iter()
         .filter(|r| {
@@ -1581,12 +1598,7 @@ fn driven(r: &Row) -> &Simulated {
 /// Timing variant (f): the geometry of (e) driven by each record's own incident wave instead of
 /// the gun, striker and shaper models, so that what remains is the specimen side's.
 fn driven_paragraph(w: &mut String, rows: &[Row]) {
-    let res = |x: &Simulated, r: &Row| {
-        (
-            x.delays.reflected_s - r.timing.record.reflected_s,
-            x.delays.transmitted_s - r.timing.record.transmitted_s,
-        )
-    };
+    let res = residuals;
     let peak_back = |x: &Reduction| x.force_back_n[x.peak_index];
     let _ = writeln!(
         w,
@@ -1605,7 +1617,6 @@ fn driven_paragraph(w: &mut String, rows: &[Row]) {
         "| sample | specimen | (f) Δ_R / Δ_T (µs) | residual R / T (µs) | within 3 µs R / T | peak back force, (f) / record | (a) shipped / record | equilibrium ratio at peak, (f) |"
     );
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|");
-    let yes = |b: bool| if b { "yes" } else { "no" };
     for r in rows {
         let d = driven(r);
         let (fr, ft) = res(d, r);
@@ -1627,14 +1638,8 @@ fn driven_paragraph(w: &mut String, rows: &[Row]) {
         );
     }
     let n = rows.len();
-    let t: Vec<f64> = rows.iter().map(|r| res(driven(r), r).1).collect();
-    let m = mean(t.iter().copied());
-    let sd = (t.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n.max(2) - 1) as f64).sqrt();
-    let k = t.iter().filter(|x| within(**x)).count();
-    let scaled_t: Vec<f64> = rows.iter().map(|r| res(scaled(r), r).1).collect();
-    let m_e = mean(scaled_t.iter().copied());
-    let sd_e =
-        (scaled_t.iter().map(|x| (x - m_e).powi(2)).sum::<f64>() / (n.max(2) - 1) as f64).sqrt();
+    let (m, sd, k) = transmitted_stats(rows, &driven);
+    let (m_e, sd_e, _) = transmitted_stats(rows, &scaled);
     let (f_lo, f_hi) = min_max(
         rows.iter()
             .map(|r| peak_back(&driven(r).reduction) / peak_back(&r.ours)),
@@ -1729,13 +1734,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
         "| sample | specimen | record Δ_R (µs) | Δ_T (µs) | (a) shipped Δ_R / Δ_T (µs) | residual R / T (µs) | (b) inserts Δ_R / Δ_T (µs) | residual R / T (µs) | (c) effective path Δ_R / Δ_T (µs) | residual R / T (µs) | (c) within 3 µs R / T |"
     );
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|");
-    let res = |s: &Simulated, r: &Row| {
-        (
-            s.delays.reflected_s - r.timing.record.reflected_s,
-            s.delays.transmitted_s - r.timing.record.transmitted_s,
-        )
-    };
-    let yes = |b: bool| if b { "yes" } else { "no" };
+    let res = residuals;
     for r in rows {
         let t = &r.timing;
         let pair = |s: &Simulated| {
