@@ -130,8 +130,7 @@ struct PulseFile {
     bars: String,
     pressure: Option<String>,
     incident_record: Option<IncidentRecordFile>,
-    #[serde(default)]
-    shaper: ShaperOverride,
+    shaper: Option<ShaperOverride>,
     cell_size_m: Option<f64>,
     #[serde(default = "default_incident_end")]
     incident_end: String,
@@ -263,9 +262,18 @@ pub(super) fn parse_bars(
     };
     let face_modulus_pa =
         apparatus.material.youngs_modulus_pa / (1.0 - apparatus.material.poisson_ratio.powi(2));
-    let shaper = f
-        .shaper
-        .apply(apparatus.shaper, face_modulus_pa, &v.table("shaper"))?;
+    if drive.is_some() && f.shaper.is_some() {
+        return Err(v.error(
+            "shaper",
+            "given with [incident_record], which replaces the gun, striker and shaper",
+            "no [shaper] table in a test driven by a record",
+        ));
+    }
+    let shaper = f.shaper.unwrap_or_default().apply(
+        apparatus.shaper,
+        face_modulus_pa,
+        &v.table("shaper"),
+    )?;
     let end = match f.incident_end.as_str() {
         _ if is_test => IncidentEnd::Specimen,
         "transmission" => IncidentEnd::Transmission,
