@@ -40,6 +40,8 @@ const AUTHORS_INSERT_LENGTH_M: f64 = 6.35e-3;
 /// Reflected and transmitted foot minus incident foot of one test, s (docs/physics.md §7.5).
 #[derive(Debug, Clone, Copy)]
 struct Delays {
+    /// Incident foot on the record's (or run's) own time base, s.
+    incident_s: f64,
     /// Reflected foot (tension, incident gauge) − incident foot, s.
     reflected_s: f64,
     /// Transmitted foot (transmission gauge) − incident foot, s.
@@ -83,6 +85,7 @@ fn foot_delays(t: &[f64], eps_incident: &[f64], eps_transmission: &[f64]) -> Opt
     let peak = inc.iter().copied().fold(0.0, f64::max);
     let between_pulses = inc[a..b].iter().sum::<f64>() / (b - a).max(1) as f64 / peak;
     Some(Delays {
+        incident_s: t_i,
         reflected_s,
         transmitted_s: foot_in(&tra, 1.0, 100e-6, 550e-6)?,
         between_pulses,
@@ -95,6 +98,10 @@ struct Simulated {
     delays: Delays,
     /// Its reduction (`shpb run`'s reduction of the simulated records).
     reduction: Reduction,
+    /// Times of its gauge records, s.
+    time_s: Vec<f64>,
+    /// Its transmission-gauge strain (noise-free, tension positive).
+    transmission_strain: Vec<f64>,
 }
 
 /// Runs the virtual test `validation/fig4-virtual-shpb/<scene>.toml` with its set-up changed by
@@ -138,7 +145,12 @@ fn simulate_with(
         .reduction
         .clone()
         .ok_or_else(|| bad("no reduction of the simulated records"))?;
-    Ok(Simulated { delays, reduction })
+    Ok(Simulated {
+        delays,
+        reduction,
+        time_s: t.to_vec(),
+        transmission_strain: strain("transmission")?.to_vec(),
+    })
 }
 
 /// [`simulate`] with both gauge paths scaled by `path_scale` ([`with_scaled_paths`]) and the
@@ -254,6 +266,8 @@ struct Timing {
     /// The same geometry driven by the record's own incident wave instead of gun, striker and
     /// shaper (docs/physics.md §6.10).
     driven: Option<Simulated>,
+    /// [`transmitted_shape_rms`] of the driven test against the record.
+    driven_shape_rms: f64,
     /// Record reduced with the reflected window on its own foot delay (transmitted as stated).
     record_reflected_on_foot: Reduction,
     /// Record reduced with the effective incident path (both windows).
@@ -614,6 +628,7 @@ fn main() -> Result<()> {
             effective: None,
             scaled: None,
             driven: None,
+            driven_shape_rms: f64::NAN,
             record_reflected_on_foot,
             record_effective_path: None,
             record_on_feet: None,
@@ -685,7 +700,14 @@ fn main() -> Result<()> {
             problem: "no incident pulse".into(),
             allowed: "a record with an incident pulse".into(),
         })?;
-        r.timing.driven = Some(simulate_driven(&root, sample.scene, path_scale, drive)?);
+        let driven = simulate_driven(&root, sample.scene, path_scale, drive)?;
+        r.timing.driven_shape_rms = transmitted_shape_rms(
+            &driven,
+            &input.time_s,
+            &input.transmission_strain,
+            &r.timing.record,
+        );
+        r.timing.driven = Some(driven);
         let run_with = |w: WindowOverride, dispersion| -> Result<Reduction> {
             reduce(
                 &input,
@@ -752,13 +774,20 @@ fn main() -> Result<()> {
             )
             .ok_or_else(no_feet)?;
             let scene = format!("{}-10psi", d.material);
+            let simulated = simulate_driven(&root, &scene, path_scale, drive)?;
             Ok(DayRow {
                 number: d.number,
                 label: d.authors_label,
                 material: d.material,
                 incident_peak_pa: incident_peak_pa(&record, app.material.youngs_modulus_pa),
+                shape_rms: transmitted_shape_rms(
+                    &simulated,
+                    &input.time_s,
+                    &input.transmission_strain,
+                    &delays,
+                ),
                 delays,
-                simulated: simulate_driven(&root, &scene, path_scale, drive)?,
+                simulated,
                 record,
             })
         })
@@ -1308,6 +1337,8 @@ struct DayRow {
     record: Reduction,
     /// The virtual test: geometry (e), driven by the record's incident wave.
     simulated: Simulated,
+    /// [`transmitted_shape_rms`] of the virtual test against the record.
+    shape_rms: f64,
 }
 
 /// The section on the 2013-06-06 records: pressures, striker and shaper unknown, so the record's
@@ -1332,15 +1363,15 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
     );
     let _ = writeln!(
         w,
-        "| sample | specimen (test_data.txt) | incident peak (MPa) | peak back force record / simulated (kN) | simulated / record | Δ_T record / simulated (µs) | residual T (µs) | within 3 µs | equilibrium ratio at peak, record / simulated |"
+        "| sample | specimen (test_data.txt) | incident peak (MPa) | peak back force record / simulated (kN) | simulated / record | Δ_T record / simulated (µs) | residual T (µs) | within 3 µs | equilibrium ratio at peak, record / simulated | transmitted shape RMS, of its peak |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|");
     for d in day {
         let (f_rec, f_sim) = (peak_back(&d.record), peak_back(&d.simulated.reduction));
         let residual = d.simulated.delays.transmitted_s - d.delays.transmitted_s;
         let _ = writeln!(
             w,
-            "| {} | {} (\"{}\") | {:.1} | {:.2} / {:.2} | {:.3} | {} / {} | {:+.1} | {} | {:.2} / {:.3} |",
+            "| {} | {} (\"{}\") | {:.1} | {:.2} / {:.2} | {:.3} | {} / {} | {:+.1} | {} | {:.2} / {:.3} | {:.3} |",
             d.number,
             d.material,
             d.label,
@@ -1354,6 +1385,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
             yes(within(residual)),
             d.record.equilibrium_ratio_at_peak,
             d.simulated.reduction.equilibrium_ratio_at_peak,
+            d.shape_rms,
         );
     }
     let ratios: Vec<f64> = day
@@ -1402,7 +1434,8 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
         w,
         "\nSimulated / record peak back force {:.3}–{:.3} (2013-05-22 driven the same way, *Timing* \
          (f): {:.3}–{:.3}); within ±10 % on samples {close:?} ({}/{}); further off: {}. \
-         Transmitted residual {:+.1} ± {:.1} µs (mean ± sd), {k}/{} within 3 µs; the records' \
+         Transmitted residual {:+.1} ± {:.1} µs (mean ± sd), {k}/{} within 3 µs; transmitted \
+         shape RMS {:.3}–{:.3} of the record's peak (as in *Timing* (f)); the records' \
          equilibrium ratio at peak {:.2}–{:.2}.\n",
         r_lo,
         r_hi,
@@ -1414,6 +1447,8 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
         m * 1e6,
         sd * 1e6,
         day.len(),
+        min_max(day.iter().map(|d| d.shape_rms)).0,
+        min_max(day.iter().map(|d| d.shape_rms)).1,
         q_lo,
         q_hi,
     );
@@ -1735,6 +1770,46 @@ fn yes(b: bool) -> &'static str {
     if b { "yes" } else { "no" }
 }
 
+/// Window of the transmitted-shape comparison around each transmitted foot, s.
+const SHAPE_WINDOW_S: (f64, f64) = (-10e-6, 250e-6);
+
+/// RMS difference of a virtual test's transmission-gauge signal and a record's, each on its own
+/// time base from its own transmitted foot over [`SHAPE_WINDOW_S`] (so the arrival residual does
+/// not enter), both after the feet's moving average, relative to the record's peak: how well the
+/// pulse's shape is predicted.
+fn transmitted_shape_rms(
+    sim: &Simulated,
+    record_t: &[f64],
+    record_strain: &[f64],
+    record: &Delays,
+) -> f64 {
+    let smooth = |t: &[f64], e: &[f64]| {
+        let half = (0.5 * FOOT_SMOOTHING_S / (t[1] - t[0])).round() as usize;
+        moving_average(e, half)
+    };
+    let (a, b) = (
+        smooth(&sim.time_s, &sim.transmission_strain),
+        smooth(record_t, record_strain),
+    );
+    let at = |t: &[f64], e: &[f64], x: f64| {
+        let j = t.partition_point(|&v| v < x).clamp(1, t.len() - 1);
+        let w = ((x - t[j - 1]) / (t[j] - t[j - 1])).clamp(0.0, 1.0);
+        e[j - 1] + w * (e[j] - e[j - 1])
+    };
+    let foot_sim = sim.delays.incident_s + sim.delays.transmitted_s;
+    let foot_rec = record.incident_s + record.transmitted_s;
+    let dt = record_t[1] - record_t[0];
+    let n = ((SHAPE_WINDOW_S.1 - SHAPE_WINDOW_S.0) / dt).round() as usize;
+    let diff: Vec<f64> = (0..=n)
+        .map(|k| {
+            let tau = SHAPE_WINDOW_S.0 + k as f64 * dt;
+            at(&sim.time_s, &a, foot_sim + tau) - at(record_t, &b, foot_rec + tau)
+        })
+        .collect();
+    let peak = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    (diff.iter().map(|d| d * d).sum::<f64>() / diff.len() as f64).sqrt() / peak
+}
+
 /// The virtual test with the effective incident path (fitted before the report is written).
 fn eff(r: &Row) -> &Simulated {
     r.timing
@@ -1865,15 +1940,15 @@ fn driven_paragraph(w: &mut String, rows: &[Row]) {
     );
     let _ = writeln!(
         w,
-        "| sample | specimen | (f) Δ_R / Δ_T (µs) | residual R / T (µs) | within 3 µs R / T | peak back force, (f) / record | (a) shipped / record | equilibrium ratio at peak, (f) |"
+        "| sample | specimen | (f) Δ_R / Δ_T (µs) | residual R / T (µs) | within 3 µs R / T | peak back force, (f) / record | (a) shipped / record | equilibrium ratio at peak, (f) | transmitted shape RMS, of its peak |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         let d = driven(r);
         let (fr, ft) = res(d, r);
         let _ = writeln!(
             w,
-            "| {} | {} {} psi | {} / {} | {:+.1} / {:+.1} | {} / {} | {:.3} | {:.3} | {:.3} |",
+            "| {} | {} {} psi | {} / {} | {:+.1} / {:+.1} | {} / {} | {:.3} | {:.3} | {:.3} | {:.3} |",
             r.n,
             r.material,
             r.psi,
@@ -1886,8 +1961,22 @@ fn driven_paragraph(w: &mut String, rows: &[Row]) {
             peak_back(&d.reduction) / peak_back(&r.ours),
             peak_back(&r.timing.shipped.reduction) / peak_back(&r.ours),
             d.reduction.equilibrium_ratio_at_peak,
+            r.timing.driven_shape_rms,
         );
     }
+    let (s_lo, s_hi) = min_max(rows.iter().map(|r| r.timing.driven_shape_rms));
+    let _ = writeln!(
+        w,
+        "\nTransmitted shape RMS: the RMS difference of the virtual and the recorded \
+         transmission-gauge stress, each from its own transmitted foot over {:.0} to {:.0} µs \
+         (the arrival residual left out), both on the feet's {:.0} µs moving average, relative to \
+         the record's peak: {:.3}–{:.3}, the record's noise included.",
+        SHAPE_WINDOW_S.0 * 1e6,
+        SHAPE_WINDOW_S.1 * 1e6,
+        FOOT_SMOOTHING_S * 1e6,
+        s_lo,
+        s_hi
+    );
     let n = rows.len();
     let (m, sd, k) = transmitted_stats(rows, &driven);
     let (m_e, sd_e, _) = transmitted_stats(rows, &scaled);
