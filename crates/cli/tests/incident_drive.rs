@@ -7,8 +7,7 @@ mod common;
 
 use common::repo;
 use shpb::apparatus::IncidentDrive;
-use shpb::gauge::{FOOT_SMOOTHING_S, RawRecord, pulse_foot};
-use shpb::numeric::moving_average;
+use shpb::gauge::{RawRecord, foot_signal, pulse_foot};
 use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
 use shpb_input::gauges::RawRecordFile;
@@ -16,9 +15,9 @@ use shpb_input::gauges::RawRecordFile;
 /// Where the compressive pulse of a strain series (tension positive) first rises through
 /// `fraction` of its peak, after the timing's moving average.
 fn crossing_s(t: &[f64], strain: &[f64], fraction: f64) -> f64 {
-    let half = (0.5 * FOOT_SMOOTHING_S / (t[1] - t[0])).round() as usize;
-    let c: Vec<f64> = moving_average(strain, half).iter().map(|e| -e).collect();
-    pulse_foot(&c, fraction).unwrap().time_s(t)
+    pulse_foot(&foot_signal(strain, t[1] - t[0]), fraction)
+        .unwrap()
+        .time_s(t)
 }
 
 #[test]

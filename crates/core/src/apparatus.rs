@@ -306,11 +306,7 @@ impl IncidentDrive {
         if dt_s.is_nan() || dt_s <= 0.0 {
             return None;
         }
-        let half = (0.5 * crate::gauge::FOOT_SMOOTHING_S / dt_s).round() as usize;
-        let compression: Vec<f64> = crate::numeric::moving_average(strain, half)
-            .iter()
-            .map(|e| -e)
-            .collect();
+        let compression = crate::gauge::foot_signal(strain, dt_s);
         let foot = crate::gauge::pulse_foot(&compression, crate::gauge::FOOT_FRACTION)?;
         let level = -crate::gauge::FOOT_FRACTION * compression[foot.peak_index];
         let margin = (DRIVE_MARGIN_S / dt_s).round() as usize;

@@ -496,6 +496,17 @@ pub const FOOT_FRACTION: f64 = 0.02;
 /// well under 1 µs, the same on both).
 pub const FOOT_SMOOTHING_S: f64 = 2e-6;
 
+/// A strain series (tension positive, sample step `dt_s`) as pulse feet are read on it
+/// (docs/physics.md §7.5): compression positive, on a centred moving average over
+/// [`FOOT_SMOOTHING_S`].
+pub fn foot_signal(strain: &[f64], dt_s: f64) -> Vec<f64> {
+    let half = (0.5 * FOOT_SMOOTHING_S / dt_s).round() as usize;
+    crate::numeric::moving_average(strain, half)
+        .iter()
+        .map(|e| -e)
+        .collect()
+}
+
 /// The foot of the first pulse of `y` at `fraction` of its peak (see [`PulseFoot`];
 /// docs/physics.md §7.5); None if `y` has no positive value.
 pub fn pulse_foot(y: &[f64], fraction: f64) -> Option<PulseFoot> {

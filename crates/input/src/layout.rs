@@ -125,6 +125,31 @@ pub enum LayoutRecord {
     Strains(ReductionInput),
 }
 
+impl LayoutRecord {
+    /// Samples in the record.
+    pub fn samples(&self) -> usize {
+        match self {
+            LayoutRecord::Voltages(r) => r.time_s.len(),
+            LayoutRecord::Strains(s) => s.time_s.len(),
+        }
+    }
+
+    /// The record as bar strains: voltages through the set-up's bridges, the mean of their first
+    /// `baseline_samples` samples removed ([`shpb_core::reduce::record_strains`]); strains as read.
+    pub fn into_strains(
+        self,
+        apparatus: &shpb_core::apparatus::Apparatus,
+        baseline_samples: usize,
+    ) -> shpb_core::Result<ReductionInput> {
+        match self {
+            LayoutRecord::Voltages(raw) => {
+                shpb_core::reduce::record_strains(&raw, apparatus, baseline_samples)
+            }
+            LayoutRecord::Strains(input) => Ok(input),
+        }
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ChannelFile {

@@ -13,7 +13,6 @@ use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_core::solver::ContactSeries;
 use shpb_input::files::{self, InputFile, Provenance};
-use shpb_input::layout::LayoutRecord;
 use shpb_input::prelude::*;
 use shpb_input::scene::Value;
 use shpb_input::{Error, Result, Validator};
@@ -492,12 +491,9 @@ pub fn reduce_record_with(
         )?
     } else if let Some(layout) = &choices.layout {
         let name = record.display().to_string();
-        let input = match layout.read(record)? {
-            LayoutRecord::Voltages(raw) => {
-                shpb_core::reduce::record_strains(&raw, &apparatus, options.baseline_samples)?
-            }
-            LayoutRecord::Strains(input) => input,
-        };
+        let input = layout
+            .read(record)?
+            .into_strains(&apparatus, options.baseline_samples)?;
         shpb_core::reduce::reduce_named(
             &input,
             &ReductionSetup::from_apparatus(&apparatus)?,

@@ -463,7 +463,7 @@ fn incident_drive(
     }
     // The record as bridge voltages (through the set-up's bridges) or, through a layout, as
     // voltages or bar strains.
-    let record = match &r.layout {
+    let mut record = match &r.layout {
         None => crate::layout::LayoutRecord::Voltages(shpb_core::gauge::RawRecord::read(&path)?),
         Some(l) => {
             let layout_path = base_dir.join(l);
@@ -477,10 +477,7 @@ fn incident_drive(
             crate::layout::RecordLayout::from_file(&layout_path)?.read(&path)?
         }
     };
-    let samples = match &record {
-        crate::layout::LayoutRecord::Voltages(r) => r.time_s.len(),
-        crate::layout::LayoutRecord::Strains(s) => s.time_s.len(),
-    };
+    let samples = record.samples();
     let baseline = match r.baseline_samples {
         Some(n) => rv.in_range(
             "baseline_samples",
@@ -493,15 +490,14 @@ fn incident_drive(
             .baseline_samples
             .min(samples / 2),
     };
-    let input = match record {
-        crate::layout::LayoutRecord::Voltages(rec) => {
-            shpb_core::reduce::record_strains(&rec, apparatus, baseline).map_err(rv.core("file"))?
-        }
-        crate::layout::LayoutRecord::Strains(mut s) => {
-            s.incident_strain = shpb_core::gauge::remove_baseline(&s.incident_strain, baseline);
-            s
-        }
-    };
+    // Voltages lose their baseline on the way to strains; strains as read lose it here (no
+    // reduction follows to take it).
+    if let crate::layout::LayoutRecord::Strains(s) = &mut record {
+        s.incident_strain = shpb_core::gauge::remove_baseline(&s.incident_strain, baseline);
+    }
+    let input = record
+        .into_strains(apparatus, baseline)
+        .map_err(rv.core("file"))?;
     shpb_core::apparatus::IncidentDrive::from_incident_gauge(
         &input.time_s,
         &input.incident_strain,

@@ -12,8 +12,10 @@ mod common;
 
 use shpb_core::apparatus::{Apparatus, IncidentDrive, Insert, PulseOptions};
 use shpb_core::bar::BarMaterial;
-use shpb_core::gauge::{BridgeKind, FOOT_FRACTION, FOOT_SMOOTHING_S, RawRecord, pulse_foot};
-use shpb_core::numeric::{argmax, least_squares, min_max, moving_average};
+use shpb_core::gauge::{
+    BridgeKind, FOOT_FRACTION, FOOT_SMOOTHING_S, RawRecord, foot_signal, pulse_foot,
+};
+use shpb_core::numeric::{argmax, least_squares, min_max};
 use shpb_core::reduce::{
     Alignment, Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
 };
@@ -58,16 +60,9 @@ struct Delays {
 /// transmitted one the first compressive pulse of the transmission gauge 100–550 µs after it.
 fn foot_delays(t: &[f64], eps_incident: &[f64], eps_transmission: &[f64]) -> Option<Delays> {
     let dt = t.get(1)? - t[0];
-    let half = (FOOT_SMOOTHING_S / dt / 2.0).round() as usize;
     // Compression positive.
-    let inc: Vec<f64> = moving_average(eps_incident, half)
-        .iter()
-        .map(|e| -e)
-        .collect();
-    let tra: Vec<f64> = moving_average(eps_transmission, half)
-        .iter()
-        .map(|e| -e)
-        .collect();
+    let inc = foot_signal(eps_incident, dt);
+    let tra = foot_signal(eps_transmission, dt);
     let t_i = pulse_foot(&inc, FOOT_FRACTION)?.time_s(t);
     let foot_in = |y: &[f64], sign: f64, from: f64, to: f64| -> Option<f64> {
         let (a, b) = (
@@ -1341,6 +1336,13 @@ struct DayRow {
     shape_rms: f64,
 }
 
+impl DayRow {
+    /// Transmitted arrival of the virtual test less the record's, s.
+    fn transmitted_residual_s(&self) -> f64 {
+        self.simulated.delays.transmitted_s - self.delays.transmitted_s
+    }
+}
+
 /// The section on the 2013-06-06 records: pressures, striker and shaper unknown, so the record's
 /// own incident wave drives the virtual test (docs/physics.md §6.10), which then predicts the
 /// transmitted peak force and arrival of a day nothing was fitted on.
@@ -1368,7 +1370,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|");
     for d in day {
         let (f_rec, f_sim) = (peak_back(&d.record), peak_back(&d.simulated.reduction));
-        let residual = d.simulated.delays.transmitted_s - d.delays.transmitted_s;
+        let residual = d.transmitted_residual_s();
         let _ = writeln!(
             w,
             "| {} | {} (\"{}\") | {:.1} | {:.2} / {:.2} | {:.3} | {} / {} | {:+.1} | {} | {:.2} / {:.3} | {:.3} |",
@@ -1393,18 +1395,10 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
         .map(|d| peak_back(&d.simulated.reduction) / peak_back(&d.record))
         .collect();
     let (r_lo, r_hi) = min_max(ratios.iter().copied());
-    let (m, sd) = {
-        let t: Vec<f64> = day
-            .iter()
-            .map(|d| d.simulated.delays.transmitted_s - d.delays.transmitted_s)
-            .collect();
-        let m = mean(t.iter().copied());
-        (m, sample_sd(&t, m))
-    };
-    let k = day
-        .iter()
-        .filter(|d| within(d.simulated.delays.transmitted_s - d.delays.transmitted_s))
-        .count();
+    let day_residuals: Vec<f64> = day.iter().map(DayRow::transmitted_residual_s).collect();
+    let m = mean(day_residuals.iter().copied());
+    let sd = sample_sd(&day_residuals, m);
+    let k = day_residuals.iter().filter(|x| within(**x)).count();
     let (f_lo, f_hi) = min_max(
         rows.iter()
             .map(|r| peak_back(&driven(r).reduction) / peak_back(&r.ours)),
@@ -1425,7 +1419,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
                 "sample {} ({:.2}; transmitted foot {:+.1} µs off, the record's equilibrium ratio {:.2})",
                 d.number,
                 r,
-                (d.simulated.delays.transmitted_s - d.delays.transmitted_s) * 1e6,
+                d.transmitted_residual_s() * 1e6,
                 d.record.equilibrium_ratio_at_peak
             )
         })
@@ -1469,9 +1463,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
         const LATE_FOOT_US: f64 = 10.0;
         let late: Vec<usize> = day
             .iter()
-            .filter(|d| {
-                (d.delays.transmitted_s - d.simulated.delays.transmitted_s) * 1e6 > LATE_FOOT_US
-            })
+            .filter(|d| -d.transmitted_residual_s() * 1e6 > LATE_FOOT_US)
             .map(|d| d.number)
             .collect();
         let (k_lo, k_hi) = min_max(
@@ -1783,10 +1775,8 @@ fn transmitted_shape_rms(
     record_strain: &[f64],
     record: &Delays,
 ) -> f64 {
-    let smooth = |t: &[f64], e: &[f64]| {
-        let half = (0.5 * FOOT_SMOOTHING_S / (t[1] - t[0])).round() as usize;
-        moving_average(e, half)
-    };
+    // Compression positive (the sign leaves the RMS of a difference and |peak| unchanged).
+    let smooth = |t: &[f64], e: &[f64]| foot_signal(e, t[1] - t[0]);
     let (a, b) = (
         smooth(&sim.time_s, &sim.transmission_strain),
         smooth(record_t, record_strain),
