@@ -136,6 +136,36 @@ fn a_recorded_incident_wave_drives_the_virtual_test() {
         (work - carried).abs() <= noise,
         "{work} J vs {carried} J (noise {noise} J)"
     );
+
+    // The run keeps the force it applied (`/drive/{time,force}`): it starts and ends at rest
+    // (tapered edges), its work on a bar at rest is Σ F² Δt / Z, the drive's
+    // work the bar's ledger recorded, and the file holds it as the run did.
+    let applied = out.drive.as_ref().expect("a driven run keeps its drive");
+    let f = &applied.force_n;
+    let dt = applied.time_s[1] - applied.time_s[0];
+    assert_eq!(applied.time_s.len(), f.len());
+    assert_eq!(applied.time_s[0], 0.0);
+    let peak = f.iter().copied().fold(0.0, f64::max);
+    // (The band limit leaves the first level at 6e-5 of the peak, under the record's noise.)
+    assert!(f[0].abs().max(f[f.len() - 1].abs()) <= 1e-4 * peak);
+    let on_bar_at_rest = f.iter().map(|x| x * x).sum::<f64>() * dt / z;
+    assert!(
+        (on_bar_at_rest - work).abs() <= 1e-9 * work,
+        "{on_bar_at_rest} J vs {work} J"
+    );
+    let h5 = dir.path().join("driven.h5");
+    shpb::io::write_hdf5(&h5, false, "kind = \"shpb\"", None, &out).unwrap();
+    let back = shpb_output::run_file::read_run_file(&h5).unwrap();
+    let read = |path: &str| -> Vec<f64> {
+        back.datasets
+            .iter()
+            .find(|d| d.path == path)
+            .unwrap_or_else(|| panic!("{path} in the run file"))
+            .data
+            .to_vec()
+    };
+    assert_eq!(&read("drive/force"), f);
+    assert_eq!(&read("drive/time"), &applied.time_s);
 }
 
 /// The same record as bar strains in a lab's own layout (`shpb strain --csv`, read back through a

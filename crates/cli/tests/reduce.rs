@@ -974,6 +974,7 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
         reduction: None,
         warnings: Vec::new(),
         chain: None,
+        drive: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run.h5");

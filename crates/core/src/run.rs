@@ -46,6 +46,20 @@ pub struct RunOutput {
     pub warnings: Vec<String>,
     /// `/chain/*`: every contact and sphere of a chain of spheres (chain scenes).
     pub chain: Option<ChainSeries>,
+    /// `/drive/{time,force}`: the force a recorded incident wave applied at the incident bar's
+    /// impact end (`[incident_record]` scenes, docs/physics.md §6.10).
+    pub drive: Option<DriveSeries>,
+}
+
+/// The prescribed force on the incident bar's impact end, one value per time step (the force of
+/// level n acts at t = n Δt), as the solver applied it: the recorded incident wave after its
+/// edge taper and band limit (docs/physics.md §6.10).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DriveSeries {
+    /// Times of the levels, s.
+    pub time_s: Vec<f64>,
+    /// Force toward +x (compression of the bar) at each level, N.
+    pub force_n: Vec<f64>,
 }
 
 pub use crate::solver::record::ChainSeries;
@@ -74,6 +88,7 @@ impl RunOutput {
             reduction: None,
             warnings: Vec::new(),
             chain: None,
+            drive: None,
         }
     }
 }

@@ -590,6 +590,12 @@ fn run_pulse(
         reduction,
         warnings,
         chain: spheres_rec.map(|rec| rec.into_series()),
+        drive: driven.then(|| crate::run::DriveSeries {
+            time_s: (0..chain.drive_force_n.len())
+                .map(|k| k as f64 * chain.dt_s)
+                .collect(),
+            force_n: chain.drive_force_n.clone(),
+        }),
     })
 }
 

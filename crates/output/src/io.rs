@@ -132,6 +132,25 @@ pub fn write_hdf5(
             }
             origin(&g, "time", TIME_ORIGIN, 0.0)?;
         }
+        if let Some(d) = &out.drive {
+            let g = f.create_group("drive").map_err(h5err(path))?;
+            write_dataset(&g, "time", &d.time_s, "s", path)?;
+            write_dataset(&g, "force", &d.force_n, "N", path)?;
+            origin(
+                &g,
+                "time",
+                "the drive's first level (t = 0 of the simulation)",
+                0.0,
+            )?;
+            let force = g.dataset("force").map_err(h5err(path))?;
+            string_attr(
+                &force,
+                "description",
+                "force on the incident bar's impact end (compression positive), one value per \
+                 time step: the recorded incident wave after its edge taper and band limit",
+                path,
+            )?;
+        }
         if let Some(t) = &out.time_s {
             let root = f.group("/").map_err(h5err(path))?;
             write_dataset(&root, "time", t, "s", path)?;

@@ -35,7 +35,8 @@ fn one_d<'a>(path: String, data: &'a [f64], units: &'a str) -> Dataset<'a> {
 }
 
 /// The numeric datasets [`crate::io::write_hdf5`] writes for `out`, in the order written:
-/// `contact/*`, `chain/*`, `time`, `gauges/<name>/{strain,voltage}`, `bars/<name>/{x,time,snapshots}`,
+/// `contact/*`, `chain/*`, `drive/{time,force}`, `time`, `gauges/<name>/{strain,voltage}`,
+/// `bars/<name>/{x,time,snapshots}`,
 /// `reduction/*`, `energy/*`, `summary/<key>` (scalars).
 pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
     let mut v = Vec::new();
@@ -53,6 +54,10 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
                 units: Cow::Borrowed(units),
             });
         }
+    }
+    if let Some(d) = &out.drive {
+        v.push(one_d("drive/time".into(), &d.time_s, "s"));
+        v.push(one_d("drive/force".into(), &d.force_n, "N"));
     }
     if let Some(t) = &out.time_s {
         v.push(one_d("time".into(), t, "s"));
@@ -215,6 +220,10 @@ mod tests {
             reduction: None,
             warnings: vec!["a warning".into()],
             chain: None,
+            drive: Some(shpb_core::run::DriveSeries {
+                time_s: vec![0.0, 1e-7, 2e-7],
+                force_n: vec![0.0, 3.0, 0.0],
+            }),
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.h5");

@@ -94,6 +94,7 @@ pub fn strain(
         reduction: None,
         warnings: Vec::new(),
         chain: None,
+        drive: None,
     };
     let text = format!(
         "record = \"{}\"\nbars = \"{}\"\nbaseline_samples = {n}\n",
