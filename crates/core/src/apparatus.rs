@@ -173,6 +173,8 @@ pub struct SpecimenSetup {
     pub region2: crate::contact::Region2Form,
     /// Unloading rule of the contact law.
     pub unloading: crate::contact::Unloading,
+    /// How the spheres sit between the bars before the test (every contact).
+    pub seating: crate::specimen::Seating,
 }
 
 /// Fewest cells the chain gives a cylindrical specimen (docs/physics.md §6.9): its lowest
@@ -454,6 +456,7 @@ impl Apparatus {
                             law: sp.law,
                             region2: sp.region2,
                             unloading: sp.unloading,
+                            seating: sp.seating,
                         });
                         if k + 2 < n {
                             bodies.push(crate::solver::BodySpec::Mass(crate::solver::MassSpec {

@@ -460,6 +460,17 @@ fn run_pulse(
         ]
     };
     summary.push(item("time_step", chain.dt_s, "s"));
+    // A seated specimen says how (§6.11): with a preload, `/contact` holds the whole force and
+    // the gauges and the reduction the change from it.
+    match options.specimen.as_ref().map(|sp| sp.seating) {
+        Some(crate::specimen::Seating::Gap { gap_m }) => {
+            summary.push(item("seating_gap", gap_m, "m"));
+        }
+        Some(crate::specimen::Seating::Preload { force_n }) => {
+            summary.push(item("seating_preload", force_n, "N"));
+        }
+        _ => {}
+    }
     let mut gauges = Vec::new();
     let mut time = None;
     for (k, probe) in chain.gauges.iter().enumerate() {

@@ -193,3 +193,24 @@ impl SphereChain {
             .fold(f64::INFINITY, f64::min)
     }
 }
+
+/// How the spheres of a test sit between the bars before the incident wave arrives
+/// (docs/physics.md §6.11): applied to every sphere–sphere contact of the specimen.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Seating {
+    /// Touching at rest, carrying no force (the default).
+    #[default]
+    Touching,
+    /// Each contact open by `gap_m` (m, > 0): it carries force once its closure exceeds the gap.
+    Gap {
+        /// The gap, m.
+        gap_m: f64,
+    },
+    /// Each contact pressed by a static force `force_n` (N, > 0), bars and spheres at rest in
+    /// equilibrium under it; the test is the change from that state (linear bars: the static
+    /// state superposes), the contact law starting from its quasi-static loading to that force.
+    Preload {
+        /// The static force, N.
+        force_n: f64,
+    },
+}

@@ -5,7 +5,7 @@ use crate::error::{Error, Result, Validator};
 use crate::material::MaterialFile;
 use serde::Deserialize;
 use shpb_core::material::Material;
-use shpb_core::specimen::{Sphere, SphereChain, SpherePair};
+use shpb_core::specimen::{Seating, Sphere, SphereChain, SpherePair};
 use std::path::Path;
 
 /// One sphere as written in a pair file or a scene's `[specimen]` table.
@@ -59,7 +59,17 @@ pub struct SpecimenSpec {
     pub diameter_m: Option<f64>,
     /// One table per sphere of a chain, sphere 1 first.
     pub sphere: Option<Vec<SphereSpec>>,
+    /// `shpb` scenes: each contact open by this gap before the test, m (0 to 1 mm).
+    pub gap_m: Option<f64>,
+    /// `shpb` scenes: each contact pressed by this static force before the test, N (0 to 10 kN).
+    pub preload_n: Option<f64>,
 }
+
+/// Largest seating gap a scene may give, m: beyond it the spheres are not seated but loose.
+pub const MAX_GAP_M: f64 = 1e-3;
+
+/// Largest seating preload a scene may give, N.
+pub const MAX_PRELOAD_N: f64 = 1e4;
 
 /// What a cylindrical specimen is given as, for messages.
 pub const CYLINDER_FORM: &str = "shape = \"cylinder\" with length_m and diameter_m (each greater than 0, at most 0.1 m) and material (a built-in name such as \"al2017\", a material .toml, or a table { density_kg_m3, youngs_modulus_pa, poisson_ratio })";
@@ -137,6 +147,59 @@ pub fn resolve_pair(
 }
 
 impl SpecimenSpec {
+    /// How the spheres sit between the bars (`gap_m` or `preload_n`, `shpb` scenes;
+    /// docs/physics.md §6.11): touching without either (or with a zero one).
+    pub fn build_seating(&self, v: &Validator) -> Result<Seating> {
+        let gap = self
+            .gap_m
+            .map(|g| v.in_range("gap_m", g, 0.0, MAX_GAP_M, "m"))
+            .transpose()?
+            .unwrap_or(0.0);
+        let preload = self
+            .preload_n
+            .map(|f| v.in_range("preload_n", f, 0.0, MAX_PRELOAD_N, "N"))
+            .transpose()?
+            .unwrap_or(0.0);
+        match (gap > 0.0, preload > 0.0) {
+            (true, true) => Err(v.error(
+                "preload_n",
+                "a contact cannot be both open by a gap and pressed by a preload",
+                "either gap_m or preload_n",
+            )),
+            (true, false) => Ok(Seating::Gap { gap_m: gap }),
+            (false, true) => Ok(Seating::Preload { force_n: preload }),
+            (false, false) => Ok(Seating::Touching),
+        }
+    }
+
+    /// The table without its seating keys (the `shpb` parser reads those with
+    /// [`SpecimenSpec::build_seating`] and the spheres from the rest).
+    pub fn spheres_only(&self) -> SpecimenSpec {
+        SpecimenSpec {
+            gap_m: None,
+            preload_n: None,
+            ..self.clone()
+        }
+    }
+
+    /// Refuses the seating keys where no bars hold the specimen (every scene kind but `shpb`,
+    /// and a cylinder, which sits on butt joints).
+    fn refuse_seating_keys(&self, v: &Validator) -> Result<()> {
+        for (key, given) in [
+            ("gap_m", self.gap_m.is_some()),
+            ("preload_n", self.preload_n.is_some()),
+        ] {
+            if given {
+                return Err(v.error(
+                    key,
+                    format!("`{key}` is how spheres sit between the bars of a test"),
+                    "kind = \"shpb\" with a specimen of spheres",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Whether the table asks for a cylinder (`shape = "cylinder"`); an unknown `shape` is an
     /// error naming the allowed ones.
     pub fn is_cylinder(&self, v: &Validator) -> Result<bool> {
@@ -189,6 +252,7 @@ impl SpecimenSpec {
         base_dir: &Path,
         v: &Validator,
     ) -> Result<shpb_core::apparatus::CylinderSpecimen> {
+        self.refuse_seating_keys(v)?;
         for (key, given) in [
             ("pair", self.pair.is_some()),
             ("sphere1", self.sphere1.is_some()),
@@ -251,6 +315,7 @@ impl SpecimenSpec {
     /// Validates the specimen of a chain (`chain` and `shpb` scenes): any of [`CHAIN_FORMS`].
     pub fn build_chain(&self, base_dir: &Path, v: &Validator) -> Result<SphereChain> {
         self.refuse_cylinder_keys(v)?;
+        self.refuse_seating_keys(v)?;
         if !self.is_chain_form() {
             return self.build(base_dir, v).map(|p| SphereChain::from_pair(&p));
         }
@@ -338,6 +403,7 @@ impl SpecimenSpec {
     /// Validates the specimen table of a scene.
     pub fn build(&self, base_dir: &Path, v: &Validator) -> Result<SpherePair> {
         self.refuse_cylinder_keys(v)?;
+        self.refuse_seating_keys(v)?;
         if self.is_chain_form() {
             return Err(v.error(
                 "count",

@@ -18,7 +18,7 @@
 use super::body::Body;
 use crate::contact::{Contact, ContactEval, LawKind, Region2Form, Unloading};
 use crate::shaper::{PulseShaper, ShaperState};
-use crate::specimen::ContactProperties;
+use crate::specimen::{ContactProperties, Seating};
 
 /// How two body ends touch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +38,8 @@ pub enum Joint {
         region2: Region2Form,
         /// Unloading rule.
         unloading: Unloading,
+        /// How the pair sits before the test (a gap, or a static preload).
+        seating: Seating,
     },
 }
 
@@ -53,26 +55,40 @@ pub struct JointState {
     pub contact: ContactEval,
     /// Sphere approach δ at which the last force was evaluated, m.
     pub approach_m: f64,
-    /// Compressive force carried in the last step, N.
+    /// Compressive force carried in the last step, N: for a preloaded contact the change from
+    /// the static preload (≥ −preload), which is what the bodies, at rest under the preload,
+    /// feel of it.
     pub force_n: f64,
     /// Work the joint has taken from the bodies, J (dissipation plus elastic energy held).
     pub work_j: f64,
+    /// Added to the bodies' closure to give the contact's approach, m: −gap of a gapped contact,
+    /// the static approach δ0 of a preloaded one, 0 otherwise.
+    pub closure_offset_m: f64,
+    /// The static force of a preloaded contact at δ0 (its law's quasi-static loading), N; 0
+    /// otherwise. The contact's force is `force_n + static_force_n`.
+    pub static_force_n: f64,
 }
 
 impl JointState {
     /// A joint with no history.
     pub fn new(joint: Joint) -> JointState {
-        let law = match joint {
+        let (mut law, seating) = match joint {
             Joint::Spheres {
                 props,
                 law,
                 region2,
                 unloading,
-            } => Some(law.build_options(props, region2, unloading)),
-            _ => None,
+                seating,
+            } => (Some(law.build_options(props, region2, unloading)), seating),
+            _ => (None, Seating::Touching),
+        };
+        let (closure_offset_m, static_force_n) = match (seating, law.as_mut()) {
+            (Seating::Gap { gap_m }, Some(_)) => (-gap_m, 0.0),
+            (Seating::Preload { force_n }, Some(l)) => preload(l.as_mut(), force_n),
+            _ => (0.0, 0.0),
         };
         let contact = match &law {
-            Some(l) => l.trial(0.0, 0.0),
+            Some(l) => l.trial(closure_offset_m, 0.0),
             None => ContactEval {
                 force_n: 0.0,
                 yield_stress_pa: 0.0,
@@ -84,10 +100,17 @@ impl JointState {
             shaper: ShaperState::default(),
             law,
             contact,
-            approach_m: 0.0,
+            approach_m: closure_offset_m,
             force_n: 0.0,
             work_j: 0.0,
+            closure_offset_m,
+            static_force_n,
         }
+    }
+
+    /// The contact's force: what the joint carries plus a preload's static force, N.
+    pub fn contact_force_n(&self) -> f64 {
+        self.force_n + self.static_force_n
     }
 
     /// Work taken from the bodies so far (plastic work plus elastic energy held), J.
@@ -109,10 +132,25 @@ impl JointState {
                     s.force_n(&mut shaper.clone(), p.average_closure_m(f, dt_s), dt_s)
                 })
             }
-            Joint::Spheres { .. } => {
+            Joint::Spheres {
+                seating: Seating::Touching,
+                ..
+            } => {
                 let law = self.law.as_ref().expect("sphere joints carry their law");
                 solve_force(|f| {
                     law.trial_force(p.average_closure_m(f, dt_s), p.closure_rate_m_s(f, dt_s))
+                })
+            }
+            Joint::Spheres { .. } => {
+                // Seated otherwise: the law at the approach closure + offset, less the static
+                // force; a preloaded contact may carry down to −preload (the spheres part).
+                let law = self.law.as_ref().expect("sphere joints carry their law");
+                let (offset, f0) = (self.closure_offset_m, self.static_force_n);
+                solve_force_from(-f0, |f| {
+                    law.trial_force(
+                        p.average_closure_m(f, dt_s) + offset,
+                        p.closure_rate_m_s(f, dt_s),
+                    ) - f0
                 })
             }
         }
@@ -126,7 +164,7 @@ impl JointState {
             }
             Joint::Spheres { .. } => {
                 let law = self.law.as_mut().expect("sphere joints carry their law");
-                self.approach_m = p.average_closure_m(f, dt_s);
+                self.approach_m = p.average_closure_m(f, dt_s) + self.closure_offset_m;
                 self.contact = law.evaluate(self.approach_m, p.closure_rate_m_s(f, dt_s));
             }
             Joint::Butt => {}
@@ -209,6 +247,42 @@ fn solve_force(law: impl Fn(f64) -> f64) -> f64 {
         |f| law(f) > f,
     );
     0.5 * (lo + hi)
+}
+
+/// [`solve_force`] on [lo, law(lo)] instead of [0, law(0)] (a preloaded contact's change of
+/// force reaches down to −preload), to 1e-12 of the bracket's largest magnitude.
+fn solve_force_from(lo: f64, law: impl Fn(f64) -> f64) -> f64 {
+    let hi = law(lo);
+    if hi <= lo {
+        return lo;
+    }
+    let scale = hi.abs().max(lo.abs());
+    let (a, b) = crate::numeric::bisect(lo, hi, 100, |a, b| b - a <= 1e-12 * scale, |f| law(f) > f);
+    0.5 * (a + b)
+}
+
+/// Quasi-static loading of a fresh contact to `force_n`: the approach δ0 at which its virgin
+/// curve at rest carries that force (bisection), reached in 64 equal steps at rest so the law's
+/// memory holds it; returns (δ0, the law's force there).
+fn preload(law: &mut dyn Contact, force_n: f64) -> (f64, f64) {
+    let mut hi = 1e-9;
+    while law.trial_force(hi, 0.0) < force_n && hi < 1.0 {
+        hi *= 2.0;
+    }
+    let (lo, hi) = crate::numeric::bisect(
+        0.0,
+        hi,
+        200,
+        |lo, hi| hi - lo <= 1e-15 * hi,
+        |d| law.trial_force(d, 0.0) < force_n,
+    );
+    let delta0 = 0.5 * (lo + hi);
+    let steps = 64;
+    let mut f = 0.0;
+    for k in 1..=steps {
+        f = law.evaluate(delta0 * k as f64 / steps as f64, 0.0).force_n;
+    }
+    (delta0, f)
 }
 
 /// Root of F = law(F) for a law that does not grow with F and crosses F = law(F) once (the

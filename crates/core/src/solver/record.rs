@@ -193,7 +193,8 @@ fn joint_level_time(step: usize, every: usize, dt_s: f64) -> Option<f64> {
 
 impl Recorder for ContactRecorder {
     fn record(&mut self, step: usize, _time_s: f64, _bodies: &[Body], joints: &[JointState]) {
-        // The force is the one the joint applied to the bodies (what the gauges see): it equals
+        // The force is the one the joint applied to the bodies (what the gauges see), plus a
+        // preload's static force (the contact's whole force; docs/physics.md §6.11): it equals
         // the law's value at the committed approach to the solve's 1e-12, except where the solve
         // stops on the law's jump at a turning point (the `dynamic` unloading starts from the
         // largest force reached, so at δ = δmax the law holds any force between the loading and
@@ -201,7 +202,7 @@ impl Recorder for ContactRecorder {
         if let Some(t) = joint_level_time(step, self.every, self.dt_s) {
             let j = &joints[self.joint];
             let applied = ContactEval {
-                force_n: j.force_n,
+                force_n: j.contact_force_n(),
                 ..j.contact
             };
             self.series.push(t, j.approach_m, &applied);
@@ -310,7 +311,7 @@ impl Recorder for SphereChainRecorder {
             self.series.time_s.push(t);
             for (k, &j) in self.joints.iter().enumerate() {
                 // The force applied to the bodies, as `ContactRecorder` records it.
-                self.series.contact_force_n[k].push(joints[j].force_n);
+                self.series.contact_force_n[k].push(joints[j].contact_force_n());
                 self.series.contact_approach_m[k].push(joints[j].approach_m);
             }
         }

@@ -79,6 +79,7 @@ pub fn hertz_chain(
                 law: LawKind::Hertz,
                 region2: Region2Form::Smooth,
                 unloading: Unloading::Static,
+                seating: crate::specimen::Seating::Touching,
             };
             count.saturating_sub(1)
         ],

@@ -187,10 +187,11 @@ pub(super) fn parse_bars(
             None
         }
         (Some(spec), true) => Some(shpb_core::apparatus::SpecimenSetup {
-            spheres: spec.build_chain(base_dir, &sv)?,
+            spheres: spec.spheres_only().build_chain(base_dir, &sv)?,
             law: f.law,
             region2: f.region2,
             unloading: f.unloading,
+            seating: spec.build_seating(&sv)?,
         }),
         (None, true) => {
             return Err(v.error(

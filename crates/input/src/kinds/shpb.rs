@@ -39,7 +39,7 @@ const SPECIMEN: Key = Key {
     key: "specimen",
     unit: "",
     default: "required",
-    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio)",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2), each contact seated touching (default), across gap_m (m, to 1 mm) or pressed by preload_n (N, to 10 kN); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio)",
 };
 
 fn parse(
@@ -130,6 +130,31 @@ mod tests {
         let c = options.cylinder.unwrap();
         assert_eq!(c.material.youngs_modulus_pa, 200e9);
         assert_eq!(options.cell_size_m, 5e-4);
+    }
+
+    /// `gap_m` and `preload_n` seat the spheres (docs/physics.md §6.11); zero or absent is
+    /// touching, as before.
+    #[test]
+    fn the_seating_keys_are_read() {
+        use shpb_core::specimen::Seating;
+        let v = Validator::new("s.toml");
+        let seating = |extra: &str| {
+            let text = format!(
+                "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n[specimen]\npair = \"ss440c\"\n{extra}"
+            );
+            let (_, _, _, p) = parse(&text, "s.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+            let SceneParams::Pulse { options, .. } = p else {
+                panic!("not a bar scene")
+            };
+            options.specimen.unwrap().seating
+        };
+        assert_eq!(seating(""), Seating::Touching);
+        assert_eq!(seating("gap_m = 0.0\n"), Seating::Touching);
+        assert_eq!(seating("gap_m = 2e-5\n"), Seating::Gap { gap_m: 2e-5 });
+        assert_eq!(
+            seating("preload_n = 50.0\n"),
+            Seating::Preload { force_n: 50.0 }
+        );
     }
 
     #[test]
