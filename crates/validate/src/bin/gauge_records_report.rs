@@ -2403,6 +2403,14 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
         .map(|(_, v)| stats(*v, false).0)
         .fold(f64::INFINITY, f64::min);
     let d_t_gap = d_t_scaled_m - o_gap * c0;
+    let ratio = |k: usize| {
+        min_max(
+            rows.iter()
+                .map(|r| variants[k].1(r).reduction.equilibrium_ratio_at_peak),
+        )
+    };
+    let ((t_lo, t_hi), (g_lo, g_hi), (p_lo, p_hi)) = (ratio(0), ratio(1), ratio(2));
+    let (r_lo, r_hi) = min_max(rows.iter().map(|r| r.ours.equilibrium_ratio_at_peak));
     let _ = writeln!(
         w,
         "Reading (an inference from eight records and two probes). Across a {:.0} µm gap the \
@@ -2414,7 +2422,10 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
          sharpens the toe (foot {:+.1} µs) and leaves the body late (spread {:.1} µs). Al2017 \
          keeps a spread of {:.1} µs or more in all three. So seating as modelled here accounts \
          for the shape of the steels' pulses only with a geometry the other arrivals do not \
-         support; the records do not say how the pairs sat.\n",
+         support; the records do not say how the pairs sat. Nor does either seating unbalance \
+         the simulated test as the records are: equilibrium ratio at peak {:.3}–{:.3} across \
+         the gap, {:.3}–{:.3} preloaded, {:.3}–{:.3} touching (records {:.2}–{:.2}, next \
+         section).\n",
         PROBE_GAP_M * 1e6,
         s_gap * 1e6,
         s_touch * 1e6,
@@ -2427,6 +2438,14 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
         f_pre * 1e6,
         s_pre * 1e6,
         al_least * 1e6,
+        g_lo,
+        g_hi,
+        p_lo,
+        p_hi,
+        t_lo,
+        t_hi,
+        r_lo,
+        r_hi,
     );
 }
 
