@@ -26,7 +26,7 @@ use shpb_input::csv::CsvTable;
 use shpb_input::gauges::reduce_record_file;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
-use shpb_output::plot::{Axes, Curve, xy_plot};
+use shpb_output::plot::{Axes, Curve, panels_figure, xy_plot};
 use shpb_validate::gauge_records::{SAMPLES, SAMPLES_2013_06_06, effective_mass_kg};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -345,6 +345,8 @@ struct Timing {
     driven_preload: Option<Simulated>,
     /// The record's [`transmitted_rise`].
     record_rise: [f64; 4],
+    /// The record's transmission-gauge strain on its times less its incident foot (s, strain).
+    record_transmitted: (Vec<f64>, Vec<f64>),
     /// Record reduced with the reflected window on its own foot delay (transmitted as stated).
     record_reflected_on_foot: Reduction,
     /// Record reduced with the effective incident path (both windows).
@@ -717,6 +719,10 @@ fn main() -> Result<()> {
                     problem: "no transmitted pulse rising through 50 % of its peak".into(),
                     allowed: "a record with the three pulses".into(),
                 })?,
+            record_transmitted: (
+                t.iter().map(|x| x - record_delays.incident_s).collect(),
+                input.transmission_strain.clone(),
+            ),
             record_reflected_on_foot,
             record_effective_path: None,
             record_on_feet: None,
@@ -949,11 +955,99 @@ fn main() -> Result<()> {
         )?;
     }
 
+    transmitted_figure(
+        &out_dir.join(TRANSMITTED_PNG),
+        &rows,
+        app.material.youngs_modulus_pa,
+    )?;
+
     let md = report(&rows, &day, &app, &fit)?;
     let path = out_dir.join("REPORT.md");
     std::fs::write(&path, md).map_err(|e| Error::io(&path, e))?;
-    println!("wrote {} and {} plots", path.display(), rows.len());
+    println!("wrote {} and {} plots", path.display(), rows.len() + 1);
     Ok(())
+}
+
+/// A curve of a figure: label, abscissae, ordinates, whether measured.
+type Trace = (String, Vec<f64>, Vec<f64>, bool);
+
+/// The figure of *Timing* (g): each record's transmitted pulse against its driven tests.
+const TRANSMITTED_PNG: &str = "transmitted_driven.png";
+
+/// Writes [`TRANSMITTED_PNG`]: per record, the transmission-gauge stress (compression positive,
+/// on the feet's moving average) against the time since the incident foot, record and driven
+/// tests touching, across the probe gap and preloaded.
+fn transmitted_figure(path: &Path, rows: &[Row], e_pa: f64) -> Result<()> {
+    let stress = |t: &[f64], eps: &[f64]| -> Vec<f64> {
+        foot_signal(eps, t[1] - t[0])
+            .iter()
+            .map(|x| x * e_pa)
+            .collect()
+    };
+    let window = |t: &[f64]| {
+        (
+            t.partition_point(|&x| x < TRANSMITTED_WINDOW_S.0 + 80e-6),
+            t.partition_point(|&x| x <= TRANSMITTED_WINDOW_S.0 + 380e-6),
+        )
+    };
+    // (time since the incident foot, stress) of each curve of each record.
+    let series: Vec<Vec<Trace>> = rows
+        .iter()
+        .map(|r| {
+            let (tr, er) = &r.timing.record_transmitted;
+            let mut v = vec![("record".to_string(), tr.clone(), stress(tr, er), true)];
+            let sims: [(&str, Option<&Simulated>); 3] = [
+                ("driven, touching (f)", Some(driven(r))),
+                ("driven, gap", r.timing.driven_gap.as_ref()),
+                ("driven, preload", r.timing.driven_preload.as_ref()),
+            ];
+            for (label, sim) in sims {
+                if let Some(x) = sim {
+                    let t: Vec<f64> = x.time_s.iter().map(|t| t - x.delays.incident_s).collect();
+                    let y = stress(&x.time_s, &x.transmission_strain);
+                    v.push((label.to_string(), t, y, false));
+                }
+            }
+            // On the 2 µs average, a point every 0.5 µs shows all there is (and keeps the PNG small).
+            v.into_iter()
+                .map(|(label, t, y, measured)| {
+                    let (a, b) = window(&t);
+                    let every = ((0.5e-6 / (t[1] - t[0])).round() as usize).max(1);
+                    let pick = |x: &[f64]| x[a..b].iter().step_by(every).copied().collect();
+                    (label, pick(&t), pick(&y), measured)
+                })
+                .collect()
+        })
+        .collect();
+    let titles: Vec<String> = rows
+        .iter()
+        .map(|r| format!("sample {}: {} at {} psi", r.n, r.material, r.psi))
+        .collect();
+    let panels: Vec<(Axes, Vec<Curve>)> = series
+        .iter()
+        .zip(&titles)
+        .map(|(curves, title)| {
+            (
+                Axes {
+                    title,
+                    x_label: "time since the incident foot (µs)",
+                    y_label: "transmission-gauge stress (MPa)",
+                    x_scale: 1e6,
+                    y_scale: 1e-6,
+                },
+                curves
+                    .iter()
+                    .map(|(label, t, y, measured)| Curve {
+                        label: label.clone(),
+                        x: t,
+                        y,
+                        measured: *measured,
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    panels_figure(path, true, 4, &panels)
 }
 
 /// A time or a displacement in µs or µm, one decimal.
@@ -2150,7 +2244,9 @@ fn rise_paragraph(w: &mut String, rows: &[Row]) {
          foot; each on the feet's {:.0} µs moving average, relative to the incident foot on the \
          same time base), in each record and in its driven test (f), as residuals (f) − record; \
          and the same with the record's incident wave scaled by {:.2} before it drives the test, \
-         to see what the timing owes to the wave's amplitude.\n",
+         to see what the timing owes to the wave's amplitude. Figure: \
+         `transmitted_driven.png` (each record's transmitted pulse against its driven tests, \
+         touching and seated as below).\n",
         levels.join(", "),
         FOOT_SMOOTHING_S * 1e6,
         DRIVE_SCALE
