@@ -132,21 +132,13 @@ impl JointState {
                     s.force_n(&mut shaper.clone(), p.average_closure_m(f, dt_s), dt_s)
                 })
             }
-            Joint::Spheres {
-                seating: Seating::Touching,
-                ..
-            } => {
-                let law = self.law.as_ref().expect("sphere joints carry their law");
-                solve_force(|f| {
-                    law.trial_force(p.average_closure_m(f, dt_s), p.closure_rate_m_s(f, dt_s))
-                })
-            }
             Joint::Spheres { .. } => {
-                // Seated otherwise: the law at the approach closure + offset, less the static
-                // force; a preloaded contact may carry down to −preload (the spheres part).
+                // The law at the approach (closure + the seating's offset) less a preload's
+                // static force; a preloaded contact may carry down to −preload (the spheres
+                // part). Touching, both are 0.
                 let law = self.law.as_ref().expect("sphere joints carry their law");
                 let (offset, f0) = (self.closure_offset_m, self.static_force_n);
-                solve_force_from(-f0, |f| {
+                solve_force(-f0, |f| {
                     law.trial_force(
                         p.average_closure_m(f, dt_s) + offset,
                         p.closure_rate_m_s(f, dt_s),
@@ -227,37 +219,27 @@ impl JointPrediction {
 }
 
 /// Root of F = law(F) for a law that does not grow with F (more force, less closure), in
-/// [0, law(0)], by bisection to 1e-12 relative. Kept for the sphere contacts: a rate-dependent
+/// [lo, law(lo)] (lo = 0, or −preload for a preloaded contact, whose change of force reaches
+/// down to it), by bisection to 1e-12 of the bracket's largest magnitude. Kept for the sphere
+/// contacts: a rate-dependent
 /// law switches branch where the closure rate reaches zero and can cross F = law(F) more than
 /// once there; bisection's choice among those crossings is the one the shipped results hold
 /// (an Illinois iteration picks another at the peak of the ss440c test, 5 % off in force). The
 /// several crossings are the default `dynamic` unloading's: its curve starts above the loading
 /// force once the rate has fallen, so turning early is self-consistent; under
 /// `dynamic-continuous` only the rate's zero turns (docs/physics.md §3, "A continuous turn").
-fn solve_force(law: impl Fn(f64) -> f64) -> f64 {
-    let f_hi = law(0.0);
-    if f_hi <= 0.0 {
-        return 0.0;
-    }
-    let (lo, hi) = crate::numeric::bisect(
-        0.0,
-        f_hi,
-        100,
-        |lo, hi| hi - lo <= 1e-12 * hi,
-        |f| law(f) > f,
-    );
-    0.5 * (lo + hi)
-}
-
-/// [`solve_force`] on [lo, law(lo)] instead of [0, law(0)] (a preloaded contact's change of
-/// force reaches down to −preload), to 1e-12 of the bracket's largest magnitude.
-fn solve_force_from(lo: f64, law: impl Fn(f64) -> f64) -> f64 {
+fn solve_force(lo: f64, law: impl Fn(f64) -> f64) -> f64 {
     let hi = law(lo);
     if hi <= lo {
         return lo;
     }
-    let scale = hi.abs().max(lo.abs());
-    let (a, b) = crate::numeric::bisect(lo, hi, 100, |a, b| b - a <= 1e-12 * scale, |f| law(f) > f);
+    let (a, b) = crate::numeric::bisect(
+        lo,
+        hi,
+        100,
+        |a, b| b - a <= 1e-12 * a.abs().max(b.abs()),
+        |f| law(f) > f,
+    );
     0.5 * (a + b)
 }
 
