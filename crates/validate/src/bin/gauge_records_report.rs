@@ -2537,7 +2537,7 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
         w,
         "Reading (an inference from eight records and two probes). Across a {:.0} µm gap the \
          steels' transmitted pulses come nearer the records' shape (spread {:.1} µs against \
-         {:.1} touching) but {:+.1} µs late at every level: the gap delays the pair's loading, \
+         {:.1} touching) but {:+.1} µs late on average over the levels: the gap delays the pair's loading, \
          then loads it at speed. Read as the seating, it would put the transmission gauge \
          {:.3} m from the contact, {:.0} % short of the stated {:.4} m, where the reflected \
          feet put the incident gauge {:.1} % short (the path of (e)). A {:.0} N preload \
