@@ -806,40 +806,19 @@ fn main() -> Result<()> {
             ..drive.clone()
         };
         r.timing.driven_larger = Some(simulate_driven(&root, sample.scene, path_scale, larger)?);
-        r.timing.driven_hertz = Some(simulate_driven_with(
-            &root,
-            sample.scene,
-            path_scale,
-            drive.clone(),
-            Some(LawKind::Hertz),
-            None,
-        )?);
-        r.timing.driven_gap = Some(simulate_driven_with(
-            &root,
-            sample.scene,
-            path_scale,
-            drive.clone(),
-            None,
-            Some(Seating::Gap { gap_m: PROBE_GAP_M }),
-        )?);
-        r.timing.driven_small_gap = Some(simulate_driven_with(
-            &root,
-            sample.scene,
-            path_scale,
-            drive.clone(),
-            None,
-            Some(Seating::Gap { gap_m: SMALL_GAP_M }),
-        )?);
-        r.timing.driven_preload = Some(simulate_driven_with(
-            &root,
-            sample.scene,
-            path_scale,
-            drive.clone(),
+        let variant = |law: Option<LawKind>, seating: Option<Seating>| {
+            simulate_driven_with(&root, sample.scene, path_scale, drive.clone(), law, seating)
+                .map(Some)
+        };
+        r.timing.driven_hertz = variant(Some(LawKind::Hertz), None)?;
+        r.timing.driven_gap = variant(None, Some(Seating::Gap { gap_m: PROBE_GAP_M }))?;
+        r.timing.driven_small_gap = variant(None, Some(Seating::Gap { gap_m: SMALL_GAP_M }))?;
+        r.timing.driven_preload = variant(
             None,
             Some(Seating::Preload {
                 force_n: PROBE_PRELOAD_N,
             }),
-        )?);
+        )?;
         let driven = simulate_driven(&root, sample.scene, path_scale, drive)?;
         r.timing.driven_shape_rms = transmitted_shape_rms(
             &driven,
