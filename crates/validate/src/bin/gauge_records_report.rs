@@ -127,9 +127,13 @@ fn transmitted_rise(t: &[f64], eps_transmission: &[f64], t_i: f64) -> Option<[f6
     Some(out)
 }
 
-/// [`transmitted_rise`] of a virtual test, on its own incident foot.
-fn simulated_rise(sim: &Simulated) -> Option<[f64; 4]> {
-    transmitted_rise(&sim.time_s, &sim.transmission_strain, sim.delays.incident_s)
+/// [`transmitted_rise`] of a virtual test of record `r`, on its own incident foot, less the
+/// record's: the residual (simulated − record) at each of [`RISE_LEVELS`], s.
+fn rise_residuals(sim: &Simulated, r: &Row) -> [f64; 4] {
+    let a = transmitted_rise(&sim.time_s, &sim.transmission_strain, sim.delays.incident_s)
+        .expect("a driven test's transmitted pulse rises");
+    let b = r.timing.record_rise;
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]]
 }
 
 /// A virtual test of one record's material and pressure with one set-up variant.
@@ -2226,7 +2230,6 @@ fn driven_paragraph(w: &mut String, rows: &[Row]) {
 
 /// *Timing* (g): the transmitted pulse's rise, level by level, record against driven test.
 fn rise_paragraph(w: &mut String, rows: &[Row]) {
-    let rise = |x: &Simulated| simulated_rise(x).expect("a driven test's transmitted pulse rises");
     let levels: Vec<String> = RISE_LEVELS
         .iter()
         .map(|f| format!("{:.0}", f * 100.0))
@@ -2268,28 +2271,32 @@ fn rise_paragraph(w: &mut String, rows: &[Row]) {
     let mut res_hertz = vec![Vec::new(); RISE_LEVELS.len()];
     let mut hertz_peak = Vec::new();
     let mut moved = 0.0f64;
-    let minus =
-        |a: [f64; 4], b: [f64; 4]| -> Vec<f64> { a.iter().zip(&b).map(|(x, y)| x - y).collect() };
     for r in rows {
         let rec = r.timing.record_rise;
-        let d = rise(driven(r));
-        let l = rise(
-            r.timing
-                .driven_larger
-                .as_ref()
-                .expect("run before the report"),
-        );
+        let larger = r
+            .timing
+            .driven_larger
+            .as_ref()
+            .expect("run before the report");
         let hertz = r
             .timing
             .driven_hertz
             .as_ref()
             .expect("run before the report");
-        let (rd, rl, rh) = (minus(d, rec), minus(l, rec), minus(rise(hertz), rec));
+        let (rd, rl, rh) = (
+            rise_residuals(driven(r), r),
+            rise_residuals(larger, r),
+            rise_residuals(hertz, r),
+        );
         for k in 0..RISE_LEVELS.len() {
             res[k].push(rd[k]);
             res_hertz[k].push(rh[k]);
         }
-        moved = moved.max(d.iter().zip(&l).fold(0.0, |m, (a, b)| m.max((a - b).abs())));
+        moved = moved.max(
+            rd.iter()
+                .zip(&rl)
+                .fold(0.0, |m, (a, b)| m.max((a - b).abs())),
+        );
         let peak = hertz.reduction.peak_back_force_n / r.ours.peak_back_force_n;
         hertz_peak.push(peak);
         let _ = writeln!(
@@ -2386,11 +2393,6 @@ type Variant = fn(&Row) -> &Simulated;
 /// *Timing* (g), continued: the driven tests with the pair seated across a gap or preloaded
 /// (docs/physics.md §6.11), residual per level and its spread over the levels.
 fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d_t_scaled_m: f64) {
-    let rise = |x: &Simulated| simulated_rise(x).expect("a driven test's transmitted pulse rises");
-    let residuals = |x: &Simulated, r: &Row| -> [f64; 4] {
-        let (a, b) = (rise(x), r.timing.record_rise);
-        [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]]
-    };
     let spread = |v: &[f64; 4]| {
         let (lo, hi) = min_max(v.iter().copied());
         hi - lo
@@ -2442,7 +2444,7 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
     for r in rows {
         let cells: Vec<String> = variants
             .iter()
-            .map(|(_, v)| fmt(&residuals(v(r), r)))
+            .map(|(_, v)| fmt(&rise_residuals(v(r), r)))
             .collect();
         let _ = writeln!(
             w,
@@ -2458,7 +2460,7 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
         let sel: Vec<[f64; 4]> = rows
             .iter()
             .filter(|r| r.material.starts_with("SS") == steel)
-            .map(|r| residuals(v(r), r))
+            .map(|r| rise_residuals(v(r), r))
             .collect();
         let n = sel.len() as f64;
         let spread_mean = sel.iter().map(&spread).sum::<f64>() / n;
