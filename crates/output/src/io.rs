@@ -9,6 +9,11 @@ pub use crate::atomic::{check_output, write_atomically, write_text_atomically};
 pub use crate::h5::{h5err, string_attr, vlu, write_dataset};
 use std::path::Path;
 
+/// The `/drive` columns of a driven run (name, data, units), as both writers list them.
+pub fn drive_columns(d: &shpb_core::run::DriveSeries) -> [(&'static str, &[f64], &'static str); 2] {
+    [("time", &d.time_s, "s"), ("force", &d.force_n, "N")]
+}
+
 /// The `/contact` datasets of a series: (name, data, units), absent ones skipped.
 pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static str)> {
     let mut cols = Vec::new();
@@ -134,8 +139,9 @@ pub fn write_hdf5(
         }
         if let Some(d) = &out.drive {
             let g = f.create_group("drive").map_err(h5err(path))?;
-            write_dataset(&g, "time", &d.time_s, "s", path)?;
-            write_dataset(&g, "force", &d.force_n, "N", path)?;
+            for (name, data, units) in drive_columns(d) {
+                write_dataset(&g, name, data, units, path)?;
+            }
             origin(
                 &g,
                 "time",

@@ -56,8 +56,9 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
         }
     }
     if let Some(d) = &out.drive {
-        v.push(one_d("drive/time".into(), &d.time_s, "s"));
-        v.push(one_d("drive/force".into(), &d.force_n, "N"));
+        for (name, data, units) in crate::io::drive_columns(d) {
+            v.push(one_d(format!("drive/{name}"), data, units));
+        }
     }
     if let Some(t) = &out.time_s {
         v.push(one_d("time".into(), t, "s"));
