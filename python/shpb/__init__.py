@@ -308,6 +308,7 @@ def reduce(
     specimen_length_m: Optional[float] = None,
     specimen_diameter_m: Optional[float] = None,
     layout: Optional[PathLike] = None,
+    balance_bound_s: float = 60e-6,
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -322,7 +323,8 @@ def reduce(
     {stress,strain,strain_rate,true_stress,true_strain}``, compression positive
     (docs/physics.md §7.8), and ``peak_stress``, ``strain_at_peak_stress``,
     ``mean_strain_rate`` in the summary. ``layout``: a record layout file (``--layout``) for a
-    lab's own text export."""
+    lab's own text export. ``balance_bound_s``: the bound of ``align="balance"``'s search on
+    each window shift, s (``--balance-bound``)."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -336,6 +338,7 @@ def reduce(
             specimen_length_m,
             specimen_diameter_m,
             None if layout is None else os.fspath(layout),
+            float(balance_bound_s),
         )
     )
 

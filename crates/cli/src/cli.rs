@@ -448,6 +448,14 @@ pub enum Command {
             allow_hyphen_values = true
         )]
         smooth: f64,
+        /// Bound of `--align balance`'s search on each window shift, s (docs/physics.md §7.6).
+        #[arg(
+            long,
+            value_name = "SECONDS",
+            default_value_t = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S,
+            allow_hyphen_values = true
+        )]
+        balance_bound: f64,
         /// Incident window start on the record clock, s (overrides the detected foot).
         #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
         incident_start: Option<f64>,
@@ -661,6 +669,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             tyas_pope,
             align,
             smooth,
+            balance_bound,
             incident_start,
             reflected_delay,
             transmitted_delay,
@@ -697,6 +706,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                     tyas_pope,
                     alignment: align.into(),
                     smoothing_s: smooth,
+                    balance_bound_s: balance_bound,
                     window: (window != Default::default()).then_some(window),
                     layout: layout
                         .as_deref()

@@ -100,9 +100,8 @@ pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
 
 pub use crate::gauge::DEFAULT_SMOOTHING_S;
 
-/// Default bound of the balance search on each window shift, s: 20 µs, more than the 14 µs by
-/// which the authors' reflected pulses precede their stated gauge distance.
-pub const DEFAULT_BALANCE_BOUND_S: f64 = 20e-6;
+/// Default bound of the balance search on each window shift, s: 60 µs (docs/physics.md §7.6).
+pub const DEFAULT_BALANCE_BOUND_S: f64 = 60e-6;
 
 /// Bancroft first-mode fit for ν = 0.31 (docs/physics.md §7): A, B, C, D, E, F of
 /// `c/c0 = A + B/(C y⁴ + D y³ + E y² + F y^1.5 + 1)`, `y = a/Λ`.
@@ -1147,7 +1146,7 @@ pub fn reduce_named(
     if at_bound {
         warnings.push(format!(
             "the balance search stopped at its bound (±{:.1} µs): the best shift may lie beyond \
-             it; check the gauge distances, or widen the bound",
+             it; check the gauge distances, or widen the bound (--balance-bound)",
             options.balance_bound_s * 1e6
         ));
     }

@@ -501,10 +501,11 @@ fn curve<'py>(
 /// The lab's reduction of a raw record or run file (`shpb reduce`): `dispersion` is `none`,
 /// `bancroft` or `pochhammer-chree` (`--dispersion`), `tyas_pope` adds the Tyas–Pope factors,
 /// `align` is `geometric`, `foot` or `balance` (`--align`), `smooth` the moving-average width in
-/// s (`--smooth`), `layout` a record layout file (`--layout`); with a cylinder's length and diameter (m, both or neither) also its 1/2/3-wave
-/// curves (docs/physics.md §7.6–7.9).
+/// s (`--smooth`), `layout` a record layout file (`--layout`), `balance_bound_s` the bound of the
+/// balance search (`--balance-bound`); with a cylinder's length and diameter (m, both or
+/// neither) also its 1/2/3-wave curves (docs/physics.md §7.6–7.9).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S))]
 #[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
@@ -517,6 +518,7 @@ fn reduce(
     specimen_length_m: Option<f64>,
     specimen_diameter_m: Option<f64>,
     layout: Option<PathBuf>,
+    balance_bound_s: f64,
 ) -> PyResult<RunData> {
     let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
         return Err(input_error(
@@ -551,6 +553,7 @@ fn reduce(
             tyas_pope,
             alignment,
             smoothing_s: smooth,
+            balance_bound_s,
             window: None,
             cylinder: geometry,
             layout: layout
@@ -575,6 +578,9 @@ fn reduce(
             " --align {} --smooth {smooth:e}",
             alignment.name()
         ));
+        if alignment == shpb_core::reduce::Alignment::Balance {
+            scene.push_str(&format!(" --balance-bound {balance_bound_s:e}"));
+        }
         if let Some(g) = &geometry {
             scene.push_str(&format!(
                 " --specimen-length {} --specimen-diameter {}",

@@ -312,6 +312,10 @@ pub fn reduce_record(
     )
 }
 
+/// Largest bound of the balance search (`--balance-bound`), s: 200 µs, most of the authors'
+/// 232 µs window; a shift beyond would leave little of the pulses to compare.
+const MAX_BALANCE_BOUND_S: f64 = 200e-6;
+
 /// The choices of `shpb reduce` beyond the record and set-up (its flags; docs/physics.md §7).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordOptions {
@@ -324,6 +328,9 @@ pub struct RecordOptions {
     /// Moving-average width applied to both channels, s (`--smooth`, default
     /// [`shpb_core::reduce::DEFAULT_SMOOTHING_S`], as `shpb run` smooths simulated records).
     pub smoothing_s: f64,
+    /// Bound of the balance search on each window shift, s (`--balance-bound`, default
+    /// [`shpb_core::reduce::DEFAULT_BALANCE_BOUND_S`]; used by `--align balance` only).
+    pub balance_bound_s: f64,
     /// Manual windows (`--incident-start`, `--reflected-delay`, `--transmitted-delay`,
     /// `--duration`).
     pub window: Option<shpb_core::reduce::WindowOverride>,
@@ -341,6 +348,7 @@ impl Default for RecordOptions {
             tyas_pope: false,
             alignment: shpb_core::reduce::Alignment::Geometric,
             smoothing_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+            balance_bound_s: shpb_core::reduce::DEFAULT_BALANCE_BOUND_S,
             window: None,
             cylinder: None,
             layout: None,
@@ -359,6 +367,16 @@ pub fn reduce_record_with(
             "--smooth",
             format!("{} s is out of range", choices.smoothing_s),
             "0 (off) or a positive width in seconds, e.g. 2e-6",
+        ));
+    }
+    if !(choices.balance_bound_s.is_finite()
+        && choices.balance_bound_s > 0.0
+        && choices.balance_bound_s <= MAX_BALANCE_BOUND_S)
+    {
+        return Err(input_err(
+            "--balance-bound",
+            format!("{} s is out of range", choices.balance_bound_s),
+            "a positive bound in seconds up to 2e-4 (200 µs), e.g. 6e-5",
         ));
     }
     if let Some(w) = choices.window {
@@ -444,6 +462,7 @@ pub fn reduce_record_with(
         specimen_radii_m: cylinder.is_none().then_some(radii),
         alignment: choices.alignment,
         smoothing_window_s: choices.smoothing_s,
+        balance_bound_s: choices.balance_bound_s,
         window: choices.window,
         ..ReductionOptions::default()
     };

@@ -71,6 +71,9 @@ fn command_line(records: &[PathBuf], bars: &str, o: &Outputs, choices: &RecordOp
         choices.alignment.name(),
         choices.smoothing_s
     ));
+    if choices.alignment == shpb_core::reduce::Alignment::Balance {
+        c.push_str(&format!(" --balance-bound {:e}", choices.balance_bound_s));
+    }
     if let Some(w) = choices.window {
         for (flag, v) in [
             ("--incident-start", w.incident_start_s),
