@@ -6,7 +6,7 @@ use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit, pct};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, RawRecord, pulse_metrics};
-use shpb_core::reduce::record_strains;
+use shpb_core::reduce::{Reduction, record_strains};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_core::shaper::PulseShaper;
@@ -187,6 +187,18 @@ pub fn effective_mass_kg(
         .map(|(y, s)| (y - m * s).powi(2))
         .sum();
     (total > 0.0).then(|| (m, 1.0 - residual / total))
+}
+
+/// RMS front/back imbalance of a reduction over its pulse: F_front − F_back where F_3wave exceeds
+/// 20 % of its peak, relative to that peak: a whole-loading measure of equilibrium
+/// (docs/physics.md §7.5).
+pub fn imbalance_rms(r: &Reduction) -> f64 {
+    let peak = r.force_3wave_n.iter().copied().fold(0.0, f64::max);
+    let d: Vec<f64> = (0..r.time_s.len())
+        .filter(|&k| r.force_3wave_n[k] > 0.2 * peak)
+        .map(|k| r.force_front_n[k] - r.force_back_n[k])
+        .collect();
+    (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt() / peak
 }
 
 /// Pre-trigger samples whose mean is each record channel's baseline (90 µs at 10 MHz).

@@ -182,8 +182,11 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
 }
 
 /// Summary note on the simulated equilibrium ratio (docs/physics.md §7.5): the ideal bar test's
-/// value, a lower bound on what a real test of the set-up shows through the same reduction.
+/// value, a lower bound on what a real test of the set-up shows through the same reduction, and
+/// how far the authors' records agree with it (validation/gauge-records/REPORT.md).
 const EQUILIBRIUM_NOTE: &str = "note: the equilibrium ratio is the ideal test's (aligned \
-     contact, exact gauge distances): the eight real 2013-05-22 tests of the authors' set-up read \
-     0.15-1.09 through the same reduction where the simulation reads about 0.01, so take it as a \
-     lower bound (docs/physics.md §7.5)\n";
+     contact, exact gauge distances, touching pair), a lower bound: the eight real 2013-05-22 \
+     tests of the authors' set-up read 0.15-1.09 through the stated gauge distances where the \
+     simulation reads about 0.01, and 0.03-0.10 through the windows that balance them (shpb \
+     reduce --align balance, transmitted windows 23-34 us earlier than stated) (docs/physics.md \
+     §7.5)\n";

@@ -27,7 +27,7 @@ use shpb_input::gauges::reduce_record_file;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
 use shpb_output::plot::{Axes, Curve, panels_figure, xy_plot};
-use shpb_validate::gauge_records::{SAMPLES, SAMPLES_2013_06_06, effective_mass_kg};
+use shpb_validate::gauge_records::{SAMPLES, SAMPLES_2013_06_06, effective_mass_kg, imbalance_rms};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -878,6 +878,14 @@ fn main() -> Result<()> {
             let rec = RawRecord::read(&path)?;
             let input = record_strains(&rec, &app, default.baseline_samples)?;
             let record = reduce(&input, &setup, &default)?;
+            let balanced = reduce(
+                &input,
+                &setup,
+                &ReductionOptions {
+                    alignment: Alignment::Balance,
+                    ..ReductionOptions::default()
+                },
+            )?;
             let no_feet = || Error::Input {
                 file: path.display().to_string(),
                 key: "incident_V".into(),
@@ -912,6 +920,7 @@ fn main() -> Result<()> {
                 delays,
                 simulated,
                 record,
+                balanced,
             })
         })
         .collect::<Result<Vec<_>>>()?;
@@ -1527,6 +1536,7 @@ fn report(rows: &[Row], day: &[DayRow], app: &Apparatus, fit: &PathFit) -> Resul
         us(rd(&|r| onset(&r.ours.displacement_m, &r.ours.force_back_n)).1),
     );
     timing_section(w, rows, app, fit);
+    balanced_windows_section(w, rows, day, app);
     held_out_day_section(w, rows, day);
     alignment_section(w, rows);
     Ok(md)
@@ -1546,6 +1556,8 @@ struct DayRow {
     delays: Delays,
     /// The record's reduction (defaults).
     record: Reduction,
+    /// The record reduced with `shpb reduce --align balance`'s defaults.
+    balanced: Reduction,
     /// The virtual test: geometry (e), driven by the record's incident wave.
     simulated: Simulated,
     /// [`transmitted_shape_rms`] of the virtual test against the record.
@@ -1858,26 +1870,253 @@ fn alignment_section(w: &mut String, rows: &[Row]) {
          agree that the reflected window belongs {:.0}–{:.0} µs before the geometric delay on every \
          record, two independent estimates of the offset of *The records' own reflected delay* \
          above (the stated incident-gauge distance, or c0, does not describe these tests). The \
-         transmitted delay is not pinned the same way: the feet scatter over {:.0} µs between \
-         records, and the balance search stops at its ±{:.0} µs bound (on one shift or both) on {} \
-         of {} records, so the front/back balance of these records cannot choose the windows. {} — the records' imbalance \
-         is not an artefact of where the windows are cut. `foot` is the strategy whose choices \
-         are reproducible from record to record; `balance` is for records whose forces can \
-         balance, and says when its shift reached the bound.\n",
+         transmitted delay is not pinned by the feet, which scatter over {:.0} µs between records \
+         and wait for the contact force to build; the balance search, stopping inside its ±{:.0} µs \
+         bound on {} of {} records, puts it {:.0}–{:.0} µs before the geometric delay, where the \
+         records come nearest equilibrium ({}; *The windows that balance the records* above reads \
+         what that offset means). `foot` is the strategy whose choices need no model of the \
+         test; `balance` the one that finds where a record's windows balance, and says when its \
+         shift reached the bound.\n",
         -fr_hi.max(br_hi),
         -fr_lo.min(br_lo),
         ft_hi - ft_lo,
         shpb_core::reduce::DEFAULT_BALANCE_BOUND_S * 1e6,
-        at_bound,
+        rows.len() - at_bound,
         rows.len(),
+        -bt_hi,
+        -bt_lo,
         if in_eq == 0 {
-            "No alignment brings any record into equilibrium by the 0.05 criterion".to_string()
+            "though none within the 0.05 criterion".to_string()
         } else {
             format!(
-                "Only {in_eq} of the {} reductions come into or near equilibrium",
+                "{in_eq} of the {} reductions in or near equilibrium by the 0.05 criterion",
                 3 * rows.len()
             )
         }
+    );
+}
+
+/// The last word on the records' imbalance: both windows searched at once by `shpb reduce --align
+/// balance` (docs/physics.md §7.5–7.6), the paths its delays imply, and the records so balanced
+/// against the virtual tests.
+fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &Apparatus) {
+    let c0 = app.material.wave_speed_m_s();
+    let distance = |name: &str| {
+        app.gauges
+            .channel(name)
+            .expect("a channel of the authors' set-up")
+            .distance_from_specimen_m
+    };
+    let (d_i_stated, d_t_stated) = (distance("incident"), distance("transmission"));
+    // Paths of a balanced reduction: incident gauge c0 Δ_R/2, transmission gauge c0 Δ_T − d_I,
+    // and how early the transmitted window is against the stated transmission path, s.
+    let paths = |b: &Reduction| {
+        let d_i = c0 * b.windows.reflected_delay_s / 2.0;
+        let d_t = c0 * b.windows.transmitted_delay_s - d_i;
+        (d_i, d_t, (d_t_stated - d_t) / c0)
+    };
+    let foot_t = |x: &Reduction| x.alignment.measured_transmitted_delay_s.unwrap_or(f64::NAN);
+    // Face-to-face transit: the transmitted foot after the transmitted window's start, s.
+    let transit = |x: &Reduction| foot_t(x) - x.windows.transmitted_delay_s;
+    let _ = writeln!(
+        w,
+        "\n**The windows that balance the records.** The paragraphs above move the reflected window \
+         alone, or put both windows on the records' feet. `shpb reduce --align balance` \
+         (docs/physics.md §7.6) searches both at once, each within ±{} µs of its geometric delay, for \
+         the shifts that minimise Σ(F_front − F_back)²/ΣF_back² over the whole incident pulse (10 % \
+         of its peak up to 10 % down); on a virtual test it returns the test's own geometry within \
+         1 µs (`crates/cli/tests/reduce_batch.rs`), so it does not make a shift up. Its delays \
+         imply the paths: incident gauge d_I = c0 Δ_R/2 (stated {:.4} m), transmission gauge \
+         c0 Δ_T − d_I (stated {:.4} m). *Early*: how much sooner the transmitted window starts than \
+         that d_I and the stated transmission path allow. *Transit*: the record's transmitted \
+         foot after the window's start, i.e. from the incident pulse's arrival at the front face to \
+         the transmitted pulse's departure from the back face (simulated: the virtual test (a)'s, \
+         on its own geometry). RMS imbalance: |F_front − F_back| where F_3wave exceeds 20 % of its \
+         peak, of that peak. Simulated: virtual test (a), shipped set-up.\n",
+        us(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S),
+        d_i_stated,
+        d_t_stated
+    );
+    let _ = writeln!(
+        w,
+        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for r in rows {
+        let b = &r.aligned[2];
+        let sim = &r.timing.shipped.reduction;
+        let (d_i, d_t, early) = paths(b);
+        let _ = writeln!(
+            w,
+            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} |",
+            r.n,
+            r.material,
+            r.psi,
+            us(b.windows.reflected_delay_s),
+            d_i,
+            us(b.windows.transmitted_delay_s),
+            d_t,
+            us(early),
+            us(transit(b)),
+            us(transit(sim)),
+            imbalance_rms(&r.aligned[0]),
+            imbalance_rms(&r.aligned[1]),
+            imbalance_rms(b),
+            imbalance_rms(sim),
+            b.equilibrium_ratio_at_peak,
+            sim.equilibrium_ratio_at_peak,
+            us(b.displacement_at_peak_force_m),
+            us(sim.displacement_at_peak_force_m),
+        );
+    }
+    let balanced: Vec<&Reduction> = rows.iter().map(|r| &r.aligned[2]).collect();
+    let range = |f: &dyn Fn(&Reduction) -> f64| min_max(balanced.iter().map(|b| f(b)));
+    let d_is: Vec<f64> = balanced.iter().map(|b| paths(b).0).collect();
+    let d_i_mean = mean(d_is.iter().copied());
+    let d_i_sd = sample_sd(&d_is, d_i_mean);
+    let (r_lo, r_hi) = range(&|b| b.windows.reflected_delay_s * 1e6);
+    let (sr_lo, sr_hi) =
+        range(&|b| (b.windows.reflected_delay_s - b.alignment.geometric_reflected_delay_s) * 1e6);
+    let (af_lo, af_hi) = range(&|b| {
+        (b.windows.reflected_delay_s - b.alignment.measured_reflected_delay_s.unwrap_or(f64::NAN))
+            * 1e6
+    });
+    let (st_lo, st_hi) = range(&|b| {
+        (b.windows.transmitted_delay_s - b.alignment.geometric_transmitted_delay_s) * 1e6
+    });
+    let (e_lo, e_hi) = range(&|b| paths(b).2 * 1e6);
+    let (p_lo, p_hi) = range(&|b| paths(b).1);
+    let at_bound = balanced.iter().filter(|b| b.alignment.at_bound).count();
+    let by_material =
+        |m: &str, f: &dyn Fn(&Row) -> f64| min_max(rows.iter().filter(|r| r.material == m).map(f));
+    let mut materials: Vec<&str> = rows.iter().map(|r| r.material).collect();
+    materials.dedup();
+    let early_by_material = materials
+        .iter()
+        .map(|m| {
+            let (lo, hi) = by_material(m, &|r| paths(&r.aligned[2]).2 * 1e6);
+            format!("{m} {lo:.1}–{hi:.1} µs")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let transit_by_material = materials
+        .iter()
+        .map(|m| {
+            let (lo, hi) = by_material(m, &|r| transit(&r.aligned[2]) * 1e6);
+            let (slo, shi) = by_material(m, &|r| transit(&r.timing.shipped.reduction) * 1e6);
+            format!("{m} {lo:.1}–{hi:.1} µs against {slo:.1}–{shi:.1} µs")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let rms = |k: usize| min_max(rows.iter().map(|r| imbalance_rms(&r.aligned[k])));
+    let (g_lo, g_hi) = rms(0);
+    let (f_lo, f_hi) = rms(1);
+    let (b_lo, b_hi) = rms(2);
+    let (s_lo, s_hi) = min_max(
+        rows.iter()
+            .map(|r| imbalance_rms(&r.timing.shipped.reduction)),
+    );
+    let (q_lo, q_hi) = range(&|b| b.equilibrium_ratio_at_peak);
+    let steels =
+        |f: &dyn Fn(&Row) -> f64| min_max(rows.iter().filter(|r| r.material != "Al2017").map(f));
+    let (qs_lo, qs_hi) = steels(&|r| r.aligned[2].equilibrium_ratio_at_peak);
+    let (qa_lo, qa_hi) = by_material("Al2017", &|r| r.aligned[2].equilibrium_ratio_at_peak);
+    let (sq_lo, sq_hi) = min_max(
+        rows.iter()
+            .map(|r| r.timing.shipped.reduction.equilibrium_ratio_at_peak),
+    );
+    let delta = |r: &Row| {
+        100.0
+            * (r.aligned[2].displacement_at_peak_force_m
+                / r.timing.shipped.reduction.displacement_at_peak_force_m
+                - 1.0)
+    };
+    let (dd_lo, dd_hi) = min_max(rows.iter().map(delta));
+    // The records' RMS imbalance (alignment k) over the virtual test's.
+    let times = |k: usize| {
+        min_max(
+            rows.iter()
+                .map(|r| imbalance_rms(&r.aligned[k]) / imbalance_rms(&r.timing.shipped.reduction)),
+        )
+    };
+    let (dg_lo, dg_hi) = min_max(rows.iter().map(|r| {
+        100.0
+            * (r.aligned[0].displacement_at_peak_force_m
+                / r.timing.shipped.reduction.displacement_at_peak_force_m
+                - 1.0)
+    }));
+    let _ = writeln!(
+        w,
+        "\nThe search stops inside its bound on {} of {} records. It moves the reflected window \
+         {sr_lo:+.1} to {sr_hi:+.1} µs from the geometric delay, to {r_lo:.1}–{r_hi:.1} µs on every \
+         record (a spread of {:.1} µs, {af_lo:.1}–{af_hi:.1} µs after the records' 2 % reflected \
+         feet, which sit on the pulses' toe): one incident path, d_I = {d_i_mean:.4} ± {d_i_sd:.4} m \
+         (sample sd), {:.1} % short of the stated one. It moves the transmitted window \
+         {st_lo:+.1} to {st_hi:+.1} µs: with that incident path, {e_lo:.1}–{e_hi:.1} µs earlier \
+         than the stated transmission path allows (a path of {p_lo:.3}–{p_hi:.3} m against \
+         {d_t_stated:.4} m; by specimen: {early_by_material}). So balanced, the records' RMS \
+         imbalance over the pulse falls from {g_lo:.3}–{g_hi:.3} (stated geometry) and \
+         {f_lo:.3}–{f_hi:.3} (feet) to {b_lo:.3}–{b_hi:.3}, against {s_lo:.3}–{s_hi:.3} for the \
+         virtual tests; the ratio at peak to {q_lo:.3}–{q_hi:.3} (SS440c and SS302 \
+         {qs_lo:.3}–{qs_hi:.3}, Al2017 {qa_lo:.3}–{qa_hi:.3}) against {sq_lo:.3}–{sq_hi:.3} \
+         simulated; and δ at peak comes {dd_lo:+.0} to {dd_hi:+.0} % off the simulated one (with \
+         the stated geometry {dg_lo:+.0} to {dg_hi:+.0} %). The transit from face to face is then \
+         longer than the touching pair's in the virtual test: {transit_by_material}.\n",
+        rows.len() - at_bound,
+        rows.len(),
+        r_hi - r_lo,
+        100.0 * (1.0 - d_i_mean / d_i_stated),
+    );
+    // The held-out day, the same search.
+    let day_range = |f: &dyn Fn(&Reduction) -> f64| min_max(day.iter().map(|d| f(&d.balanced)));
+    let (dr_lo, dr_hi) = day_range(&|b| b.windows.reflected_delay_s * 1e6);
+    let (ddi_lo, ddi_hi) = day_range(&|b| paths(b).0);
+    let (de_lo, de_hi) = day_range(&|b| paths(b).2 * 1e6);
+    let (dq_lo, dq_hi) = day_range(&|b| b.equilibrium_ratio_at_peak);
+    let (dgq_lo, dgq_hi) = min_max(day.iter().map(|d| d.record.equilibrium_ratio_at_peak));
+    let day_bound = day.iter().filter(|d| d.balanced.alignment.at_bound).count();
+    let _ = writeln!(
+        w,
+        "The held-out day (2013-06-06, below) gives the same: the search stops inside its bound on \
+         {} of {} records, reflected windows at {dr_lo:.1}–{dr_hi:.1} µs (d_I = \
+         {ddi_lo:.4}–{ddi_hi:.4} m), transmitted ones {de_lo:.1}–{de_hi:.1} µs earlier than the \
+         stated path allows, ratios at peak {dq_lo:.3}–{dq_hi:.3} balanced against \
+         {dgq_lo:.3}–{dgq_hi:.3} with the stated geometry.\n",
+        day.len() - day_bound,
+        day.len(),
+    );
+    let _ = writeln!(
+        w,
+        "Reading (inference). Cut where the stated distances put them, each record's back force \
+         runs ahead of its front force; the balance starts the transmitted windows {:.1}–{:.1} µs \
+         earlier than the stated distances do (the reflected ones {:.1}–{:.1} µs), which moves the \
+         back force later against the front one. No passive specimen does that in one dimension: a light pair carries the same \
+         force on both faces, a mass between them makes the front force lead (*Mass between the \
+         faces* above), a compliance or a seating gap delays both alike. Moved so, the records' RMS \
+         imbalance is {:.1}–{:.1} times the virtual tests', against {:.0}–{:.0} times through the \
+         stated windows (the soft Al2017 pair least: its small back force pins its \
+         shift least). So the imbalance \
+         these records show through geometric windows is not the specimens' state but where their \
+         transmitted pulses sit against their incident ones, which the paragraphs above, moving \
+         one window at a time or both to the feet, could not find. What puts them there the \
+         records cannot tell: a transmission gauge nearer the specimen than stated, by about the \
+         amount the *Seating* probe needed (0.252 m), or a delay between the two channels' clocks \
+         (trigger, digitiser), together with a transit longer than the touching pair's (seating \
+         gaps of tens of µm lengthen it by about that much, *Seating* in *Timing*). A fixed \
+         gauge or clock offset would be the same on every record; here it grows from SS440c to the \
+         softer pairs, so part of it comes with the specimen, or with the pulse shapes the search \
+         matches. The simulator's equilibrium prediction stands as that of the ideal test at the \
+         stated seating; a real record's equilibrium can be judged only once its transmitted \
+         window is placed by something other than the stated distance — its own balance, which by \
+         construction finds the best balance the record allows.",
+        -st_hi,
+        -st_lo,
+        -sr_hi,
+        -sr_lo,
+        times(2).0,
+        times(2).1,
+        times(0).0,
+        times(0).1,
     );
 }
 
@@ -1915,17 +2154,6 @@ fn effective_path(rows: &[Row], app: &Apparatus) -> PathFit {
         half_spread_m: 0.5 * (hi - lo),
         std_m: sample_sd(&each, d_m),
     }
-}
-
-/// RMS of F_front − F_back over the samples where F_3wave exceeds 20 % of its peak, relative to
-/// that peak: a whole-loading measure of equilibrium.
-fn imbalance_rms(r: &Reduction) -> f64 {
-    let peak = r.force_3wave_n.iter().copied().fold(0.0, f64::max);
-    let d: Vec<f64> = (0..r.time_s.len())
-        .filter(|&k| r.force_3wave_n[k] > 0.2 * peak)
-        .map(|k| r.force_front_n[k] - r.force_back_n[k])
-        .collect();
-    (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt() / peak
 }
 
 /// Compressive peak of the incident wave at the face, Pa.
@@ -2524,9 +2752,11 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
          feet put the incident gauge {:.1} % short (the path of (e)). A {:.0} N preload \
          sharpens the toe (foot {:+.1} µs) and leaves the body late (spread {:.1} µs). Al2017 \
          keeps a spread of {:.1} µs or more in all three. So seating as modelled here accounts \
-         for the shape of the steels' pulses only with a geometry the other arrivals do not \
-         support; the records do not say how the pairs sat. Nor does either seating unbalance \
-         the simulated test as the records are: equilibrium ratio at peak {:.3}–{:.3} across \
+         for the shape of the steels' pulses only with a transmission path the arrivals alone do \
+         not support — but the records' own front/back balance, searched independently of any \
+         model, puts the SS440c transmitted windows at that path too (*The windows that balance \
+         the records*, next section); the records do not say how the pairs sat. Nor does either \
+         seating unbalance the simulated test as the records are through the stated windows: equilibrium ratio at peak {:.3}–{:.3} across \
          the gap, {:.3}–{:.3} preloaded, {:.3}–{:.3} touching (records {:.2}–{:.2}, next \
          section).\n\nHow finely the foot depends on the seating: a gap of only {:.0} µm, the \
          order of a ground face's finish, delays the transmitted foot of the driven tests by \
@@ -2802,7 +3032,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
              the feet, against {:.3}–{:.3} simulated: aligning the windows {} the ratio, and what \
              remains would need {:.0}–{:.0} µs of further misalignment at the measured sensitivity \
              ({:.3}–{:.3} per µs), far more than the ±{:.1} µs of the fitted path or the sub-µs foot \
-             resolution, so it is not timing. At the peak F_front − F_back is {:+.1} to {:+.1} % of the incident wave's \
+             resolution, so it is not the reflected window's timing. At the peak F_front − F_back is {:+.1} to {:+.1} % of the incident wave's \
              peak force, front below back: the two-wave front force A(σI + σR) is the small \
              difference of two large waves, and an error of that share of the incident wave in the \
              reflected one (or the incident one) at that instant gives the whole imbalance; \
@@ -2838,19 +3068,20 @@ the simulated ratio is the ideal test's lower bound.\n",
     let sensitivity = min_max(rows.iter().map(|r| r.timing.sensitivity_per_s * 1e-6));
     let _ = writeln!(
         w,
-        "So misalignment explains little of the records' imbalance: re-aligned by their own feet or \
-         by the effective path, the ratios at peak stay more than ten times the simulated ones and do \
+        "So misalignment of the reflected window explains little of the records' imbalance: \
+         re-aligned by their own feet or by the effective path, the ratios at peak stay more than ten times the simulated ones and do \
          not fall consistently (the RMS imbalance over the loading does, table *The records' own reflected \
          delay* above). The ratio's sensitivity to the reflected window, taken relative to the \
          ratio's own denominator F_3wave, is {:.3}–{:.3} per µs for every material (docs/physics.md \
          §7.5 estimates 0.03 per µs for SS440c and 0.18 per µs for Al2017 relative to the back \
          force, which for Al2017 is a third of F_3wave at a ratio near 1). What remains is the same \
          share of the incident wave, {:+.1} to {:+.1} %, on every record whatever the material, pressure \
-         or ratio: a systematic mismatch between the records' incident and reflected waves (their \
-         relative amplitude or shape as read at the gauge: attenuation over the extra 2 d_eff of \
-         path, the dispersion correction, the incident-bar end and insert interfaces, contact \
-         misalignment), not shot-to-shot timing. Which of these it is was not identified here; the \
-         simulated ratio is therefore the ideal test's, a lower bound, as `shpb run` says.",
+         or ratio. Read at that one instant it looks like a mismatch between the records' incident \
+         and reflected waves (their relative amplitude or shape as read at the gauge: attenuation \
+         over the extra 2 d_eff of path, the dispersion correction, the incident-bar end and insert \
+         interfaces, contact misalignment); the next paragraphs test those candidates, and the time \
+         history of the imbalance (*Mass between the faces*, *The windows that balance the \
+         records*) shows where it comes from instead.",
         sensitivity.0, sensitivity.1, all_share.0, all_share.1,
     );
     let quiet = min_max(rows.iter().map(|r| r.timing.record.between_pulses * 100.0));
@@ -3008,9 +3239,8 @@ fn mass_between_faces_section(w: &mut String, rows: &[Row], z: f64, ea: f64) {
          match at peak is a coincidence of one instant. Nor can anything else between the faces give \
          it: a massless compliance (an insert's seating, a gap closing) carries the same force on \
          both sides, and a holder leaking force to the frame would leave the back force below the \
-         front one, the other sign. What is left lies between the incident gauge and the front face, \
-         or in how the incident and reflected waves are read there, which these records cannot \
-         separate.",
+         front one, the other sign. What is left is how the records' waves are placed against \
+         each other, which the next paragraph searches.",
         m_shipped.0,
         m_shipped.1,
         m_heavy.0,
