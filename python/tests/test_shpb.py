@@ -292,6 +292,22 @@ def test_reduce_alignment_and_smoothing_keywords_equal_the_flags(cli, tmp_path):
         shpb.reduce(RECORD, align="auto")
 
 
+def test_reduce_balance_bound_keyword_equals_the_flag(cli, tmp_path):
+    # balance_bound_s= is `--balance-bound`: the same windows, the same datasets, the same error.
+    cli(
+        "reduce", RECORD, "--bars", "authors", "-o", tmp_path / "b.h5",
+        "--align", "balance", "--balance-bound", "3e-5",
+    )
+    r = shpb.reduce(RECORD, bars="authors", align="balance", balance_bound_s=3e-5)
+    for k, (data, units) in h5_datasets(tmp_path / "b.h5").items():
+        assert same(r[k], data), k
+    code, message = cli_message(cli, "reduce", RECORD, "--balance-bound", "0")
+    with pytest.raises(shpb.InputError) as e:
+        shpb.reduce(RECORD, balance_bound_s=0.0)
+    assert "`--balance-bound`" in str(e.value) and "`--balance-bound`" in message
+    assert code == 2
+
+
 def test_sweep_in_parallel_equals_serial():
     kw = dict(set={"pressure": ["8psi", "10psi", "12psi"]})
     scene = "scenes/shpb-ss440c-10psi.toml"
