@@ -145,6 +145,14 @@ fn each_alignment_reports_what_it_chose_on_a_real_record() {
     let s_t = number(&balance, "balance_shift_transmitted_s");
     assert!(s_r.abs() < bound && s_t.abs() < bound, "{s_r} {s_t}");
     assert!((number(&balance, "reflected_delay") - (g_r + s_r)).abs() < 1e-12);
+    // …and the gauge path its reflected delay implies: on uniform bars without inserts the
+    // path scales with the delay (d_I = c0 Δ_R/2), the stated 0.644525 m with the geometric one.
+    let path_i = number(&balance, "balance_incident_path_m");
+    let expected = 0.644525 * (g_r + s_r) / g_r;
+    assert!(
+        (path_i / expected - 1.0).abs() < 1e-12,
+        "{path_i} {expected}"
+    );
     // The balance search finds the reflected offset the record's foot shows: its window starts
     // within 5 µs after the 2 % foot, which is detected on the reflected pulse's toe (on a
     // simulated test the search lands within 1 µs of the true geometry, the next test).
@@ -199,6 +207,14 @@ fn on_a_simulated_test_the_alignments_agree_with_the_geometry_and_nothing_is_war
     for key in ["balance_shift_reflected_s", "balance_shift_transmitted_s"] {
         let s = number(&balance, key);
         assert!(s.abs() <= 1e-6, "{key} = {s}: {balance}");
+    }
+    // So the paths it implies are the run's own within c0 × 1 µs (4.9 mm).
+    for (key, stated) in [
+        ("balance_incident_path_m", 0.644525),
+        ("balance_transmission_path_m", 0.3683),
+    ] {
+        let p = number(&balance, key);
+        assert!((p - stated).abs() < 4.9e-3, "{key} = {p}");
     }
     let d_g = number(&geometric, "displacement_at_peak_force_m");
     let d_b = number(&balance, "displacement_at_peak_force_m");

@@ -1327,6 +1327,8 @@ pub fn reduce_named(
             measured_reflected_delay_s,
             measured_transmitted_delay_s,
             balance_shift_s,
+            balance_paths_m: balance_shift_s
+                .map(|(sr, st)| (d_i + c_i * sr / 2.0, d_t + c_t * (st - sr / 2.0))),
             balance_bound_s: options.balance_bound_s,
             at_bound,
         },

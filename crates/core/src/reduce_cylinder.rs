@@ -314,6 +314,7 @@ mod tests {
                 measured_reflected_delay_s: None,
                 measured_transmitted_delay_s: None,
                 balance_shift_s: None,
+                balance_paths_m: None,
                 balance_bound_s: crate::reduce::DEFAULT_BALANCE_BOUND_S,
                 at_bound: false,
             },

@@ -252,11 +252,14 @@ pub fn report_markdown(command: &str, records: &[BatchRecord]) -> String {
             cell(Some(r.windows.duration_s), 1e6, 1),
             match a.balance_shift_s {
                 Some((sr, st)) => format!(
-                    " Balance search (±{} µs): reflected shifted {} µs, transmitted {} µs{}.",
+                    " Balance search (±{} µs): reflected shifted {} µs, transmitted {} µs{}{}.",
                     cell(Some(a.balance_bound_s), 1e6, 1),
                     us(Some(sr)),
                     us(Some(st)),
-                    if a.at_bound { ", at the bound" } else { "" }
+                    if a.at_bound { ", at the bound" } else { "" },
+                    a.balance_paths_m.map_or(String::new(), |(pi, pt)| format!(
+                        "; as gauge paths, incident {pi:.4} m and transmission {pt:.4} m"
+                    ))
                 ),
                 None => String::new(),
             }

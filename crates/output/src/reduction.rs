@@ -153,6 +153,10 @@ pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
         v.push(("balance_shift_reflected", sr, "s"));
         v.push(("balance_shift_transmitted", st, "s"));
     }
+    if let Some((pi, pt)) = a.balance_paths_m {
+        v.push(("balance_incident_path", pi, "m"));
+        v.push(("balance_transmission_path", pt, "m"));
+    }
     let q = &r.quality;
     v.extend([
         ("equilibrium_mean_loading", q.equilibrium_mean, "1"),

@@ -325,6 +325,20 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
         q.signal_to_noise.0,
         q.signal_to_noise.1,
     );
+    if let (Some((sr, st)), Some((pi, pt))) = (a.balance_shift_s, a.balance_paths_m) {
+        // The set-up's paths as the reduction reads them (inserts included).
+        let stated = ReductionSetup::from_apparatus(apparatus).ok();
+        text.push_str(&format!(
+            "balance: reflected shifted {:+.2} µs, transmitted {:+.2} µs{}: as gauge paths (gauge to face, on the bars' c0), incident {:.4} m and transmission {:.4} m against the set-up's {:.4} m and {:.4} m\n",
+            sr * 1e6,
+            st * 1e6,
+            if a.at_bound { " (at the bound)" } else { "" },
+            pi,
+            pt,
+            stated.as_ref().map_or(f64::NAN, |s| s.incident_gauge_m),
+            stated.as_ref().map_or(f64::NAN, |s| s.transmission_gauge_m),
+        ));
+    }
     if let Some(c) = cylinder {
         text.push_str(&format!(
             "cylinder {:.3} mm × {:.3} mm (1-wave, compression positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
@@ -363,6 +377,8 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
             "measured_transmitted_delay_s": opt(a.measured_transmitted_delay_s),
             "balance_shift_reflected_s": opt(a.balance_shift_s.map(|s| s.0)),
             "balance_shift_transmitted_s": opt(a.balance_shift_s.map(|s| s.1)),
+            "balance_incident_path_m": opt(a.balance_paths_m.map(|p| p.0)),
+            "balance_transmission_path_m": opt(a.balance_paths_m.map(|p| p.1)),
             "at_bound": a.at_bound,
         },
         "quality": {

@@ -52,6 +52,9 @@ pub struct AlignmentReport {
     pub measured_transmitted_delay_s: Option<f64>,
     /// Shifts the balance search added to the geometric delays (reflected, transmitted), s.
     pub balance_shift_s: Option<(f64, f64)>,
+    /// The gauge paths the balance delays imply, gauge to face (incident, transmission), m:
+    /// d_I + c_I s_R/2 and d_T + c_T (s_T − s_R/2), on the bars' c0 (docs/physics.md §7.6).
+    pub balance_paths_m: Option<(f64, f64)>,
     /// Bound of the balance search on each shift, s.
     pub balance_bound_s: f64,
     /// Whether a balance shift stopped at its bound (the optimum may lie beyond it).
