@@ -968,10 +968,12 @@ fn main() -> Result<()> {
         app.material.youngs_modulus_pa,
     )?;
 
+    balanced_figure(&out_dir.join(BALANCED_PNG), &rows)?;
+
     let md = report(&rows, &day, &app, &fit)?;
     let path = out_dir.join("REPORT.md");
     std::fs::write(&path, md).map_err(|e| Error::io(&path, e))?;
-    println!("wrote {} and {} plots", path.display(), rows.len() + 1);
+    println!("wrote {} and {} plots", path.display(), rows.len() + 2);
     Ok(())
 }
 
@@ -1041,6 +1043,83 @@ fn transmitted_figure(path: &Path, rows: &[Row], e_pa: f64) -> Result<()> {
                     y_label: "transmission-gauge stress (MPa)",
                     x_scale: 1e6,
                     y_scale: 1e-6,
+                },
+                curves
+                    .iter()
+                    .map(|(label, t, y, measured)| Curve {
+                        label: label.clone(),
+                        x: t,
+                        y,
+                        measured: *measured,
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    panels_figure(path, true, 4, &panels)
+}
+
+/// When a reduction's back force first rises through half its peak (linear between samples), s
+/// on its time axis.
+fn half_rise_s(r: &Reduction) -> f64 {
+    let f = &r.force_back_n;
+    let level = 0.5 * f[r.peak_index];
+    (1..=r.peak_index)
+        .find(|&k| f[k] >= level)
+        .map_or(f64::NAN, |k| {
+            let a = (level - f[k - 1]) / (f[k] - f[k - 1]);
+            r.time_s[k - 1] + a * (r.time_s[k] - r.time_s[k - 1])
+        })
+}
+
+/// The figure of *The windows that balance the records*.
+const BALANCED_PNG: &str = "balanced_windows.png";
+
+/// Writes [`BALANCED_PNG`]: per record, the front and back forces through the stated windows and
+/// through the balanced ones (`--align balance`), and the virtual test's back force.
+fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
+    // A point every 0.5 µs of the 2 µs-smoothed forces shows all there is (and keeps the PNG
+    // small).
+    let pick = |x: &[f64]| -> Vec<f64> { x.iter().step_by(5).copied().collect() };
+    let series: Vec<Vec<Trace>> = rows
+        .iter()
+        .map(|r| {
+            let (stated, balanced) = (&r.aligned[0], &r.aligned[2]);
+            let sim = &r.timing.shipped.reduction;
+            [
+                ("front, stated windows", stated, false),
+                ("back, stated windows", stated, true),
+                ("front, balanced windows", balanced, false),
+                ("back, balanced windows", balanced, true),
+                ("virtual test (a), back", sim, true),
+            ]
+            .into_iter()
+            .map(|(label, x, back)| {
+                let y = if back {
+                    &x.force_back_n
+                } else {
+                    &x.force_front_n
+                };
+                (label.to_string(), pick(&x.time_s), pick(y), false)
+            })
+            .collect()
+        })
+        .collect();
+    let titles: Vec<String> = rows
+        .iter()
+        .map(|r| format!("sample {}: {} at {} psi", r.n, r.material, r.psi))
+        .collect();
+    let panels: Vec<(Axes, Vec<Curve>)> = series
+        .iter()
+        .zip(&titles)
+        .map(|(curves, title)| {
+            (
+                Axes {
+                    title,
+                    x_label: "time at the faces (µs)",
+                    y_label: "force (kN)",
+                    x_scale: 1e6,
+                    y_scale: 1e-3,
                 },
                 curves
                     .iter()
@@ -1932,15 +2011,17 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          foot after the window's start, i.e. from the incident pulse's arrival at the front face to \
          the transmitted pulse's departure from the back face (simulated: the virtual test (a)'s, \
          on its own geometry). RMS imbalance: |F_front − F_back| where F_3wave exceeds 20 % of its \
-         peak, of that peak. Simulated: virtual test (a), shipped set-up.\n",
+         peak, of that peak. Simulated: virtual test (a), shipped set-up. Figure `{BALANCED_PNG}`: each record's \
+         front and back forces through the stated and the balanced windows, with the virtual \
+         test's back force.\n",
         us(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S),
         d_i_stated,
         d_t_stated
     );
     let _ = writeln!(
         w,
-        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|"
+        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated | back force at half its peak, rising (µs): balanced / simulated |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rows {
         let b = &r.aligned[2];
@@ -1948,7 +2029,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         let (d_i, d_t, early) = paths(b);
         let _ = writeln!(
             w,
-            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} |",
+            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} | {} / {} |",
             r.n,
             r.material,
             r.psi,
@@ -1967,6 +2048,8 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
             sim.equilibrium_ratio_at_peak,
             us(b.displacement_at_peak_force_m),
             us(sim.displacement_at_peak_force_m),
+            us(half_rise_s(b)),
+            us(half_rise_s(sim)),
         );
     }
     let balanced: Vec<&Reduction> = rows.iter().map(|r| &r.aligned[2]).collect();
@@ -2039,6 +2122,18 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
                 .map(|r| imbalance_rms(&r.aligned[k]) / imbalance_rms(&r.timing.shipped.reduction)),
         )
     };
+    let peak_lag =
+        |r: &Row| (half_rise_s(&r.aligned[2]) - half_rise_s(&r.timing.shipped.reduction)) * 1e6;
+    let (pl_lo, pl_hi) = min_max(rows.iter().map(peak_lag));
+    let half_rise_by_material = materials
+        .iter()
+        .map(|m| {
+            let (lo, hi) = by_material(m, &peak_lag);
+            format!("{m} {lo:+.1} to {hi:+.1} µs")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let (pls_lo, pls_hi) = steels(&peak_lag);
     let (dg_lo, dg_hi) = min_max(rows.iter().map(|r| {
         100.0
             * (r.aligned[0].displacement_at_peak_force_m
@@ -2060,7 +2155,9 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          virtual tests; the ratio at peak to {q_lo:.3}–{q_hi:.3} (SS440c and SS302 \
          {qs_lo:.3}–{qs_hi:.3}, Al2017 {qa_lo:.3}–{qa_hi:.3}) against {sq_lo:.3}–{sq_hi:.3} \
          simulated; and δ at peak comes {dd_lo:+.0} to {dd_hi:+.0} % off the simulated one (with \
-         the stated geometry {dg_lo:+.0} to {dg_hi:+.0} %). The transit from face to face is then \
+         the stated geometry {dg_lo:+.0} to {dg_hi:+.0} %); the balanced back force \
+         rises through half its peak {pl_lo:+.1} to {pl_hi:+.1} µs from the virtual test's \
+         (steels {pls_lo:+.1} to {pls_hi:+.1} µs; figure). Measured by the 2 % feet, the transit from face to face is \
          longer than the touching pair's in the virtual test: {transit_by_material}.\n",
         rows.len() - at_bound,
         rows.len(),
@@ -2098,14 +2195,17 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          shift least). So the imbalance \
          these records show through geometric windows is not the specimens' state but where their \
          transmitted pulses sit against their incident ones, which the paragraphs above, moving \
-         one window at a time or both to the feet, could not find. What puts them there the \
-         records cannot tell: a transmission gauge nearer the specimen than stated, by about the \
-         amount the *Seating* probe needed (0.252 m), or a delay between the two channels' clocks \
-         (trigger, digitiser), together with a transit longer than the touching pair's (seating \
-         gaps of tens of µm lengthen it by about that much, *Seating* in *Timing*). A fixed \
-         gauge or clock offset would be the same on every record; here it grows from SS440c to the \
-         softer pairs, so part of it comes with the specimen, or with the pulse shapes the search \
-         matches. The simulator's equilibrium prediction stands as that of the ideal test at the \
+         one window at a time or both to the feet, could not find. At the faces, so placed, the \
+         records' forces come near the virtual tests' in time and shape (figure; half-peak rise \
+         {}): what the simulation predicts at the faces the records show, within those lags, once \
+         their windows balance; what it does not predict is where each record's transmitted pulse \
+         sits on its gauge's clock. What puts it there the records cannot tell: a transmission gauge nearer \
+         the specimen than stated, by about the amount the *Seating* probe needed (0.252 m), or a \
+         delay between the two channels' clocks (trigger, digitiser). A fixed gauge or clock \
+         offset would be the same on every record; here it grows from SS440c to the softer pairs, \
+         so part of it comes with the specimen (the 2 % feet, which sit in the toes, suggest \
+         transits longer than the touching pair's; seating gaps of tens of µm lengthen it by \
+         about that much, *Seating* in *Timing*), or with the pulse shapes the search matches. The simulator's equilibrium prediction stands as that of the ideal test at the \
          stated seating; a real record's equilibrium can be judged only once its transmitted \
          window is placed by something other than the stated distance — its own balance, which by \
          construction finds the best balance the record allows.",
@@ -2117,6 +2217,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         times(2).1,
         times(0).0,
         times(0).1,
+        half_rise_by_material,
     );
 }
 
