@@ -1124,6 +1124,14 @@ fn transmitted_figure(path: &Path, rows: &[Row], e_pa: f64) -> Result<()> {
     panels_figure(path, true, 4, &panels)
 }
 
+/// The RMS front/back imbalance a reduction's baseline noise alone gives, relative to its 3-wave
+/// peak: E A √(2 σ_I² + σ_T²) (the front force adds two samples of the incident channel).
+fn noise_floor(r: &Reduction, ea_n: f64) -> f64 {
+    let (si, st) = r.quality.noise_strain;
+    let peak = r.force_3wave_n.iter().copied().fold(0.0, f64::max);
+    ea_n * (2.0 * si * si + st * st).sqrt() / peak
+}
+
 /// (h)'s two driven tests of a record: touching, and across the probe gap.
 fn balanced_sims(r: &Row) -> (&Simulated, &Simulated) {
     (
@@ -2202,6 +2210,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
             .distance_from_specimen_m
     };
     let (d_i_stated, d_t_stated) = (distance("incident"), distance("transmission"));
+    let ea = app.material.youngs_modulus_pa * app.incident.area_m2();
     // Paths of a balanced reduction (incident, transmission; `balance_paths_m`) and how early
     // the transmitted window is against the stated transmission path, s.
     let paths = |b: &Reduction| {
@@ -2225,7 +2234,9 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          foot after the window's start, i.e. from the incident pulse's arrival at the front face to \
          the transmitted pulse's departure from the back face (simulated: the virtual test (a)'s, \
          on its own geometry). RMS imbalance: |F_front − F_back| where F_3wave exceeds 20 % of its \
-         peak, of that peak. Simulated: virtual test (a), shipped set-up. Figure `{BALANCED_PNG}`: each record's \
+         peak, of that peak; its noise floor is what the channels' baseline noise alone gives \
+         (E A √(2 σ_I² + σ_T²) of the same peak, σ the smoothed baseline RMS strain: the front \
+         force adds two samples of the incident channel). Simulated: virtual test (a), shipped set-up. Figure `{BALANCED_PNG}`: each record's \
          front and back forces through the stated and the balanced windows, with the virtual \
          test's back force.\n",
         us(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S),
@@ -2234,7 +2245,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
     );
     let _ = writeln!(
         w,
-        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated | back force at half its peak, rising (µs): balanced / simulated |\n\
+        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated / noise floor | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated | back force at half its peak, rising (µs): balanced / simulated |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rows {
@@ -2243,7 +2254,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         let (d_i, d_t, early) = paths(b);
         let _ = writeln!(
             w,
-            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} | {} / {} |",
+            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} | {} / {} |",
             r.n,
             r.material,
             r.psi,
@@ -2258,6 +2269,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
             imbalance_rms(&r.aligned[1]),
             imbalance_rms(b),
             imbalance_rms(sim),
+            noise_floor(b, ea),
             b.equilibrium_ratio_at_peak,
             sim.equilibrium_ratio_at_peak,
             us(b.displacement_at_peak_force_m),
@@ -2314,6 +2326,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
             .map(|r| imbalance_rms(&r.timing.shipped.reduction)),
     );
     let (q_lo, q_hi) = range(&|b| b.equilibrium_ratio_at_peak);
+    let (n_lo, n_hi) = range(&|b| noise_floor(b, ea));
     let steels =
         |f: &dyn Fn(&Row) -> f64| min_max(rows.iter().filter(|r| r.material != "Al2017").map(f));
     let (qs_lo, qs_hi) = steels(&|r| r.aligned[2].equilibrium_ratio_at_peak);
@@ -2329,6 +2342,11 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
                 - 1.0)
     };
     let (dd_lo, dd_hi) = min_max(rows.iter().map(delta));
+    // The balanced records' RMS imbalance over the virtual test's and the noise floor together.
+    let beyond = min_max(rows.iter().map(|r| {
+        let b = &r.aligned[2];
+        imbalance_rms(b) / imbalance_rms(&r.timing.shipped.reduction).hypot(noise_floor(b, ea))
+    }));
     // The records' RMS imbalance (alignment k) over the virtual test's.
     let times = |k: usize| {
         min_max(
@@ -2366,7 +2384,7 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          {d_t_stated:.4} m; by specimen: {early_by_material}). So balanced, the records' RMS \
          imbalance over the pulse falls from {g_lo:.3}–{g_hi:.3} (stated geometry) and \
          {f_lo:.3}–{f_hi:.3} (feet) to {b_lo:.3}–{b_hi:.3}, against {s_lo:.3}–{s_hi:.3} for the \
-         virtual tests; the ratio at peak to {q_lo:.3}–{q_hi:.3} (SS440c and SS302 \
+         virtual tests and a noise floor of {n_lo:.3}–{n_hi:.3}; the ratio at peak to {q_lo:.3}–{q_hi:.3} (SS440c and SS302 \
          {qs_lo:.3}–{qs_hi:.3}, Al2017 {qa_lo:.3}–{qa_hi:.3}) against {sq_lo:.3}–{sq_hi:.3} \
          simulated; and δ at peak comes {dd_lo:+.0} to {dd_hi:+.0} % off the simulated one (with \
          the stated geometry {dg_lo:+.0} to {dg_hi:+.0} %); the balanced back force \
@@ -2406,8 +2424,10 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          force on both faces, a mass between them makes the front force lead (*Mass between the \
          faces* above), a compliance or a seating gap delays both alike. Moved so, the records' RMS \
          imbalance is {:.1}–{:.1} times the virtual tests', against {:.0}–{:.0} times through the \
-         stated windows (the soft Al2017 pair least: its small back force pins its \
-         shift least). So the imbalance \
+         stated windows, and {:.1}–{:.1} times what the virtual test's imbalance and the record's \
+         noise floor give together (√(simulated² + floor²)); the rest is the records' own \
+         (pulse shapes the virtual test does not have). The soft Al2017 pair balances least: its \
+         small back force pins its shift least. So the imbalance \
          these records show through geometric windows is not the specimens' state but where their \
          transmitted pulses sit against their incident ones, which the paragraphs above, moving \
          one window at a time or both to the feet, could not find. At the faces, so placed, the \
@@ -2432,6 +2452,8 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         times(2).1,
         times(0).0,
         times(0).1,
+        beyond.0,
+        beyond.1,
         half_rise_by_material,
     );
 }
