@@ -73,7 +73,7 @@ fn num(v: Option<f64>) -> String {
 }
 
 /// Column names of the batch summary (SI units in the names).
-pub const SUMMARY_COLUMNS: [&str; 33] = [
+pub const SUMMARY_COLUMNS: [&str; 35] = [
     "record",
     "status",
     "alignment",
@@ -107,6 +107,8 @@ pub const SUMMARY_COLUMNS: [&str; 33] = [
     "signal_to_noise_transmission",
     "pulse_overlap_s",
     "warnings",
+    "balance_incident_path_m",
+    "balance_transmission_path_m",
 ];
 
 /// The summary CSV text: a header of [`SUMMARY_COLUMNS`], then one row per record.
@@ -156,6 +158,8 @@ pub fn summary_csv(records: &[BatchRecord]) -> String {
                 row.push(num(Some(q.signal_to_noise.1)));
                 row.push(num(Some(q.pulse_overlap_s)));
                 row.push(csv_field(&r.warnings.join("; ")));
+                row.push(num(a.balance_paths_m.map(|p| p.0)));
+                row.push(num(a.balance_paths_m.map(|p| p.1)));
             }
         }
         text.push_str(&row.join(","));
