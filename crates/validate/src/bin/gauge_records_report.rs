@@ -1093,35 +1093,16 @@ fn transmitted_figure(path: &Path, rows: &[Row], e_pa: f64) -> Result<()> {
                 .collect()
         })
         .collect();
-    let titles: Vec<String> = rows
-        .iter()
-        .map(|r| format!("sample {}: {} at {} psi", r.n, r.material, r.psi))
-        .collect();
-    let panels: Vec<(Axes, Vec<Curve>)> = series
-        .iter()
-        .zip(&titles)
-        .map(|(curves, title)| {
-            (
-                Axes {
-                    title,
-                    x_label: "time since the incident foot (µs)",
-                    y_label: "transmission-gauge stress (MPa)",
-                    x_scale: 1e6,
-                    y_scale: 1e-6,
-                },
-                curves
-                    .iter()
-                    .map(|(label, t, y, measured)| Curve {
-                        label: label.clone(),
-                        x: t,
-                        y,
-                        measured: *measured,
-                    })
-                    .collect(),
-            )
-        })
-        .collect();
-    panels_figure(path, true, 4, &panels)
+    record_panels(
+        path,
+        rows,
+        &series,
+        (
+            "time since the incident foot (µs)",
+            "transmission-gauge stress (MPa)",
+        ),
+        1e-6,
+    )
 }
 
 /// The RMS front/back imbalance a reduction's baseline noise alone gives, relative to its 3-wave
@@ -1328,6 +1309,24 @@ fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
             .collect()
         })
         .collect();
+    record_panels(
+        path,
+        rows,
+        &series,
+        ("time at the faces (µs)", "force (kN)"),
+        1e-3,
+    )
+}
+
+/// Writes one panel per record (4 across, titled by sample, material and pressure) of its
+/// `series`, time in µs against the quantity times `y_scale`, labelled `(x, y)`.
+fn record_panels(
+    path: &Path,
+    rows: &[Row],
+    series: &[Vec<Trace>],
+    (x_label, y_label): (&str, &str),
+    y_scale: f64,
+) -> Result<()> {
     let titles: Vec<String> = rows
         .iter()
         .map(|r| format!("sample {}: {} at {} psi", r.n, r.material, r.psi))
@@ -1339,10 +1338,10 @@ fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
             (
                 Axes {
                     title,
-                    x_label: "time at the faces (µs)",
-                    y_label: "force (kN)",
+                    x_label,
+                    y_label,
                     x_scale: 1e6,
-                    y_scale: 1e-3,
+                    y_scale,
                 },
                 curves
                     .iter()
