@@ -824,12 +824,7 @@ fn main() -> Result<()> {
     // The effective incident path: the one gauge-to-contact distance that makes the simulated
     // reflected delay match the eight records' on average (docs/physics.md §7.5).
     let fit = effective_path(&rows, &app);
-    let path_scale = fit.d_m
-        / app
-            .gauges
-            .channel("incident")
-            .expect("incident channel")
-            .distance_from_specimen_m;
+    let path_scale = fit.d_m / stated_paths_m(&app).0;
     let balanced_paths = balanced_paths_m(&rows);
     for (r, sample) in rows.iter_mut().zip(SAMPLES) {
         let sim = simulate(&root, sample.scene, &|a| with_incident_path(a, fit.d_m))?;
@@ -1373,12 +1368,7 @@ fn report(rows: &[Row], day: &[DayRow], app: &Apparatus, fit: &PathFit) -> Resul
         .iter()
         .filter(|r| (r.ours.peak_back_force_n / r.authors.f_peak() - 1.0).abs() <= TOLERANCE)
         .count();
-    let d_i = inc.distance_from_specimen_m;
-    let d_t = app
-        .gauges
-        .channel("transmission")
-        .expect("transmission channel")
-        .distance_from_specimen_m;
+    let (d_i, d_t) = stated_paths_m(app);
     // Writing to a String cannot fail.
     let _ = writeln!(
         w,
@@ -2202,13 +2192,7 @@ fn alignment_section(w: &mut String, rows: &[Row]) {
 /// against the virtual tests.
 fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &Apparatus) {
     let c0 = app.material.wave_speed_m_s();
-    let distance = |name: &str| {
-        app.gauges
-            .channel(name)
-            .expect("a channel of the authors' set-up")
-            .distance_from_specimen_m
-    };
-    let (d_i_stated, d_t_stated) = (distance("incident"), distance("transmission"));
+    let (d_i_stated, d_t_stated) = stated_paths_m(app);
     let ea = app.material.youngs_modulus_pa * app.incident.area_m2();
     // Paths of a balanced reduction (incident, transmission; `balance_paths_m`) and how early
     // the transmitted window is against the stated transmission path, s.
@@ -2599,17 +2583,22 @@ fn scaled(r: &Row) -> &Simulated {
     r.timing.scaled.as_ref().expect("built before the report")
 }
 
+/// The set-up's stated gauge distances from the specimen (incident, transmission), m.
+fn stated_paths_m(app: &Apparatus) -> (f64, f64) {
+    let distance = |name: &str| {
+        app.gauges
+            .channel(name)
+            .expect("a channel of the authors' set-up")
+            .distance_from_specimen_m
+    };
+    (distance("incident"), distance("transmission"))
+}
+
 /// Timing variant (e): both stated gauge distances scaled by d_eff/d_I, the one constant (c)
 /// fitted on the reflected feet, so that the transmitted arrivals test it independently.
 fn scaled_paths_paragraph(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) {
     let c0 = app.material.wave_speed_m_s();
-    let distance = |name: &str| {
-        app.gauges
-            .channel(name)
-            .expect("gauge channel")
-            .distance_from_specimen_m
-    };
-    let (d_i, d_t) = (distance("incident"), distance("transmission"));
+    let (d_i, d_t) = stated_paths_m(app);
     let s = fit.d_m / d_i;
     let res = residuals;
     let _ = writeln!(
@@ -3283,16 +3272,7 @@ fn timing_section(w: &mut String, rows: &[Row], app: &Apparatus, fit: &PathFit) 
     scaled_paths_paragraph(w, rows, app, fit);
     driven_paragraph(w, rows);
     rise_paragraph(w, rows);
-    let d_t = app
-        .gauges
-        .channel("transmission")
-        .expect("transmission channel")
-        .distance_from_specimen_m;
-    let d_i = app
-        .gauges
-        .channel("incident")
-        .expect("incident channel")
-        .distance_from_specimen_m;
+    let (d_i, d_t) = stated_paths_m(app);
     seating_paragraph(
         w,
         rows,
