@@ -197,8 +197,8 @@ mod tests {
     }
 
     /// A balanced test (F_front = F_back at every instant) whose reflected and transmitted waves
-    /// were cut off by known shifts — small ones, and ones of the size the authors' records need
-    /// (docs/physics.md §7.6) — : the search recovers both shifts exactly.
+    /// were cut off by known shifts, small ones and ones of the size the authors' records need
+    /// (docs/physics.md §7.6): the search recovers both shifts exactly.
     #[test]
     fn the_balance_search_recovers_known_shifts() {
         for (shifts, margin) in [((7, -4), 30), ((-22, -41), 60)] {
