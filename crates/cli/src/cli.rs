@@ -103,7 +103,8 @@ pub enum AlignArg {
     Geometric,
     /// Delays from the feet of the reflected and transmitted pulses in the record.
     Foot,
-    /// Geometric delays shifted (within ±20 µs) to balance front and back forces over the loading.
+    /// Geometric delays shifted (each within --balance-bound) to balance front and back forces over
+    /// the incident pulse.
     Balance,
 }
 
