@@ -10,6 +10,7 @@
 
 mod common;
 
+use rayon::prelude::*;
 use shpb_core::apparatus::{Apparatus, IncidentDrive, Insert, PulseOptions};
 use shpb_core::bar::BarMaterial;
 use shpb_core::contact::LawKind;
@@ -18,7 +19,8 @@ use shpb_core::gauge::{
 };
 use shpb_core::numeric::{argmax, least_squares, min_max};
 use shpb_core::reduce::{
-    Alignment, Reduction, ReductionOptions, ReductionSetup, WindowOverride, record_strains, reduce,
+    Alignment, Reduction, ReductionInput, ReductionOptions, ReductionSetup, WindowOverride,
+    record_strains, reduce,
 };
 use shpb_core::scene::{Params, SceneParams};
 use shpb_core::specimen::Seating;
@@ -621,6 +623,9 @@ struct Row {
     /// Our reduction with each window alignment of `shpb reduce --align` (geometric, foot,
     /// balance), with the command's defaults otherwise.
     aligned: Vec<Reduction>,
+    /// The transmitted delays, s, over which the balanced reduction's RMS imbalance stays within
+    /// [`PIN_TOLERANCE`] of its least ([`transmitted_pin`]).
+    transmitted_pin_s: (f64, f64),
 }
 
 fn main() -> Result<()> {
@@ -797,8 +802,10 @@ fn main() -> Result<()> {
                 .map_err(Error::from)
             })
             .collect::<Result<Vec<_>>>()?;
+        let transmitted_pin_s = transmitted_pin(&input, &setup, &aligned[2])?;
         rows.push(Row {
             aligned,
+            transmitted_pin_s,
             n,
             material,
             psi,
@@ -2212,8 +2219,11 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          of its peak up to 10 % down); on a virtual test it returns the test's own geometry within \
          1 µs (`crates/cli/tests/reduce_batch.rs`), so it does not make a shift up. Its delays \
          imply the paths: incident gauge d_I = c0 Δ_R/2 (stated {:.4} m), transmission gauge \
-         c0 Δ_T − d_I (stated {:.4} m). *Early*: how much sooner the transmitted window starts than \
-         that d_I and the stated transmission path allow. *Transit*: the record's transmitted \
+         c0 Δ_T − d_I (stated {:.4} m). *Δ_T pinned to*: the transmitted delays whose RMS imbalance \
+         (below) stays within {:.0} % of the least, the reflected window held where the balance put \
+         it (a scan of ±{:.0} µs in {:.1} µs steps): how sharply the record fixes Δ_T. *Early*: how \
+         much sooner the transmitted window starts than that d_I and the stated transmission path \
+         allow. *Transit*: the record's transmitted \
          foot after the window's start, i.e. from the incident pulse's arrival at the front face to \
          the transmitted pulse's departure from the back face (simulated: the virtual test (a)'s, \
          on its own geometry). RMS imbalance: |F_front − F_back| where F_3wave exceeds 20 % of its \
@@ -2224,12 +2234,29 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          test's back force.\n",
         us(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S),
         d_i_stated,
-        d_t_stated
+        d_t_stated,
+        PIN_TOLERANCE * 100.0,
+        PIN_SCAN_S.1 * 1e6,
+        PIN_SCAN_S.0 * 1e6,
     );
+    // The pinned interval of Δ_T, with "≤"/"≥" where it reaches the scan's edge.
+    let at_edge = |r: &Row, x: f64| {
+        (x - r.aligned[2].windows.transmitted_delay_s).abs() >= PIN_SCAN_S.1 - 0.5 * PIN_SCAN_S.0
+    };
+    let pinned = |r: &Row| {
+        let (lo, hi) = r.transmitted_pin_s;
+        format!(
+            "{}{}–{}{}",
+            if at_edge(r, lo) { "≤ " } else { "" },
+            us(lo),
+            us(hi),
+            if at_edge(r, hi) { " or more" } else { "" }
+        )
+    };
     let _ = writeln!(
         w,
-        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated / noise floor | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated | back force at half its peak, rising (µs): balanced / simulated |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|"
+        "| sample | specimen | Δ_R (µs) | d_I (m) | Δ_T (µs) | Δ_T pinned to (µs) | transmission path (m) | early (µs) | transit (µs): record / simulated | RMS imbalance: stated geometry / feet / balanced / simulated / noise floor | ratio at peak: balanced / simulated | δ at peak (µm): balanced / simulated | back force at half its peak, rising (µs): balanced / simulated |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rows {
         let b = &r.aligned[2];
@@ -2237,13 +2264,14 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         let (d_i, d_t, early) = paths(b);
         let _ = writeln!(
             w,
-            "| {} | {} {} psi | {} | {:.4} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} | {} / {} |",
+            "| {} | {} {} psi | {} | {:.4} | {} | {} | {:.3} | {} | {} / {} | {:.3} / {:.3} / {:.3} / {:.3} / {:.3} | {:.3} / {:.3} | {} / {} | {} / {} |",
             r.n,
             r.material,
             r.psi,
             us(b.windows.reflected_delay_s),
             d_i,
             us(b.windows.transmitted_delay_s),
+            pinned(r),
             d_t,
             us(early),
             us(transit(b)),
@@ -2288,6 +2316,28 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         .map(|m| {
             let (lo, hi) = by_material(m, &|r| paths(&r.aligned[2]).2 * 1e6);
             format!("{m} {lo:.1}–{hi:.1} µs")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let pin_by_material = materials
+        .iter()
+        .map(|m| {
+            let g: Vec<&Row> = rows.iter().filter(|r| r.material == *m).collect();
+            let loose = g
+                .iter()
+                .any(|r| at_edge(r, r.transmitted_pin_s.0) || at_edge(r, r.transmitted_pin_s.1));
+            let (lo, hi) = min_max(
+                g.iter()
+                    .map(|r| 0.5 * (r.transmitted_pin_s.1 - r.transmitted_pin_s.0) * 1e6),
+            );
+            if loose {
+                format!(
+                    "{m}: not within the ±{:.0} µs scan on every record",
+                    PIN_SCAN_S.1 * 1e6
+                )
+            } else {
+                format!("{m} ±{lo:.1}–{hi:.1} µs")
+            }
         })
         .collect::<Vec<_>>()
         .join(", ");
@@ -2364,7 +2414,8 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          (sample sd), {:.1} % short of the stated one. It moves the transmitted window \
          {st_lo:+.1} to {st_hi:+.1} µs: with that incident path, {e_lo:.1}–{e_hi:.1} µs earlier \
          than the stated transmission path allows (a path of {p_lo:.3}–{p_hi:.3} m against \
-         {d_t_stated:.4} m; by specimen: {early_by_material}). So balanced, the records' RMS \
+         {d_t_stated:.4} m; by specimen: {early_by_material}); the records pin Δ_T to within \
+         {pin_by_material} (half the *pinned* interval). So balanced, the records' RMS \
          imbalance over the pulse falls from {g_lo:.3}–{g_hi:.3} (stated geometry) and \
          {f_lo:.3}–{f_hi:.3} (feet) to {b_lo:.3}–{b_hi:.3}, against {s_lo:.3}–{s_hi:.3} for the \
          virtual tests and a noise floor of {n_lo:.3}–{n_hi:.3}; the ratio at peak to {q_lo:.3}–{q_hi:.3} (SS440c and SS302 \
@@ -2420,8 +2471,9 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          sits on its gauge's clock. What puts it there the records cannot tell: a transmission gauge nearer \
          the specimen than stated, by about the amount the *Seating* probe needed (0.252 m), or a \
          delay between the two channels' clocks (trigger, digitiser). A fixed gauge or clock \
-         offset would be the same on every record; here it grows from SS440c to the softer pairs, \
-         so part of it comes with the specimen (the 2 % feet, which sit in the toes, suggest \
+         offset would be the same on every record; here it grows from SS440c to the softer pairs \
+         (on some records by more than the records pin Δ_T), so part of it may come with the \
+         specimen (the 2 % feet, which sit in the toes, suggest \
          transits longer than the touching pair's; seating gaps of tens of µm lengthen it by \
          about that much, *Seating* in *Timing*), or with the pulse shapes the search matches. The simulator's equilibrium prediction stands as that of the ideal test at the \
          stated seating; a real record's equilibrium can be judged only once its transmitted \
@@ -2581,6 +2633,52 @@ fn within(x: f64) -> bool {
 /// The virtual test with both gauge paths scaled (built with the effective path).
 fn scaled(r: &Row) -> &Simulated {
     r.timing.scaled.as_ref().expect("built before the report")
+}
+
+/// How far above its least the RMS imbalance may rise for a transmitted delay to count as
+/// balancing the record as well ([`transmitted_pin`]): 10 %.
+const PIN_TOLERANCE: f64 = 0.10;
+
+/// Step and half-width of the scan of [`transmitted_pin`], s.
+const PIN_SCAN_S: (f64, f64) = (0.5e-6, 20e-6);
+
+/// How well a record pins its balanced transmitted delay: with the reflected window where the
+/// balance put it, the transmitted delay is scanned ±20 µs around the balanced one (0.5 µs
+/// steps, `shpb reduce`'s defaults otherwise) and the delays whose RMS imbalance
+/// ([`imbalance_rms`]) stays within [`PIN_TOLERANCE`] of the least are returned as (first, last),
+/// s; an end at the scan's edge means the record does not pin it within the scan.
+fn transmitted_pin(
+    input: &ReductionInput,
+    setup: &ReductionSetup,
+    balanced: &Reduction,
+) -> Result<(f64, f64)> {
+    let (step, half) = PIN_SCAN_S;
+    let n = (half / step).round() as i64;
+    let scan = (-n..=n)
+        .into_par_iter()
+        .map(|k| {
+            let delay = balanced.windows.transmitted_delay_s + k as f64 * step;
+            let r = reduce(
+                input,
+                setup,
+                &ReductionOptions {
+                    window: Some(WindowOverride {
+                        reflected_delay_s: Some(balanced.windows.reflected_delay_s),
+                        transmitted_delay_s: Some(delay),
+                        ..WindowOverride::default()
+                    }),
+                    ..ReductionOptions::default()
+                },
+            )?;
+            Ok((delay, imbalance_rms(&r)))
+        })
+        .collect::<Result<Vec<(f64, f64)>>>()?;
+    let least = scan.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    Ok(min_max(
+        scan.iter()
+            .filter(|p| p.1 <= (1.0 + PIN_TOLERANCE) * least)
+            .map(|p| p.0),
+    ))
 }
 
 /// The set-up's stated gauge distances from the specimen (incident, transmission), m.
