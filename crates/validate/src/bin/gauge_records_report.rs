@@ -1891,7 +1891,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
     );
     let _ = writeln!(
         w,
-        "| sample | specimen (test_data.txt) | incident peak (MPa) | peak back force record / simulated (kN) | simulated / record | Δ_T record / simulated (µs) | residual T (µs) | within 3 µs | equilibrium ratio at peak, record / simulated | transmitted shape RMS, of its peak |"
+        "| sample | specimen (test_data.txt) | incident peak (MPa) | peak back force record / simulated (kN) | simulated / record | Δ_T record / simulated (µs) | residual T (µs) | within 3 µs | equilibrium ratio at peak, record: stated geometry / balanced; simulated | transmitted shape RMS, of its peak |"
     );
     let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|");
     for d in day {
@@ -1899,7 +1899,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
         let residual = d.transmitted_residual_s();
         let _ = writeln!(
             w,
-            "| {} | {} (\"{}\") | {:.1} | {:.2} / {:.2} | {:.3} | {} / {} | {:+.1} | {} | {:.2} / {:.3} | {:.3} |",
+            "| {} | {} (\"{}\") | {:.1} | {:.2} / {:.2} | {:.3} | {} / {} | {:+.1} | {} | {:.2} / {:.3}; {:.3} | {:.3} |",
             d.number,
             d.material,
             d.label,
@@ -1912,6 +1912,7 @@ fn held_out_day_section(w: &mut String, rows: &[Row], day: &[DayRow]) {
             residual * 1e6,
             yes(within(residual)),
             d.record.equilibrium_ratio_at_peak,
+            d.balanced.equilibrium_ratio_at_peak,
             d.simulated.reduction.equilibrium_ratio_at_peak,
             d.shape_rms,
         );
