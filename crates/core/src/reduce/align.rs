@@ -206,6 +206,20 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+
+        /// Any shifts inside the bound, with the bound of the authors' records (60 samples
+        /// here): the search finds them exactly and does not call them at the bound.
+        #[test]
+        fn the_balance_search_recovers_any_shifts_inside_its_bound(
+            sr in -59isize..=59,
+            st in -59isize..=59,
+        ) {
+            recovers((sr, st), 60);
+        }
+    }
+
     fn recovers((sr, st): (isize, isize), margin: usize) {
         let n = 400;
         let pulse = |k: f64| {
