@@ -2222,7 +2222,9 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
          imply the paths: incident gauge d_I = c0 Δ_R/2 (stated {:.4} m), transmission gauge \
          c0 Δ_T − d_I (stated {:.4} m). *Δ_T pinned to*: the transmitted delays whose RMS imbalance \
          (below) stays within {:.0} % of the least, the reflected window held where the balance put \
-         it (a scan of ±{:.0} µs in {:.1} µs steps): how sharply the record fixes Δ_T. *Early*: how \
+         it (a scan of ±{:.0} µs in {:.1} µs steps): how sharply the record fixes Δ_T (this measure \
+         weighs where F_3wave exceeds 20 % of its peak, the search the incident pulse, so the \
+         search's Δ_T may sit up to a µs or so outside it). *Early*: how \
          much sooner the transmitted window starts than that d_I and the stated transmission path \
          allow. *Transit*: the record's transmitted \
          foot after the window's start, i.e. from the incident pulse's arrival at the front face to \
