@@ -568,25 +568,7 @@ fn reduce(
             bars.as_deref()
                 .map_or(r.apparatus.source.clone(), |b| b.display().to_string())
         );
-        if correction != DispersionCorrection::Bancroft {
-            scene.push_str(&format!(" --dispersion {}", correction.name()));
-        }
-        if tyas_pope {
-            scene.push_str(" --tyas-pope");
-        }
-        scene.push_str(&format!(
-            " --align {} --smooth {smooth:e}",
-            alignment.name()
-        ));
-        if alignment == shpb_core::reduce::Alignment::Balance {
-            scene.push_str(&format!(" --balance-bound {balance_bound_s:e}"));
-        }
-        if let Some(g) = &geometry {
-            scene.push_str(&format!(
-                " --specimen-length {} --specimen-diameter {}",
-                g.length_m, g.diameter_m
-            ));
-        }
+        scene.push_str(&choices.command_flags());
         Ok((r, scene))
     })?;
     Ok(RunData {

@@ -341,6 +341,49 @@ pub struct RecordOptions {
     pub layout: Option<shpb_input::layout::RecordLayout>,
 }
 
+impl RecordOptions {
+    /// The `shpb reduce` flags that make these choices (provenance of a reduction, for the CLI
+    /// and Python alike): `--dispersion` and `--tyas-pope` when not the default, `--align` and
+    /// `--smooth`, `--balance-bound` with `--align balance`, the manual windows given, and a
+    /// cylinder's geometry. Each flag is preceded by a space.
+    pub fn command_flags(&self) -> String {
+        let mut c = String::new();
+        if self.dispersion != shpb_core::reduce::DispersionCorrection::Bancroft {
+            c.push_str(&format!(" --dispersion {}", self.dispersion.name()));
+        }
+        if self.tyas_pope {
+            c.push_str(" --tyas-pope");
+        }
+        c.push_str(&format!(
+            " --align {} --smooth {:e}",
+            self.alignment.name(),
+            self.smoothing_s
+        ));
+        if self.alignment == shpb_core::reduce::Alignment::Balance {
+            c.push_str(&format!(" --balance-bound {:e}", self.balance_bound_s));
+        }
+        if let Some(w) = self.window {
+            for (flag, v) in [
+                ("--incident-start", w.incident_start_s),
+                ("--reflected-delay", w.reflected_delay_s),
+                ("--transmitted-delay", w.transmitted_delay_s),
+                ("--duration", w.duration_s),
+            ] {
+                if let Some(v) = v {
+                    c.push_str(&format!(" {flag} {v:e}"));
+                }
+            }
+        }
+        if let Some(g) = &self.cylinder {
+            c.push_str(&format!(
+                " --specimen-length {:e} --specimen-diameter {:e}",
+                g.length_m, g.diameter_m
+            ));
+        }
+        c
+    }
+}
+
 impl Default for RecordOptions {
     fn default() -> Self {
         RecordOptions {
@@ -640,4 +683,34 @@ pub fn study_rows(
     gun_scatter: bool,
 ) -> Result<crate::uq::Study> {
     crate::uq::study_rows(scene, samples, seed, jobs, gun_scatter, false, |_| {})
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The provenance flags name every non-default choice and only those: the default
+    /// correction unsaid, the bound only with `--align balance`, a cylinder's geometry when
+    /// given.
+    #[test]
+    fn command_flags_name_the_choices_made() {
+        let default = RecordOptions::default().command_flags();
+        assert_eq!(default, " --align geometric --smooth 2e-6");
+        let balance = RecordOptions {
+            dispersion: shpb_core::reduce::DispersionCorrection::PochhammerChree,
+            alignment: shpb_core::reduce::Alignment::Balance,
+            balance_bound_s: 3e-5,
+            cylinder: Some(shpb_core::reduce_cylinder::CylinderGeometry {
+                length_m: 6e-3,
+                diameter_m: 1.2e-2,
+            }),
+            ..RecordOptions::default()
+        }
+        .command_flags();
+        assert_eq!(
+            balance,
+            " --dispersion pochhammer-chree --align balance --smooth 2e-6 --balance-bound 3e-5 \
+             --specimen-length 6e-3 --specimen-diameter 1.2e-2"
+        );
+    }
 }

@@ -60,38 +60,7 @@ fn command_line(records: &[PathBuf], bars: &str, o: &Outputs, choices: &RecordOp
             c.push_str(&format!(" {flag} {}", p.display()));
         }
     }
-    if choices.dispersion != DispersionCorrection::Bancroft {
-        c.push_str(&format!(" --dispersion {}", choices.dispersion.name()));
-    }
-    if choices.tyas_pope {
-        c.push_str(" --tyas-pope");
-    }
-    c.push_str(&format!(
-        " --align {} --smooth {:e}",
-        choices.alignment.name(),
-        choices.smoothing_s
-    ));
-    if choices.alignment == shpb_core::reduce::Alignment::Balance {
-        c.push_str(&format!(" --balance-bound {:e}", choices.balance_bound_s));
-    }
-    if let Some(w) = choices.window {
-        for (flag, v) in [
-            ("--incident-start", w.incident_start_s),
-            ("--reflected-delay", w.reflected_delay_s),
-            ("--transmitted-delay", w.transmitted_delay_s),
-            ("--duration", w.duration_s),
-        ] {
-            if let Some(v) = v {
-                c.push_str(&format!(" {flag} {v:e}"));
-            }
-        }
-    }
-    if let Some(g) = &choices.cylinder {
-        c.push_str(&format!(
-            " --specimen-length {:e} --specimen-diameter {:e}",
-            g.length_m, g.diameter_m
-        ));
-    }
+    c.push_str(&choices.command_flags());
     if o.force {
         c.push_str(" --force");
     }
