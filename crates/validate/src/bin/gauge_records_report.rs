@@ -1160,68 +1160,59 @@ fn balanced_timing_paragraph(w: &mut String, rows: &[Row], c0: f64) {
             .collect::<Vec<_>>()
             .join(" / ")
     };
-    let reflected = |x: &Simulated, r: &Row| x.delays.reflected_s - r.timing.record.reflected_s;
-    for r in rows {
-        let (t, g) = balanced_sims(r);
+    // Residuals simulated − record, once per seating (0 touching, 1 across the gap) and record:
+    // the reflected foot, and the transmitted rise at each of RISE_LEVELS, s.
+    let residuals: [Vec<(f64, [f64; 4])>; 2] = [0, 1].map(|seated| {
+        rows.iter()
+            .map(|r| {
+                let (t, g) = balanced_sims(r);
+                let x = if seated == 1 { g } else { t };
+                (
+                    x.delays.reflected_s - r.timing.record.reflected_s,
+                    rise_residuals(x, r),
+                )
+            })
+            .collect()
+    });
+    for (k, r) in rows.iter().enumerate() {
+        let (t, g) = (residuals[0][k], residuals[1][k]);
         let _ = writeln!(
             w,
             "| {} | {} {} psi | {} | {} | {} |",
             r.n,
             r.material,
             r.psi,
-            signed(&[reflected(t, r), reflected(g, r)]),
-            signed(&rise_residuals(t, r)),
-            signed(&rise_residuals(g, r)),
+            signed(&[t.0, g.0]),
+            signed(&t.1),
+            signed(&g.1),
         );
     }
+    let within = |v: &[f64]| v.iter().filter(|x| x.abs() <= 3e-6).count();
     // Mean ± sd and how many records fall within 3 µs, of residuals in s.
-    let stats = |v: Vec<f64>| {
+    let stats = |v: &[f64]| {
         let m = mean(v.iter().copied());
-        let within = v.iter().filter(|x| x.abs() <= 3e-6).count();
         format!(
-            "{:+.1} ± {:.1} µs ({within} within 3 µs)",
+            "{:+.1} ± {:.1} µs ({} within 3 µs)",
             m * 1e6,
-            sample_sd(&v, m) * 1e6
+            sample_sd(v, m) * 1e6,
+            within(v)
         )
     };
-    let per_level = |gap: bool| {
+    let reflected = |seated: usize| -> Vec<f64> { residuals[seated].iter().map(|x| x.0).collect() };
+    let level = |seated: usize, k: usize| -> Vec<f64> {
+        residuals[seated].iter().map(|x| x.1[k]).collect()
+    };
+    let per_level = |seated: usize| {
         (0..RISE_LEVELS.len())
-            .map(|k| {
-                let v = rows
-                    .iter()
-                    .map(|r| {
-                        let (t, g) = balanced_sims(r);
-                        rise_residuals(if gap { g } else { t }, r)[k]
-                    })
-                    .collect();
-                format!("{} %: {}", levels[k], stats(v))
-            })
+            .map(|k| format!("{} %: {}", levels[k], stats(&level(seated, k))))
             .collect::<Vec<_>>()
             .join("; ")
     };
-    let within = |v: &[f64]| v.iter().filter(|x| x.abs() <= 3e-6).count();
-    let reflected_all: Vec<f64> = rows
-        .iter()
-        .flat_map(|r| {
-            let (t, g) = balanced_sims(r);
-            [reflected(t, r), reflected(g, r)]
-        })
-        .collect();
+    let reflected_all = [reflected(0), reflected(1)].concat();
     // The best level and seating for the transmitted arrival: most records within 3 µs.
-    let best_transmitted = [false, true]
-        .iter()
-        .flat_map(|&gap| {
-            (0..RISE_LEVELS.len()).map(move |k| {
-                let v: Vec<f64> = rows
-                    .iter()
-                    .map(|r| {
-                        let (t, g) = balanced_sims(r);
-                        rise_residuals(if gap { g } else { t }, r)[k]
-                    })
-                    .collect();
-                within(&v)
-            })
-        })
+    let best_transmitted = (0..2)
+        .flat_map(|seated| (0..RISE_LEVELS.len()).map(move |k| (seated, k)))
+        .map(|(seated, k)| within(&level(seated, k)))
         .max()
         .unwrap_or(0);
     let (p_lo, p_hi) = min_max(rows.iter().map(|r| {
@@ -1244,18 +1235,10 @@ fn balanced_timing_paragraph(w: &mut String, rows: &[Row], c0: f64) {
          place every record's transmitted pulse within 3 µs on the gauge's clock; at the faces \
          (figure `{BALANCED_PNG}`) the simulated and the balanced recorded forces agree as the \
          table above says.\n",
-        stats(
-            rows.iter()
-                .map(|r| reflected(balanced_sims(r).0, r))
-                .collect()
-        ),
-        stats(
-            rows.iter()
-                .map(|r| reflected(balanced_sims(r).1, r))
-                .collect()
-        ),
-        per_level(false),
-        per_level(true),
+        stats(&reflected(0)),
+        stats(&reflected(1)),
+        per_level(0),
+        per_level(1),
         within(&reflected_all),
         reflected_all.len(),
         best_transmitted,
