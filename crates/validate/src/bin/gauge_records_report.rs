@@ -2297,45 +2297,41 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
         |m: &str, f: &dyn Fn(&Row) -> f64| min_max(rows.iter().filter(|r| r.material == m).map(f));
     let mut materials: Vec<&str> = rows.iter().map(|r| r.material).collect();
     materials.dedup();
-    let early_by_material = materials
-        .iter()
-        .map(|m| {
-            let (lo, hi) = by_material(m, &|r| paths(&r.aligned[2]).2 * 1e6);
-            format!("{m} {lo:.1}–{hi:.1} µs")
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let pin_by_material = materials
-        .iter()
-        .map(|m| {
-            let g: Vec<&Row> = rows.iter().filter(|r| r.material == *m).collect();
-            let loose = g
-                .iter()
-                .any(|r| at_edge(r, r.transmitted_pin_s.0) || at_edge(r, r.transmitted_pin_s.1));
-            let (lo, hi) = min_max(
-                g.iter()
-                    .map(|r| 0.5 * (r.transmitted_pin_s.1 - r.transmitted_pin_s.0) * 1e6),
-            );
-            if loose {
-                format!(
-                    "{m}: not within the ±{:.0} µs scan on every record",
-                    PIN_SCAN_S.1 * 1e6
-                )
-            } else {
-                format!("{m} ±{lo:.1}–{hi:.1} µs")
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let transit_by_material = materials
-        .iter()
-        .map(|m| {
-            let (lo, hi) = by_material(m, &|r| transit(&r.aligned[2]) * 1e6);
-            let (slo, shi) = by_material(m, &|r| transit(&r.timing.shipped.reduction) * 1e6);
-            format!("{m} {lo:.1}–{hi:.1} µs against {slo:.1}–{shi:.1} µs")
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
+    // One phrase per specimen material, joined.
+    let each_material = |phrase: &dyn Fn(&str) -> String| {
+        materials
+            .iter()
+            .map(|m| phrase(m))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let early_by_material = each_material(&|m| {
+        let (lo, hi) = by_material(m, &|r| paths(&r.aligned[2]).2 * 1e6);
+        format!("{m} {lo:.1}–{hi:.1} µs")
+    });
+    let pin_by_material = each_material(&|m| {
+        let g: Vec<&Row> = rows.iter().filter(|r| r.material == m).collect();
+        let loose = g
+            .iter()
+            .any(|r| at_edge(r, r.transmitted_pin_s.0) || at_edge(r, r.transmitted_pin_s.1));
+        let (lo, hi) = min_max(
+            g.iter()
+                .map(|r| 0.5 * (r.transmitted_pin_s.1 - r.transmitted_pin_s.0) * 1e6),
+        );
+        if loose {
+            format!(
+                "{m}: not within the ±{:.0} µs scan on every record",
+                PIN_SCAN_S.1 * 1e6
+            )
+        } else {
+            format!("{m} ±{lo:.1}–{hi:.1} µs")
+        }
+    });
+    let transit_by_material = each_material(&|m| {
+        let (lo, hi) = by_material(m, &|r| transit(&r.aligned[2]) * 1e6);
+        let (slo, shi) = by_material(m, &|r| transit(&r.timing.shipped.reduction) * 1e6);
+        format!("{m} {lo:.1}–{hi:.1} µs against {slo:.1}–{shi:.1} µs")
+    });
     let rms = |k: usize| min_max(rows.iter().map(|r| imbalance_rms(&r.aligned[k])));
     let (g_lo, g_hi) = rms(0);
     let (f_lo, f_hi) = rms(1);
@@ -2373,18 +2369,14 @@ fn balanced_windows_section(w: &mut String, rows: &[Row], day: &[DayRow], app: &
                 .map(|r| imbalance_rms(&r.aligned[k]) / imbalance_rms(&r.timing.shipped.reduction)),
         )
     };
-    let peak_lag =
+    let half_rise_lag =
         |r: &Row| (half_rise_s(&r.aligned[2]) - half_rise_s(&r.timing.shipped.reduction)) * 1e6;
-    let (pl_lo, pl_hi) = min_max(rows.iter().map(peak_lag));
-    let half_rise_by_material = materials
-        .iter()
-        .map(|m| {
-            let (lo, hi) = by_material(m, &peak_lag);
-            format!("{m} {lo:+.1} to {hi:+.1} µs")
-        })
-        .collect::<Vec<_>>()
-        .join(", ");
-    let (pls_lo, pls_hi) = steels(&peak_lag);
+    let (pl_lo, pl_hi) = min_max(rows.iter().map(half_rise_lag));
+    let half_rise_by_material = each_material(&|m| {
+        let (lo, hi) = by_material(m, &half_rise_lag);
+        format!("{m} {lo:+.1} to {hi:+.1} µs")
+    });
+    let (pls_lo, pls_hi) = steels(&half_rise_lag);
     let (dg_lo, dg_hi) = min_max(rows.iter().map(|r| {
         100.0
             * (r.aligned[0].displacement_at_peak_force_m
