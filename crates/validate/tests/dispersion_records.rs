@@ -14,10 +14,6 @@ fn root() -> PathBuf {
 fn exact_and_bancroft_forces_of_the_eight_records_differ_by_less_than_their_noise_in_band() {
     let rows = compare_records(&root()).unwrap();
     assert_eq!(rows.len(), 8);
-    // The two-wave front force is the small difference of two large waves, each moved by the
-    // fit's long-wave offset in opposite directions: on one record (SS302 10 psi, 1.56 noise
-    // RMS) its in-band difference exceeds the noise; the report says so. More would be news.
-    let mut front_above_noise = Vec::new();
     for r in &rows {
         let label = r.sample.label;
         assert_eq!(r.bancroft.dispersion, DispersionCorrection::Bancroft);
@@ -40,9 +36,14 @@ fn exact_and_bancroft_forces_of_the_eight_records_differ_by_less_than_their_nois
             "{label}: Δ peak back force {dp} N, noise {} N",
             r.back_noise_n
         );
-        if r.max_front_difference_band_n() >= r.front_noise_n {
-            front_above_noise.push(label);
-        }
+        // The two-wave front force is the small difference of two large waves, each moved by
+        // the fit's long-wave offset in opposite directions: its in-band difference is the
+        // larger (0.52 of the noise at worst, validation/dispersion/REPORT.md), still below it.
+        let df = r.max_front_difference_band_n();
+        assert!(
+            df < r.front_noise_n,
+            "{label}: max|ΔF_front| {df} N, noise {} N",
+            r.front_noise_n
+        );
     }
-    assert!(front_above_noise.len() <= 1, "{front_above_noise:?}");
 }
