@@ -2051,7 +2051,7 @@ fn alignment_section(w: &mut String, rows: &[Row]) {
          from the stated gauge distances (2 d_I/c0, (d_I + d_T)/c0); *foot* from the feet (2 % of \
          each pulse's own peak) of the reflected and transmitted pulses in the record; *balance* \
          shifts the geometric delays, each within ±{} µs, to minimise Σ(F_front − F_back)²/ΣF_back² \
-         over the incident wave's rise (10 % to its peak). The same numbers come from \
+         over the incident pulse (from 10 % of its peak up to 10 % down). The same numbers come from \
          `shpb reduce RECORD --bars bars/authors.toml --align STRATEGY`. The verdict judges the \
          equilibrium ratio over the loading (25 % of the 3-wave peak to the peak) against 0.05.\n",
         us(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S)
