@@ -1,7 +1,8 @@
 //! The copper pulse shaper between striker and incident bar (docs/physics.md §6.5): a thin disc
 //! flattened plastically. Two laws: Frew, Forrestal & Chen's (Exp. Mech. 42, 93 (2002)) with an
-//! effective modulus, and a crushed disc of Johnson–Cook copper with the elastic compliance of the
-//! bar faces in series ([`CrushedDisc`]).
+//! effective modulus, a crushed disc of Johnson–Cook copper with the elastic compliance of the
+//! bar faces in series ([`CrushedDisc`]), and an elastic element stiffening exponentially with
+//! its closure ([`ExponentialSpring`], an empirical law: docs/physics.md §6.5.3).
 
 /// Which force law the shaper follows (set-up key `[shaper] model`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -10,6 +11,37 @@ pub enum ShaperModel {
     Frew,
     /// A Johnson–Cook copper disc crushed at constant volume, in series with the faces (§6.5.2).
     CrushedDisc(CrushedDisc),
+    /// An elastic element F = F0 (exp(c/λ) − 1) of its closure c (§6.5.3).
+    Exponential(ExponentialSpring),
+}
+
+/// An elastic shaper whose force grows exponentially with its closure c, F = F0 (exp(c/λ) − 1),
+/// and unloads along the same curve (docs/physics.md §6.5.3): an empirical law. Its time scales
+/// follow the striker's speed (a closure λ ln(F2/F1) passed at a closing speed ∝ v), as the
+/// rise of the 2013-05-22 records does; it holds no plastic memory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExponentialSpring {
+    /// Stiffening length λ: the closure over which the force grows by a factor e, m.
+    pub stiffening_length_m: f64,
+    /// Onset force F0, N: the force is F0 (e − 1) at c = λ; with F ≫ F0 it only moves the
+    /// pulse's foot in time (by λ ln(F0'/F0) of closure), not its shape.
+    pub onset_force_n: f64,
+}
+
+impl ExponentialSpring {
+    /// Force at closure `closure_m`, N: F0 (exp(c/λ) − 1) for c > 0, else 0.
+    pub fn force_n(&self, closure_m: f64) -> f64 {
+        if closure_m <= 0.0 {
+            0.0
+        } else {
+            self.onset_force_n * (closure_m / self.stiffening_length_m).exp_m1()
+        }
+    }
+
+    /// Stiffness dF/dc at closure `closure_m`, N/m: (F + F0)/λ.
+    pub fn stiffness_n_per_m(&self, closure_m: f64) -> f64 {
+        (self.force_n(closure_m) + self.onset_force_n) / self.stiffening_length_m
+    }
 }
 
 /// Johnson–Cook flow stress without the thermal term, σ = (A + B εⁿ)(1 + C ln(ε̇/ε̇0))
@@ -102,6 +134,8 @@ pub struct ShaperState {
     pub last_force_n: f64,
     /// Crushed disc: plastic thinning h0 − h of the disc, m.
     pub plastic_closure_m: f64,
+    /// Exponential: last closure seen (for the work increment), m.
+    pub last_closure_m: f64,
 }
 
 /// Smallest thickness ratio h/h0 the crushed disc may reach (its force diverges before).
@@ -139,6 +173,37 @@ impl PulseShaper {
             youngs_modulus_pa,
             model: ShaperModel::CrushedDisc(disc),
             calibrated_pressure_pa: None,
+        }
+    }
+
+    /// An exponential shaper (§6.5.3): the disc's geometry and the Frew constants unused (NaN),
+    /// no calibrated pressures.
+    pub fn exponential(spring: ExponentialSpring) -> PulseShaper {
+        PulseShaper {
+            diameter_m: f64::NAN,
+            thickness_m: f64::NAN,
+            sigma0_pa: f64::NAN,
+            n: f64::NAN,
+            m: f64::NAN,
+            youngs_modulus_pa: f64::NAN,
+            model: ShaperModel::Exponential(spring),
+            calibrated_pressure_pa: None,
+        }
+    }
+
+    /// How much later than a disc this shaper's pulse may start, s: for the exponential law the
+    /// time λ ln(1 + Z v/(2 F0))/v to close, at the striker's speed v, up to the force Z v/2 an
+    /// unshaped striker gives the bar (impedance `impedance_kg_s`), which no shaped pulse
+    /// exceeds; 0 for the disc laws, whose force rises from the first contact. A run's default
+    /// end time adds it (docs/physics.md §6.5.3).
+    pub fn onset_delay_s(&self, striker_velocity_m_s: f64, impedance_kg_s: f64) -> f64 {
+        match self.model {
+            ShaperModel::Exponential(e) if striker_velocity_m_s > 0.0 => {
+                e.stiffening_length_m
+                    * (impedance_kg_s * striker_velocity_m_s / (2.0 * e.onset_force_n)).ln_1p()
+                    / striker_velocity_m_s
+            }
+            _ => 0.0,
         }
     }
 
@@ -195,6 +260,14 @@ impl PulseShaper {
         let force = match self.model {
             ShaperModel::Frew => self.frew_force_n(state, closure_m),
             ShaperModel::CrushedDisc(d) => self.crushed_force_n(&d, state, closure_m, dt_s),
+            ShaperModel::Exponential(e) => {
+                let force = e.force_n(closure_m);
+                state.work_j +=
+                    0.5 * (force + state.last_force_n) * (closure_m - state.last_closure_m);
+                state.last_closure_m = closure_m;
+                state.last_force_n = force;
+                return force;
+            }
         };
         let strain = closure_m / self.thickness_m;
         let dh = (strain - state.last_strain) * self.thickness_m;
@@ -267,9 +340,13 @@ impl PulseShaper {
     }
 
     /// Stiffness bound dF/dclosure used for the explicit stability limit, N/m: E A/(h0 (1−ε)²)
-    /// (Frew) or the series elastic stiffness at strain ε (crushed disc).
+    /// (Frew), the series elastic stiffness at strain ε (crushed disc), or for the exponential
+    /// law, which has no thickness, (F + F0)/λ at the closure ε λ.
     pub fn max_stiffness_n_per_m(&self, strain: f64) -> f64 {
         let e = strain.clamp(0.0, 0.99);
+        if let ShaperModel::Exponential(x) = self.model {
+            return x.stiffness_n_per_m(strain.max(0.0) * x.stiffening_length_m);
+        }
         match self.model {
             ShaperModel::Frew => {
                 self.youngs_modulus_pa * self.area_m2() / (self.thickness_m * (1.0 - e) * (1.0 - e))
@@ -277,6 +354,7 @@ impl PulseShaper {
             ShaperModel::CrushedDisc(d) => {
                 self.crushed_elastic_stiffness_n_per_m(&d, e * self.thickness_m)
             }
+            ShaperModel::Exponential(_) => unreachable!("returned above"),
         }
     }
 }
@@ -385,5 +463,41 @@ mod tests {
         // the force ratio is a little lower (the faster disc is thinned less at equal closure).
         let r = ff / fs;
         assert!(r > 1.15 && r < 1.26, "{r}");
+    }
+
+    #[test]
+    fn the_exponential_law_grows_by_e_over_its_length_and_unloads_along_itself() {
+        let e = ExponentialSpring {
+            stiffening_length_m: 1e-4,
+            onset_force_n: 100.0,
+        };
+        let s = PulseShaper::exponential(e);
+        assert_eq!(e.force_n(0.0), 0.0);
+        assert_eq!(e.force_n(-1e-6), 0.0);
+        // F(c + λ) + F0 = e (F(c) + F0) at any closure.
+        for c in [1e-5, 2e-4, 5e-4] {
+            let r = (e.force_n(c + 1e-4) + 100.0) / (e.force_n(c) + 100.0);
+            assert!((r / std::f64::consts::E - 1.0).abs() < 1e-12, "{r}");
+        }
+        // Load to 0.6 mm and back to 0: the force retraces the curve and the work returns to 0
+        // (trapezoidal, so to second order in the closure step: 1e-3 of the peak work here).
+        let mut st = ShaperState::default();
+        let n = 600;
+        let mut peak_work = 0.0f64;
+        for i in (0..=n).chain((0..n).rev()) {
+            let c = i as f64 * 1e-6;
+            let f = s.force_n(&mut st, c, 1e-7);
+            assert_eq!(f, e.force_n(c));
+            peak_work = peak_work.max(st.work_j);
+        }
+        // Exact work to 0.6 mm: ∫F dc = F0 (λ (e⁶ − 1) − 6λ) = 100 (1e-4 · 402.43 − 6e-4) = 3.964 J.
+        let exact = 100.0 * (1e-4 * (6f64.exp() - 1.0) - 6e-4);
+        assert!(
+            (peak_work / exact - 1.0).abs() < 1e-4,
+            "{peak_work} vs {exact}"
+        );
+        assert!(st.work_j.abs() < 1e-9 * exact, "{}", st.work_j);
+        // Stiffness (F + F0)/λ.
+        assert!((e.stiffness_n_per_m(3e-4) - (e.force_n(3e-4) + 100.0) / 1e-4).abs() < 1e-6);
     }
 }

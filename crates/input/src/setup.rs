@@ -8,7 +8,7 @@ use serde::Deserialize;
 use shpb_core::apparatus::{Apparatus, BarGeometry, Insert, Inserts};
 use shpb_core::bar::BarMaterial;
 use shpb_core::gauge::GaugeSetup;
-use shpb_core::shaper::{CrushedDisc, JohnsonCook, PulseShaper, ShaperModel};
+use shpb_core::shaper::{CrushedDisc, ExponentialSpring, JohnsonCook, PulseShaper, ShaperModel};
 use shpb_core::striker::PSI_PA;
 use shpb_core::striker::{GasGun, Gun, LinearGun};
 use std::path::Path;
@@ -51,14 +51,16 @@ struct GunToml {
 #[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct ShaperToml {
-    /// "frew" (default) or "crushed-disc".
+    /// "frew" (default), "crushed-disc" or "exponential".
     model: Option<String>,
-    diameter_m: f64,
-    thickness_m: f64,
+    diameter_m: Option<f64>,
+    thickness_m: Option<f64>,
     sigma0_pa: Option<f64>,
     n: Option<f64>,
     m: Option<f64>,
-    youngs_modulus_pa: f64,
+    youngs_modulus_pa: Option<f64>,
+    stiffening_length_m: Option<f64>,
+    onset_force_n: Option<f64>,
     friction: Option<f64>,
     face_compliance_factor: Option<f64>,
     jc_a_pa: Option<f64>,
@@ -169,11 +171,25 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
                 )?,
             })
         }
+        "exponential" => ShaperModel::Exponential(ExponentialSpring {
+            stiffening_length_m: v.positive(
+                "stiffening_length_m",
+                need("stiffening_length_m", s.stiffening_length_m)?,
+                0.01,
+                "m",
+            )?,
+            onset_force_n: v.positive(
+                "onset_force_n",
+                need("onset_force_n", s.onset_force_n)?,
+                1e6,
+                "N",
+            )?,
+        }),
         other => {
             return Err(v.error(
                 "model",
                 format!("unknown shaper model `{other}`"),
-                "frew, crushed-disc",
+                "frew, crushed-disc, exponential",
             ));
         }
     };
@@ -185,9 +201,54 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
             Some((lo * PSI_PA, hi * PSI_PA))
         }
     };
+    if let ShaperModel::Exponential(_) = model {
+        // The law has no disc: its geometry and moduli would be silently unused.
+        for (key, x) in [
+            ("diameter_m", s.diameter_m),
+            ("thickness_m", s.thickness_m),
+            ("youngs_modulus_pa", s.youngs_modulus_pa),
+            ("sigma0_pa", s.sigma0_pa),
+            ("n", s.n),
+            ("m", s.m),
+            ("friction", s.friction),
+            ("face_compliance_factor", s.face_compliance_factor),
+        ] {
+            if x.is_some() {
+                return Err(v.error(
+                    key,
+                    "not a constant of model = \"exponential\"",
+                    "stiffening_length_m, onset_force_n",
+                ));
+            }
+        }
+        let mut shaper = PulseShaper::exponential(match model {
+            ShaperModel::Exponential(e) => e,
+            _ => unreachable!(),
+        });
+        shaper.calibrated_pressure_pa = calibrated_pressure_pa;
+        return Ok(shaper);
+    }
+    for key in ["stiffening_length_m", "onset_force_n"] {
+        let given = match key {
+            "stiffening_length_m" => s.stiffening_length_m,
+            _ => s.onset_force_n,
+        };
+        if given.is_some() {
+            return Err(v.error(
+                key,
+                format!("not a constant of model = \"{model_name}\""),
+                "model = \"exponential\"",
+            ));
+        }
+    }
     Ok(PulseShaper {
-        diameter_m: v.positive("diameter_m", s.diameter_m, 0.1, "m")?,
-        thickness_m: v.positive("thickness_m", s.thickness_m, 0.05, "m")?,
+        diameter_m: v.positive("diameter_m", need("diameter_m", s.diameter_m)?, 0.1, "m")?,
+        thickness_m: v.positive(
+            "thickness_m",
+            need("thickness_m", s.thickness_m)?,
+            0.05,
+            "m",
+        )?,
         sigma0_pa: if frew {
             v.positive("sigma0_pa", need("sigma0_pa", s.sigma0_pa)?, 1e11, "Pa")?
         } else {
@@ -203,7 +264,12 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
         } else {
             s.m.unwrap_or(f64::NAN)
         },
-        youngs_modulus_pa: v.positive("youngs_modulus_pa", s.youngs_modulus_pa, 1e13, "Pa")?,
+        youngs_modulus_pa: v.positive(
+            "youngs_modulus_pa",
+            need("youngs_modulus_pa", s.youngs_modulus_pa)?,
+            1e13,
+            "Pa",
+        )?,
         model,
         calibrated_pressure_pa,
     })
@@ -450,7 +516,7 @@ impl ApparatusFile for Apparatus {
 pub struct ShaperOverride {
     /// Use a shaper at all (default: if the set-up has one).
     pub enabled: Option<bool>,
-    /// Force law: "frew" or "crushed-disc".
+    /// Force law: "frew", "crushed-disc" or "exponential".
     pub model: Option<String>,
     /// Diameter, m.
     pub diameter_m: Option<f64>,
@@ -468,6 +534,10 @@ pub struct ShaperOverride {
     pub friction: Option<f64>,
     /// Multiplier of the Boussinesq face compliance (crushed-disc).
     pub face_compliance_factor: Option<f64>,
+    /// Stiffening length λ, m (exponential).
+    pub stiffening_length_m: Option<f64>,
+    /// Onset force F0, N (exponential).
+    pub onset_force_n: Option<f64>,
 }
 
 impl ShaperOverride {
@@ -482,6 +552,8 @@ impl ShaperOverride {
             || self.youngs_modulus_pa.is_some()
             || self.friction.is_some()
             || self.face_compliance_factor.is_some()
+            || self.stiffening_length_m.is_some()
+            || self.onset_force_n.is_some()
     }
 
     /// Applies the override to the set-up's shaper (bars of plane-strain modulus
@@ -500,7 +572,8 @@ impl ShaperOverride {
             Some(b) => b,
             None if self.enabled == Some(true)
                 || self.diameter_m.is_some()
-                || self.thickness_m.is_some() =>
+                || self.thickness_m.is_some()
+                || self.stiffening_length_m.is_some() =>
             {
                 PulseShaper {
                     diameter_m: f64::NAN,
@@ -518,19 +591,35 @@ impl ShaperOverride {
         if !self.changes_constants() {
             return Ok(Some(b));
         }
-        let (base_model, disc) = match b.model {
-            ShaperModel::Frew => ("frew", None),
-            ShaperModel::CrushedDisc(d) => ("crushed-disc", Some(d)),
+        let (base_model, disc, spring) = match b.model {
+            ShaperModel::Frew => ("frew", None, None),
+            ShaperModel::CrushedDisc(d) => ("crushed-disc", Some(d), None),
+            ShaperModel::Exponential(e) => ("exponential", None, Some(e)),
         };
-        let opt = |x: f64| x.is_finite().then_some(x);
+        let model = self.model.clone().unwrap_or_else(|| base_model.to_string());
+        let disc_keys = model != "exponential";
+        // The base's constants carry over only to a model that has them.
+        let opt = |x: f64| (disc_keys && x.is_finite()).then_some(x);
+        let (disc, spring) = if disc_keys {
+            (disc, None)
+        } else {
+            (None, spring)
+        };
         let s = ShaperToml {
-            model: Some(self.model.clone().unwrap_or_else(|| base_model.to_string())),
-            diameter_m: self.diameter_m.unwrap_or(b.diameter_m),
-            thickness_m: self.thickness_m.unwrap_or(b.thickness_m),
-            sigma0_pa: self.sigma0_pa.or(opt(b.sigma0_pa)).or(Some(0.75e9)),
-            n: self.n.or(opt(b.n)).or(Some(0.37)),
-            m: self.m.or(opt(b.m)).or(Some(4.25)),
-            youngs_modulus_pa: self.youngs_modulus_pa.unwrap_or(b.youngs_modulus_pa),
+            diameter_m: self.diameter_m.or(opt(b.diameter_m)),
+            thickness_m: self.thickness_m.or(opt(b.thickness_m)),
+            sigma0_pa: self
+                .sigma0_pa
+                .or(opt(b.sigma0_pa))
+                .or(disc_keys.then_some(0.75e9)),
+            n: self.n.or(opt(b.n)).or(disc_keys.then_some(0.37)),
+            m: self.m.or(opt(b.m)).or(disc_keys.then_some(4.25)),
+            youngs_modulus_pa: self.youngs_modulus_pa.or(opt(b.youngs_modulus_pa)),
+            stiffening_length_m: self
+                .stiffening_length_m
+                .or(spring.map(|e| e.stiffening_length_m)),
+            onset_force_n: self.onset_force_n.or(spring.map(|e| e.onset_force_n)),
+            model: Some(model),
             friction: self.friction.or(disc.map(|d| d.friction)),
             face_compliance_factor: self
                 .face_compliance_factor
@@ -709,5 +798,82 @@ mod tests {
             t.model, s.model,
             "the override keeps the model and its faces"
         );
+    }
+
+    #[test]
+    fn the_exponential_shaper_takes_its_two_constants_and_refuses_a_disc_s_constants() {
+        let text = crate::builtin::setup("authors").unwrap();
+        let head = &text[..text.find("\n[shaper]").unwrap() + 1];
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let read =
+            |shaper: &str| Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges);
+        let a = read(
+            "[shaper]\nmodel = \"exponential\"\nstiffening_length_m = 1e-4\nonset_force_n = 100\n\
+             calibrated_pressure_psi = [10.0, 15.0]\n",
+        )
+        .unwrap();
+        let s = a.shaper.unwrap();
+        assert_eq!(
+            s.model,
+            ShaperModel::Exponential(ExponentialSpring {
+                stiffening_length_m: 1e-4,
+                onset_force_n: 100.0
+            })
+        );
+        assert!(s.calibrated_pressure_pa.is_some());
+        for (bad, key) in [
+            (
+                "model = \"exponential\"\nstiffening_length_m = 1e-4\n",
+                "`shaper.onset_force_n`: missing",
+            ),
+            (
+                "model = \"exponential\"\nstiffening_length_m = -1e-4\nonset_force_n = 100\n",
+                "`shaper.stiffening_length_m`",
+            ),
+            (
+                "model = \"exponential\"\nstiffening_length_m = 1e-4\nonset_force_n = 100\nthickness_m = 5e-4\n",
+                "`shaper.thickness_m`: not a constant of model = \"exponential\"",
+            ),
+            (
+                "diameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\nsigma0_pa = 7.5e8\n\
+                 n = 0.37\nm = 4.25\nonset_force_n = 100\n",
+                "`shaper.onset_force_n`: not a constant of model = \"frew\"",
+            ),
+            ("model = \"frew\"\n", "`shaper.diameter_m`: missing"),
+        ] {
+            let e = read(&format!("[shaper]\n{bad}")).unwrap_err().to_string();
+            assert!(e.contains(key), "{bad}: {e}");
+        }
+        // A scene may switch the set-up's shaper to the exponential law and back; the other
+        // model's constants do not carry over.
+        let v = Validator::new("scene.toml");
+        let frew = Apparatus::from_toml(text, "a.toml", &gauges)
+            .unwrap()
+            .shaper
+            .unwrap();
+        let to_exp = ShaperOverride {
+            model: Some("exponential".into()),
+            stiffening_length_m: Some(1e-4),
+            onset_force_n: Some(100.0),
+            ..Default::default()
+        };
+        let x = to_exp.apply(Some(frew), 1e11, &v).unwrap().unwrap();
+        assert_eq!(x.model, s.model);
+        let longer = ShaperOverride {
+            stiffening_length_m: Some(2e-4),
+            ..Default::default()
+        };
+        let y = longer.apply(Some(x), 1e11, &v).unwrap().unwrap();
+        let ShaperModel::Exponential(e) = y.model else {
+            panic!("{:?}", y.model)
+        };
+        assert_eq!((e.stiffening_length_m, e.onset_force_n), (2e-4, 100.0));
+        let back = ShaperOverride {
+            model: Some("frew".into()),
+            ..Default::default()
+        };
+        let e = back.apply(Some(x), 1e11, &v).unwrap_err().to_string();
+        assert!(e.contains("`diameter_m`: missing"), "{e}");
     }
 }

@@ -295,6 +295,27 @@ impl GaugeStresses {
         })
     }
 
+    /// The largest transmitted stress in the transmitted pulse's window (100–550 µs after the
+    /// incident pulse's 10 % foot), Pa: [`Pulses::transmitted`]'s peak, also where that pulse
+    /// has not ended inside the window.
+    pub fn transmitted_peak_pa(&self, source: &str) -> Result<f64> {
+        let t0 = incident_pulse_of(&self.time_s, &self.incident_pa)
+            .map_err(|what| Error::Input {
+                file: source.into(),
+                key: what.into(),
+                problem: "not found".into(),
+                allowed: "signals with an incident pulse".into(),
+            })?
+            .start_10_s;
+        Ok(self
+            .time_s
+            .iter()
+            .zip(&self.transmission_pa)
+            .filter(|(t, _)| (t0 + 100e-6..=t0 + 550e-6).contains(*t))
+            .map(|(_, v)| *v)
+            .fold(f64::NEG_INFINITY, f64::max))
+    }
+
     /// Its incident, reflected and transmitted pulses; `source` names the signal in errors.
     pub fn pulses(&self, source: &str) -> Result<Pulses> {
         pulses(&self.time_s, &self.incident_pa, &self.transmission_pa).map_err(|what| {
@@ -322,12 +343,22 @@ pub fn virtual_test(
         sample.scene
     ));
     let mut params = Params::from_file(&path)?;
-    if let SceneParams::Pulse { options, .. } = &mut params.params {
+    if let SceneParams::Pulse {
+        options, apparatus, ..
+    } = &mut params.params
+    {
         if let Some(v) = striker_velocity_m_s {
             options.striker_velocity_m_s = v;
         }
         if shaper.is_some() {
             options.shaper = shaper;
+        }
+        // An exponential shaper's pulse starts later than the scene's disc's: the run is longer
+        // by as much (the scene's own default end time does the same).
+        if let Some(s) = shaper {
+            let a = &apparatus;
+            let z = a.material.density_kg_m3 * a.material.wave_speed_m_s() * a.incident.area_m2();
+            options.end_time_s += s.onset_delay_s(options.striker_velocity_m_s, z);
         }
     }
     params.run().map_err(Error::from)
@@ -345,16 +376,21 @@ fn pulse_in(t: &[f64], y: &[f64], t0: f64, t1: f64) -> Option<PulseMetrics> {
     pulse_metrics(&t[a..b], &y[a..b], false)
 }
 
-/// Finds incident (compressive), reflected (tensile, incident channel) and transmitted
-/// (compressive) pulses; `inc` and `tra` are compression-positive stresses on the times `t`.
-fn pulses(t: &[f64], inc: &[f64], tra: &[f64]) -> std::result::Result<Pulses, &'static str> {
-    // The incident pulse: around the first sample above 30 % of the channel's largest compression.
+/// The incident pulse (compressive, around the first sample above 30 % of the channel's largest
+/// compression) of compression-positive stresses `inc` on the times `t`.
+fn incident_pulse_of(t: &[f64], inc: &[f64]) -> std::result::Result<PulseMetrics, &'static str> {
     let peak = inc.iter().copied().fold(0.0, f64::max);
     let i = inc
         .iter()
         .position(|&v| v > 0.3 * peak)
         .ok_or("incident pulse")?;
-    let incident = pulse_in(t, inc, t[i] - 60e-6, t[i] + 200e-6).ok_or("incident pulse")?;
+    pulse_in(t, inc, t[i] - 60e-6, t[i] + 200e-6).ok_or("incident pulse")
+}
+
+/// Finds incident (compressive), reflected (tensile, incident channel) and transmitted
+/// (compressive) pulses; `inc` and `tra` are compression-positive stresses on the times `t`.
+fn pulses(t: &[f64], inc: &[f64], tra: &[f64]) -> std::result::Result<Pulses, &'static str> {
+    let incident = incident_pulse_of(t, inc)?;
     let t0 = incident.start_10_s;
     let tension: Vec<f64> = inc.iter().map(|v| -v).collect();
     let reflected = pulse_in(t, &tension, t0 + 150e-6, t0 + 500e-6).ok_or("reflected pulse")?;

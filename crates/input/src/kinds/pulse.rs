@@ -62,7 +62,7 @@ pub(super) const SHAPER: Key = Key {
     key: "shaper",
     unit: "",
     default: "the set-up's shaper",
-    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), model (frew, crushed-disc), diameter_m, thickness_m, sigma0_pa, n, m (frew), youngs_modulus_pa, friction, face_compliance_factor (crushed-disc)",
+    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), model (frew, crushed-disc, exponential), diameter_m, thickness_m, sigma0_pa, n, m (frew), youngs_modulus_pa, friction, face_compliance_factor (crushed-disc), stiffening_length_m, onset_force_n (exponential)",
 };
 
 /// `cell_size_m` (pulse and shpb).
@@ -381,6 +381,10 @@ pub(super) fn parse_bars(
         + 200e-6;
     // A drive starts with the record's own lead before its incident wave's foot.
     let default_end = default_end + drive.as_ref().map_or(0.0, |d| d.foot_s);
+    // An exponential shaper closes a while before its force rises (docs/physics.md §6.5.3).
+    let impedance_kg_s = apparatus.material.density_kg_m3 * c0 * apparatus.incident.area_m2();
+    let default_end =
+        default_end + shaper.map_or(0.0, |s| s.onset_delay_s(velocity, impedance_kg_s));
     let end_time_s = match f.end_time_s {
         Some(e) => v.positive("end_time_s", e, 0.1, "s")?,
         None => default_end,

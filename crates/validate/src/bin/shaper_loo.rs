@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, pulse_metrics};
 use shpb_core::numeric::min_max;
-use shpb_core::shaper::{CrushedDisc, PulseShaper, ShaperModel};
+use shpb_core::shaper::{CrushedDisc, ExponentialSpring, PulseShaper, ShaperModel};
 use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
 use shpb_validate::gauge_records::{
@@ -82,8 +82,13 @@ fn read_records(a: &Apparatus) -> Vec<Record> {
 fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper) -> Option<(PulseMetrics, f64)> {
     let c0 = a.material.wave_speed_m_s();
     let ch = a.gauges.channel("incident")?;
-    let end =
-        (a.incident.length_m - ch.distance_from_specimen_m) / c0 + INCIDENT_WINDOW_S.1 + 20e-6;
+    // An exponential shaper's pulse starts later than a disc's: its runs are longer by as much.
+    let z = a.material.density_kg_m3 * c0 * a.incident.area_m2();
+    let slack = shaper.onset_delay_s(v, z);
+    let end = (a.incident.length_m - ch.distance_from_specimen_m) / c0
+        + INCIDENT_WINDOW_S.1
+        + 20e-6
+        + slack;
     let s = a
         .incident_signal(v, Some(shaper), CELL_M, GAUGE_LENGTH_M, end)
         .ok()?;
@@ -110,7 +115,14 @@ enum Family {
     CrushedDisc,
     /// Crushed Johnson–Cook disc with ideal faces: diameter, thickness and friction μ free.
     CrushedDiscFriction,
+    /// The elastic exponential law F0 (exp(c/λ) − 1): λ free, F0 = [`ONSET_FORCE_N`].
+    Exponential,
 }
+
+/// Onset force F0 of the exponential family, N: the law is scale-free (its time scales ∝ 1/v)
+/// only while F0 ≪ the pulse's forces, so F0 is set small and stated, not fitted (fitted, it runs
+/// to its upper bound and the 10 psi rise is lost: validation/pulse/REPORT.md).
+const ONSET_FORCE_N: f64 = 10.0;
 
 impl Family {
     fn name(self) -> &'static str {
@@ -118,6 +130,7 @@ impl Family {
             Family::Frew => "frew",
             Family::CrushedDisc => "crushed-disc (face compliance free)",
             Family::CrushedDiscFriction => "crushed-disc (friction free)",
+            Family::Exponential => "exponential (λ free)",
         }
     }
     /// The model's key in the fit cache.
@@ -126,21 +139,23 @@ impl Family {
             Family::Frew => "frew",
             Family::CrushedDisc => "crushed-disc-face-compliance",
             Family::CrushedDiscFriction => "crushed-disc-friction",
+            Family::Exponential => "exponential",
         }
     }
     /// Names of the free shaper parameters and their display scale and unit.
-    fn params(self) -> [(&'static str, f64, &'static str); 3] {
+    fn params(self) -> Vec<(&'static str, f64, &'static str)> {
         let third = match self {
             Family::Frew => ("youngs_modulus_pa", 1e-9, "GPa"),
             Family::CrushedDisc => ("face_compliance_factor", 1.0, ""),
             Family::CrushedDiscFriction => ("friction", 1.0, ""),
+            Family::Exponential => return vec![("stiffening_length_m", 1e6, "µm")],
         };
-        [("diameter_m", 1e3, "mm"), ("thickness_m", 1e3, "mm"), third]
+        vec![("diameter_m", 1e3, "mm"), ("thickness_m", 1e3, "mm"), third]
     }
     /// Starting striker velocities at 10 / 12.5 / 15 psi, m/s.
     fn start_v(self) -> [f64; 3] {
         match self {
-            Family::Frew => [5.81, 6.79, 7.65],
+            Family::Frew | Family::Exponential => [5.81, 6.79, 7.65],
             _ => [7.5, 8.8, 9.9],
         }
     }
@@ -150,6 +165,7 @@ impl Family {
             Family::Frew => vec![3.98e-3, 0.429e-3, 1.43e9],
             Family::CrushedDisc => vec![3.0e-3, 0.6e-3, 5.0],
             Family::CrushedDiscFriction => vec![3.0e-3, 0.6e-3, 0.1],
+            Family::Exponential => vec![100e-6],
         }
     }
     fn bounds(self) -> Vec<(f64, f64)> {
@@ -157,6 +173,7 @@ impl Family {
             Family::Frew => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (0.3e9, 130e9)],
             Family::CrushedDisc => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (0.01, 1e3)],
             Family::CrushedDiscFriction => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (1e-3, 1.0)],
+            Family::Exponential => vec![(10e-6, 1e-3)],
         }
     }
     fn shaper(self, a: &Apparatus, p: &[f64]) -> PulseShaper {
@@ -183,6 +200,10 @@ impl Family {
                 }
                 PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
             }
+            Family::Exponential => PulseShaper::exponential(ExponentialSpring {
+                stiffening_length_m: p[0],
+                onset_force_n: ONSET_FORCE_N,
+            }),
         }
     }
 }
@@ -298,10 +319,11 @@ struct ModelFits {
     all: Fit,
 }
 
-const FAMILIES: [Family; 3] = [
+const FAMILIES: [Family; 4] = [
     Family::Frew,
     Family::CrushedDisc,
     Family::CrushedDiscFriction,
+    Family::Exponential,
 ];
 
 /// Fits `fam` on each pair of pressures and on all three.
@@ -467,10 +489,8 @@ fn simulated_transmitted_pa(
     let out = virtual_test(root, sample, run.map(|r| r.0), run.map(|r| r.1))
         .map_err(|e| e.to_string())?;
     let s = GaugeStresses::of_run(&out, e, sample.scene).map_err(|e| e.to_string())?;
-    Ok(s.pulses(sample.scene)
-        .map_err(|e| e.to_string())?
-        .transmitted
-        .peak)
+    s.transmitted_peak_pa(sample.scene)
+        .map_err(|e| e.to_string())
 }
 
 fn main() {
@@ -487,6 +507,8 @@ fn main() {
         vec![Family::Frew]
     } else if args.iter().any(|s| s == "--disc") {
         vec![Family::CrushedDisc]
+    } else if args.iter().any(|s| s == "--exponential") {
+        vec![Family::Exponential]
     } else {
         FAMILIES.to_vec()
     };
@@ -516,9 +538,12 @@ fn main() {
                 .iter()
                 .map(|&f| fit_model(&a, f, &records))
                 .collect();
-            let secs = started.elapsed().as_secs();
-            // Keep the cached fits of the models not refitted.
-            let mut all = read_cache(&cache_path).map(|c| c.0).unwrap_or_default();
+            let mut secs = started.elapsed().as_secs();
+            // Keep the cached fits of the models not refitted (and count the time they took).
+            let (mut all, old_secs) = read_cache(&cache_path).unwrap_or_default();
+            if all.iter().any(|m| !families.contains(&m.fam)) {
+                secs += old_secs;
+            }
             all.retain(|m| !families.contains(&m.fam));
             all.extend(fitted);
             all.sort_by_key(|m| FAMILIES.iter().position(|f| *f == m.fam));
@@ -659,7 +684,7 @@ fn section(
         "{BEGIN}\n## Leave one pressure out\n\nGenerated by `cargo run --release -p shpb-validate --bin shaper_loo` \
          (crates/validate/src/bin/shaper_loo.rs); do not edit by hand. Each shaper model is fitted on the \
          2013-05-22 records at two of the three pressures (gun line v² = k (p − p_loss) through the two fitted \
-         velocities, the shaper's three free constants; objective Σ (error/target)² of incident peak, rise \
+         velocities, the shaper's free constants (three, or the exponential law's one); objective Σ (error/target)² of incident peak, rise \
          10–90 %, duration at 10 % and pulse energy, targets 5 / 10 / 10 / 5 %), then predicts the held-out \
          pressure with the gun line extrapolated (10, 15 psi) or interpolated (12.5 psi). Errors are \
          (predicted − measured)/measured on each held-out record; bold: outside the issue-18 target. Nelder–Mead \
@@ -670,7 +695,9 @@ fn section(
          B = 292 MPa, n = 0.31, C = 0.025, ε̇0 = 1/s; Johnson & Cook 1983) crushed at constant volume, \
          E = 117 GPa, in series with the Boussinesq compliance of the two bar faces (docs/physics.md §6.5.2), \
          with either a multiplier of that face compliance or the Coulomb friction μ free beside diameter and \
-         thickness.\n\n\
+         thickness; **exponential**, an elastic element F = F0 (exp(c/λ) − 1) of the closure c, unloading \
+         along the same curve (docs/physics.md §6.5.3; an empirical law: a closure λ ln(F2/F1) passed at a \
+         closing speed that scales with the striker's gives rise times ∝ 1/v), λ free, F0 = {ONSET_FORCE_N} N.\n\n\
          **Transmitted peak.** For every held-out record, the full virtual test of its specimen \
          (`validation/fig4-virtual-shpb/<material>-<psi>.toml`: the record's sphere pair, the Burgoyne–Daraio \
          contact law, the authors' bars) is run with the shaper and the striker velocity that the two-pressure fit \
@@ -685,7 +712,7 @@ fn section(
         TRANSMITTED_TOL * 100.0
     );
     let mut summary = String::from(
-        "| model | held out | v predicted (m/s) | fitted on two: diameter, thickness, third | samples | peak | rise | duration | energy | transmitted peak rec. / pred. (kN) | transmitted peak | transmitted, all three |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| model | held out | v predicted (m/s) | shaper constants fitted on two | samples | peak | rise | duration | energy | transmitted peak rec. / pred. (kN) | transmitted peak | transmitted, all three |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut worst_rows = String::from(
         "| model | largest \\|peak err\\| | largest \\|rise err\\| | largest \\|duration err\\| | largest \\|energy err\\| | largest \\|transmitted peak err\\| | all within targets |\n|---|---|---|---|---|---|---|\n",
@@ -734,17 +761,20 @@ fn section(
                     worst_tra = (et.abs(), *sample);
                 }
                 worst[4] = worst[4].max(et.abs());
-                let p = &fo.fit.params;
+                let constants: Vec<String> = fo
+                    .fit
+                    .params
+                    .iter()
+                    .zip(&names)
+                    .map(|(x, (_, scale, unit))| format!("{:.3} {unit}", x * scale))
+                    .collect();
                 let _ = writeln!(
                     summary,
-                    "| {} | {} psi | {:.2} | {:.3} mm, {:.3} mm, {:.3} {} | {sample} | {} | {} | {} | {} | {:.2} / {:.2} | {} | {} |",
+                    "| {} | {} psi | {:.2} | {} | {sample} | {} | {} | {} | {} | {:.2} / {:.2} | {} | {} |",
                     fam.name(),
                     PRESSURES_PSI[fo.held_out],
                     fo.fit.velocity_m_s[fo.held_out],
-                    p[0] * 1e3,
-                    p[1] * 1e3,
-                    p[2] * names[2].1,
-                    names[2].2,
+                    constants.join(", "),
                     pct(e[0], TOL[0]),
                     pct(e[1], TOL[1]),
                     pct(e[2], TOL[2]),
@@ -850,6 +880,7 @@ fn section(
          on the same eight tests.\n",
         100.0 * shipped_worst
     );
+    sec.push_str(&rise_and_plateau(models, &all_folds));
     sec.push_str(&scatter_section(records, models, &all_folds));
     sec.push_str(&held_out_day(root, a, records));
     sec.push_str(&held_out_day_models(root, a, models));
@@ -862,6 +893,67 @@ fn section(
         started.elapsed().as_secs()
     );
     sec
+}
+
+/// Range (least, largest) of metric `j`'s held-out error at the pressure `held` over a model's
+/// records.
+fn held_out_range(folds: &[Fold], held: usize, j: usize) -> (f64, f64) {
+    min_max(
+        folds[held]
+            .errors
+            .iter()
+            .map(|(_, e)| e[j])
+            .filter(|e| e.is_finite()),
+    )
+}
+
+/// What separates the models: the 10 psi rise (how a pulse's time scale follows the striker's
+/// speed) and the 15 psi peak (the records' plateau), held out, per model.
+fn rise_and_plateau(models: &[ModelFits], folds: &[Vec<Fold>]) -> String {
+    let mut t = String::from(
+        "### The rise and the plateau
+
+The two held-out errors that separate the models: the rise at \
+         10 psi, where a pulse's time scale must follow the striker's speed beyond the fitted ones, \
+         and the peak at 15 psi, where the records hold a plateau.\n\n\
+         | model | fitted shaper constants | rise 10–90 %, 10 psi held out | peak, 15 psi held out |\n\
+         |---|---|---|---|\n",
+    );
+    for (m, f) in models.iter().zip(folds) {
+        let (r0, r1) = held_out_range(f, 0, 1);
+        let (p0, p1) = held_out_range(f, 2, 0);
+        let _ = writeln!(
+            t,
+            "| {} | {} | {:+.1} to {:+.1} % | {:+.1} to {:+.1} % |",
+            m.fam.name(),
+            m.fam.params().len(),
+            100.0 * r0,
+            100.0 * r1,
+            100.0 * p0,
+            100.0 * p1
+        );
+    }
+    t.push_str(
+        "\n**Reading (an inference from eight records).** The records' rise shortens with the \
+         striker's speed about as 1/v (*The rise, segment by segment*, above). A disc law with an \
+         elastic cushion of fixed stiffness (frew's effective modulus, the crushed disc's face \
+         compliance) has a time scale of its own, independent of v, and its rise extrapolated to \
+         10 psi comes out short; the exponential law has none (a force growing by e over each λ of \
+         closure, passed at a closing speed ∝ v), and predicts the 10 psi rise from the 12.5 and \
+         15 psi records. Its one constant barely moves between the folds (*Fitted constants*, \
+         below), where the disc models' diameter and thickness range over a factor of up to four. \
+         Fitting F0 as well undoes this: the fit then runs F0 to several kN, where the law is \
+         nearly linear at the pulse's foot, and the 10 psi rise is lost again (−16 to −23 %, a \
+         scratch fit); with F0 = 1 N instead of 10 N every error above moves by at most 0.1 \
+         percentage point. What the exponential law does not have is the records' plateau: an \
+         elastic element gives a rounded top, and its peak at 15 psi comes out 9–11 % high, as \
+         frew's does. A law that has both (an elastic exponential rise and a plastic limit \
+         reached near 15 psi) would need the limit's level from the records at 15 psi itself, \
+         which the 10 and 12.5 psi records, below it, cannot give. Of these models only the crushed \
+         disc with its face compliance free comes near the 15 psi peak, at the price of the 10 psi \
+         rise.\n\n",
+    );
+    t
 }
 
 /// A held-out record outside its target on one metric.
