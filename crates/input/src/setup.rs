@@ -735,14 +735,18 @@ mod tests {
         );
     }
 
-    #[test]
-    fn the_shaper_model_and_its_calibrated_range_are_read_and_checked() {
+    /// The authors' set-up with its `[shaper]` table replaced by `shaper`.
+    fn with_shaper(shaper: &str) -> Result<Apparatus> {
         let text = crate::builtin::setup("authors").unwrap();
         let head = &text[..text.find("\n[shaper]").unwrap() + 1];
         let gauges =
             |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
-        let read =
-            |shaper: &str| Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges);
+        Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges)
+    }
+
+    #[test]
+    fn the_shaper_model_and_its_calibrated_range_are_read_and_checked() {
+        let read = with_shaper;
         let disc = read(
             "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 4e-3\nthickness_m = 5e-4\n\
              youngs_modulus_pa = 117e9\nfriction = 0.1\ncalibrated_pressure_psi = [10.0, 15.0]\n",
@@ -802,12 +806,7 @@ mod tests {
 
     #[test]
     fn the_exponential_shaper_takes_its_two_constants_and_refuses_a_disc_s_constants() {
-        let text = crate::builtin::setup("authors").unwrap();
-        let head = &text[..text.find("\n[shaper]").unwrap() + 1];
-        let gauges =
-            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
-        let read =
-            |shaper: &str| Apparatus::from_toml(&format!("{head}{shaper}"), "a.toml", &gauges);
+        let read = with_shaper;
         let a = read(
             "[shaper]\nmodel = \"exponential\"\nstiffening_length_m = 1e-4\nonset_force_n = 100\n\
              calibrated_pressure_psi = [10.0, 15.0]\n",
@@ -848,10 +847,13 @@ mod tests {
         // A scene may switch the set-up's shaper to the exponential law and back; the other
         // model's constants do not carry over.
         let v = Validator::new("scene.toml");
-        let frew = Apparatus::from_toml(text, "a.toml", &gauges)
-            .unwrap()
-            .shaper
-            .unwrap();
+        let frew = read(
+            "[shaper]\ndiameter_m = 4e-3\nthickness_m = 5e-4\nyoungs_modulus_pa = 1e9\n\
+             sigma0_pa = 7.5e8\nn = 0.37\nm = 4.25\n",
+        )
+        .unwrap()
+        .shaper
+        .unwrap();
         let to_exp = ShaperOverride {
             model: Some("exponential".into()),
             stiffening_length_m: Some(1e-4),
