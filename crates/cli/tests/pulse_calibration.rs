@@ -35,10 +35,9 @@ fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper) -> (Vec<f64>, Vec<f64>) 
     let ch = a.gauges.channel("incident").unwrap();
     let c0 = a.material.wave_speed_m_s();
     // An exponential shaper's pulse starts later (docs/physics.md §6.5.3): 0 for the discs.
-    let z = a.material.density_kg_m3 * c0 * a.incident.area_m2();
     let end = (a.incident.length_m - ch.distance_from_specimen_m) / c0
         + 270e-6
-        + shaper.onset_delay_s(v, z);
+        + a.shaper_onset_delay_s(&shaper, v);
     let s = a.incident_signal(v, Some(shaper), 1e-3, 2e-3, end).unwrap();
     (s.time_s, s.stress_pa)
 }

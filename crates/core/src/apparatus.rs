@@ -118,6 +118,18 @@ impl Apparatus {
         self.material.density_kg_m3 * self.striker.area_m2() * self.striker.length_m
     }
 
+    /// How much later than a disc's the pulse of `shaper` may start at striker speed
+    /// `striker_velocity_m_s`, s: [`PulseShaper::onset_delay_s`] against the incident bar's
+    /// impedance (docs/physics.md §6.5.3); a run's default end time adds it.
+    pub fn shaper_onset_delay_s(&self, shaper: &PulseShaper, striker_velocity_m_s: f64) -> f64 {
+        let incident = Segment {
+            length_m: self.incident.length_m,
+            diameter_m: self.incident.diameter_m,
+            material: self.material,
+        };
+        shaper.onset_delay_s(striker_velocity_m_s, incident.impedance_kg_s())
+    }
+
     /// Striker velocity at gauge pressure `p_pa` (an out-of-range pressure is an error naming the
     /// gun's range).
     pub fn striker_velocity_m_s(&self, p_pa: f64) -> Result<f64> {

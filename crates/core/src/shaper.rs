@@ -128,13 +128,11 @@ pub struct ShaperState {
     pub max_stress_pa: f64,
     /// Plastic work dissipated so far, J (∫F dh minus the recoverable elastic part).
     pub work_j: f64,
-    /// Last strain seen (for the work increment).
-    pub last_strain: f64,
     /// Last force (for the work increment), N.
     pub last_force_n: f64,
     /// Crushed disc: plastic thinning h0 − h of the disc, m.
     pub plastic_closure_m: f64,
-    /// Exponential: last closure seen (for the work increment), m.
+    /// Last closure seen (for the work increment), m.
     pub last_closure_m: f64,
 }
 
@@ -260,19 +258,19 @@ impl PulseShaper {
         let force = match self.model {
             ShaperModel::Frew => self.frew_force_n(state, closure_m),
             ShaperModel::CrushedDisc(d) => self.crushed_force_n(&d, state, closure_m, dt_s),
-            ShaperModel::Exponential(e) => {
-                let force = e.force_n(closure_m);
-                state.work_j +=
-                    0.5 * (force + state.last_force_n) * (closure_m - state.last_closure_m);
-                state.last_closure_m = closure_m;
-                state.last_force_n = force;
-                return force;
+            ShaperModel::Exponential(e) => e.force_n(closure_m),
+        };
+        // The disc laws take the increment through the strain, as they always have (the same
+        // rounding); the exponential law has no thickness.
+        let dh = match self.model {
+            ShaperModel::Exponential(_) => closure_m - state.last_closure_m,
+            _ => {
+                (closure_m / self.thickness_m - state.last_closure_m / self.thickness_m)
+                    * self.thickness_m
             }
         };
-        let strain = closure_m / self.thickness_m;
-        let dh = (strain - state.last_strain) * self.thickness_m;
         state.work_j += 0.5 * (force + state.last_force_n) * dh;
-        state.last_strain = strain;
+        state.last_closure_m = closure_m;
         state.last_force_n = force;
         force
     }
@@ -344,9 +342,6 @@ impl PulseShaper {
     /// law, which has no thickness, (F + F0)/λ at the closure ε λ.
     pub fn max_stiffness_n_per_m(&self, strain: f64) -> f64 {
         let e = strain.clamp(0.0, 0.99);
-        if let ShaperModel::Exponential(x) = self.model {
-            return x.stiffness_n_per_m(strain.max(0.0) * x.stiffening_length_m);
-        }
         match self.model {
             ShaperModel::Frew => {
                 self.youngs_modulus_pa * self.area_m2() / (self.thickness_m * (1.0 - e) * (1.0 - e))
@@ -354,7 +349,9 @@ impl PulseShaper {
             ShaperModel::CrushedDisc(d) => {
                 self.crushed_elastic_stiffness_n_per_m(&d, e * self.thickness_m)
             }
-            ShaperModel::Exponential(_) => unreachable!("returned above"),
+            ShaperModel::Exponential(x) => {
+                x.stiffness_n_per_m(strain.max(0.0) * x.stiffening_length_m)
+            }
         }
     }
 }

@@ -201,7 +201,7 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
             Some((lo * PSI_PA, hi * PSI_PA))
         }
     };
-    if let ShaperModel::Exponential(_) = model {
+    if let ShaperModel::Exponential(spring) = model {
         // The law has no disc: its geometry and moduli would be silently unused.
         for (key, x) in [
             ("diameter_m", s.diameter_m),
@@ -221,18 +221,14 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
                 ));
             }
         }
-        let mut shaper = PulseShaper::exponential(match model {
-            ShaperModel::Exponential(e) => e,
-            _ => unreachable!(),
-        });
+        let mut shaper = PulseShaper::exponential(spring);
         shaper.calibrated_pressure_pa = calibrated_pressure_pa;
         return Ok(shaper);
     }
-    for key in ["stiffening_length_m", "onset_force_n"] {
-        let given = match key {
-            "stiffening_length_m" => s.stiffening_length_m,
-            _ => s.onset_force_n,
-        };
+    for (key, given) in [
+        ("stiffening_length_m", s.stiffening_length_m),
+        ("onset_force_n", s.onset_force_n),
+    ] {
         if given.is_some() {
             return Err(v.error(
                 key,

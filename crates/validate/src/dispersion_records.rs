@@ -146,10 +146,18 @@ impl RecordComparison {
 
     /// Largest |ΔF_front| in the pulses' band (both series through [`low_pass`]), N.
     pub fn max_front_difference_band_n(&self) -> f64 {
-        max_abs_difference(
-            &low_pass(&self.exact.force_front_n, self.dt_s),
-            &low_pass(&self.bancroft.force_front_n, self.dt_s),
-        )
+        self.largest_front_difference_band().1
+    }
+
+    /// Where in the window (sample index) the largest |ΔF_front| in the pulses' band lies, and
+    /// its size, N.
+    pub fn largest_front_difference_band(&self) -> (usize, f64) {
+        low_pass(&self.exact.force_front_n, self.dt_s)
+            .iter()
+            .zip(low_pass(&self.bancroft.force_front_n, self.dt_s))
+            .map(|(x, y)| (x - y).abs())
+            .enumerate()
+            .fold((0, 0.0f64), |b, (i, m)| if m > b.1 { (i, m) } else { b })
     }
 }
 

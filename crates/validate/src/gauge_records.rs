@@ -356,9 +356,7 @@ pub fn virtual_test(
         // An exponential shaper's pulse starts later than the scene's disc's: the run is longer
         // by as much (the scene's own default end time does the same).
         if let Some(s) = shaper {
-            let a = &apparatus;
-            let z = a.material.density_kg_m3 * a.material.wave_speed_m_s() * a.incident.area_m2();
-            options.end_time_s += s.onset_delay_s(options.striker_velocity_m_s, z);
+            options.end_time_s += apparatus.shaper_onset_delay_s(&s, options.striker_velocity_m_s);
         }
     }
     params.run().map_err(Error::from)

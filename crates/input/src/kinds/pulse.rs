@@ -382,9 +382,8 @@ pub(super) fn parse_bars(
     // A drive starts with the record's own lead before its incident wave's foot.
     let default_end = default_end + drive.as_ref().map_or(0.0, |d| d.foot_s);
     // An exponential shaper closes a while before its force rises (docs/physics.md §6.5.3).
-    let impedance_kg_s = apparatus.material.density_kg_m3 * c0 * apparatus.incident.area_m2();
     let default_end =
-        default_end + shaper.map_or(0.0, |s| s.onset_delay_s(velocity, impedance_kg_s));
+        default_end + shaper.map_or(0.0, |s| apparatus.shaper_onset_delay_s(&s, velocity));
     let end_time_s = match f.end_time_s {
         Some(e) => v.positive("end_time_s", e, 0.1, "s")?,
         None => default_end,

@@ -198,15 +198,7 @@ fn main() -> Result<()> {
     let (worst_front_label, worst_front_at_us, _) = rows
         .iter()
         .map(|r| {
-            let d: Vec<f64> = low_pass(&r.exact.force_front_n, r.dt_s)
-                .iter()
-                .zip(low_pass(&r.bancroft.force_front_n, r.dt_s))
-                .map(|(x, y)| (x - y).abs())
-                .collect();
-            let (i, m) = d
-                .iter()
-                .enumerate()
-                .fold((0, 0.0f64), |b, (i, &m)| if m > b.1 { (i, m) } else { b });
+            let (i, m) = r.largest_front_difference_band();
             (r.sample.label, i as f64 * r.dt_s * 1e6, m / r.front_noise_n)
         })
         .fold(("", 0.0, -1.0), |b, x| if x.2 > b.2 { x } else { b });

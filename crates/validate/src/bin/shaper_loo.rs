@@ -83,8 +83,7 @@ fn simulate(a: &Apparatus, v: f64, shaper: PulseShaper) -> Option<(PulseMetrics,
     let c0 = a.material.wave_speed_m_s();
     let ch = a.gauges.channel("incident")?;
     // An exponential shaper's pulse starts later than a disc's: its runs are longer by as much.
-    let z = a.material.density_kg_m3 * c0 * a.incident.area_m2();
-    let slack = shaper.onset_delay_s(v, z);
+    let slack = a.shaper_onset_delay_s(&shaper, v);
     let end = (a.incident.length_m - ch.distance_from_specimen_m) / c0
         + INCIDENT_WINDOW_S.1
         + 20e-6
@@ -916,17 +915,19 @@ fn rise_and_plateau(
     folds: &[Vec<Fold>],
 ) -> String {
     let mut t = String::from(
-        "### The rise and the plateau
-
-The two held-out errors that separate the models: the rise at \
+        "### The rise and the plateau\n\nThe two held-out errors that separate the models: the rise at \
          10 psi, where a pulse's time scale must follow the striker's speed beyond the fitted ones, \
          and the peak at 15 psi, where the records hold a plateau.\n\n\
          | model | fitted shaper constants | rise 10–90 %, 10 psi held out | peak, 15 psi held out |\n\
          |---|---|---|---|\n",
     );
+    let mut exponential_peak = (f64::NAN, f64::NAN);
     for (m, f) in models.iter().zip(folds) {
         let (r0, r1) = held_out_range(f, 0, 1);
         let (p0, p1) = held_out_range(f, 2, 0);
+        if m.fam == Family::Exponential {
+            exponential_peak = (100.0 * p0, 100.0 * p1);
+        }
         let _ = writeln!(
             t,
             "| {} | {} | {:+.1} to {:+.1} % | {:+.1} to {:+.1} % |",
@@ -953,12 +954,13 @@ The two held-out errors that separate the models: the rise at \
          nearly linear at the pulse's foot, and the 10 psi rise is lost again (−16 to −23 %, a \
          scratch fit). F0 itself, stated, matters little while it is small: {f0_line} What the \
          exponential law does not have is the records' plateau: an \
-         elastic element gives a rounded top, and its peak at 15 psi comes out 9–11 % high, as \
-         frew's does. A law that has both (an elastic exponential rise and a plastic limit \
+         elastic element gives a rounded top, and its peak at 15 psi comes out {:+.1} to {:+.1} % \
+         off, as frew's does. A law that has both (an elastic exponential rise and a plastic limit \
          reached near 15 psi) would need the limit's level from the records at 15 psi itself, \
          which the 10 and 12.5 psi records, below it, cannot give. Of these models only the crushed \
          disc with its face compliance free comes near the 15 psi peak, at the price of the 10 psi \
          rise.\n\n",
+        exponential_peak.0, exponential_peak.1
     );
     t
 }
