@@ -180,6 +180,17 @@ fn parse(
         .expect("time column has at least two samples");
     let end = match f.end_time_s {
         Some(e) => v.positive("end_time_s", e, 1.0, "s")?,
+        // The drive starts at t = 0: a record that ends there has nothing to run.
+        None if last <= 0.0 => {
+            return Err(Error::Input {
+                file: csv_path.display().to_string(),
+                key: f.time_column.clone(),
+                problem: format!("ends at {last:e} s, at or before the run's start t = 0"),
+                allowed: format!(
+                    "times reaching past 0 s (the drive starts at t = 0), or end_time_s in {file}"
+                ),
+            });
+        }
         None => last,
     };
     if end / dt > 5e8 {
@@ -349,6 +360,29 @@ mod tests {
         .to_string();
         assert!(
             e.starts_with("f.toml: `force_csv`: cannot read /nonexistent/validation/"),
+            "{e}"
+        );
+    }
+
+    /// A record whose times end at or before t = 0 (the drive's start) is refused naming the CSV
+    /// and its time column (found by `proptest_inputs::force_driven_csv_never_panics`: it gave a
+    /// run of end time 0).
+    #[test]
+    fn a_record_ending_before_the_start_is_refused() {
+        let dir = std::env::temp_dir().join(format!("shpb-force-end-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("f.csv");
+        std::fs::write(&csv, "a,time_s,force_N\n0e0,-638.2,1.0\n1e-6,0e0,1.0\n").unwrap();
+        let text = format!(
+            "kind = \"force-driven\"\nforce_csv = \"{}\"\nspecimen = {{ pair = \"ss440c\" }}\n",
+            csv.display()
+        );
+        let v = Validator::new("f.toml");
+        let e = parse(&text, "f.toml", &dir, Fidelity::Fast, &v)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("{}: `time_s`: ends at 0e0 s", csv.display())),
             "{e}"
         );
     }
