@@ -1084,11 +1084,11 @@ fn transmitted_figure(path: &Path, rows: &[Row], e_pa: f64) -> Result<()> {
                     v.push((label.to_string(), t, y, false));
                 }
             }
-            // On the 2 µs average, a point every 0.5 µs shows all there is (and keeps the PNG small).
+            // A point every 0.5 µs (plot_stride).
             v.into_iter()
                 .map(|(label, t, y, measured)| {
                     let (a, b) = window(&t);
-                    let every = ((0.5e-6 / (t[1] - t[0])).round() as usize).max(1);
+                    let every = plot_stride(&t);
                     let pick = |x: &[f64]| x[a..b].iter().step_by(every).copied().collect();
                     (label, pick(&t), pick(&y), measured)
                 })
@@ -1267,9 +1267,6 @@ const BALANCED_PNG: &str = "balanced_windows.png";
 /// Writes [`BALANCED_PNG`]: per record, the front and back forces through the stated windows and
 /// through the balanced ones (`--align balance`), and the virtual test's back force.
 fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
-    // A point every 0.5 µs of the 2 µs-smoothed forces shows all there is (and keeps the PNG
-    // small).
-    let pick = |x: &[f64]| -> Vec<f64> { x.iter().step_by(5).copied().collect() };
     let series: Vec<Vec<Trace>> = rows
         .iter()
         .map(|r| {
@@ -1289,6 +1286,8 @@ fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
                 } else {
                     &x.force_front_n
                 };
+                let every = plot_stride(&x.time_s);
+                let pick = |v: &[f64]| -> Vec<f64> { v.iter().step_by(every).copied().collect() };
                 (label.to_string(), pick(&x.time_s), pick(y), false)
             })
             .collect()
@@ -1301,6 +1300,12 @@ fn balanced_figure(path: &Path, rows: &[Row]) -> Result<()> {
         ("time at the faces (µs)", "force (kN)"),
         1e-3,
     )
+}
+
+/// Every how many samples of the series on times `t` a figure takes a point: one per 0.5 µs
+/// shows all there is on the 2 µs-smoothed traces (and keeps the PNGs small).
+fn plot_stride(t: &[f64]) -> usize {
+    ((0.5e-6 / (t[1] - t[0])).round() as usize).max(1)
 }
 
 /// Writes one panel per record (4 across, titled by sample, material and pressure) of its
