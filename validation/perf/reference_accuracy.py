@@ -3,6 +3,9 @@
 
 Runs the SS440c 10 psi test (scenes/shpb-ss440c-10psi.toml) on ladders of bar cells:
   * `pochhammer-chree` delay lines (today's `reference`: 1 mm) down to 1/64 mm,
+  * elementary delay lines (`none`, the bars of `standard`) down to 1/64 mm: the same joints on
+    bars whose transport is exact, so what remains at 1 mm is the joints' step
+    (validation/perf/REPORT.md, issue-20 table),
   * the `love-rod` finite-difference chain (the `reference` before it: 0.125 mm) down to 1/64 mm,
 each under the default `dynamic` unloading, and the `pochhammer-chree` ladder again under
 `dynamic-continuous`; then compares every run with the finest run of its ladder and every run with
@@ -30,6 +33,7 @@ ROOT = os.path.normpath(os.path.join(os.path.dirname(__file__), "..", ".."))
 LADDER_MM = [1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125, 0.015625]
 LADDERS = [
     ("pochhammer-chree", "dynamic", LADDER_MM),
+    ("none", "dynamic", LADDER_MM),
     ("love-rod", "dynamic", LADDER_MM[3:]),
     ("pochhammer-chree", "dynamic-continuous", LADDER_MM),
 ]
