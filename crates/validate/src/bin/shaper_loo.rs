@@ -25,7 +25,7 @@ mod nelder_mead;
 
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
-use shpb_core::gauge::{PulseMetrics, pulse_metrics};
+use shpb_core::gauge::{PulseMetrics, RawRecord, pulse_metrics};
 use shpb_core::numeric::min_max;
 use shpb_core::shaper::{CrushedDisc, ExponentialSpring, PulseShaper, ShaperModel};
 use shpb_input::prelude::*;
@@ -940,6 +940,7 @@ fn rise_and_plateau(
         );
     }
     let f0_line = exponential_onset_sensitivity(a, records, models, folds);
+    let clipping = unclipped_tops();
     let _ = write!(
         t,
         "\n**Reading (an inference from eight records).** The records' rise shortens with the \
@@ -959,10 +960,62 @@ fn rise_and_plateau(
          reached near 15 psi) would need the limit's level from the records at 15 psi itself, \
          which the 10 and 12.5 psi records, below it, cannot give. Of these models only the crushed \
          disc with its face compliance free comes near the 15 psi peak, at the price of the 10 psi \
-         rise.\n\n",
+         rise. {clipping}\n\n",
         exponential_peak.0, exponential_peak.1
     );
     t
+}
+
+/// Whether the 15 psi records' incident tops could be a limit of the signal chain rather than of
+/// the pulse: each record's extreme compressive incident voltage, how many samples lie within one
+/// digitiser count of it, and the record's largest magnitude on that channel (a sentence).
+fn unclipped_tops() -> String {
+    let root = common::repo_root();
+    let mut rows = Vec::new();
+    for s in SAMPLES.iter().filter(|s| s.psi == 15.0) {
+        let r = RawRecord::read(&s.record_path(&root)).expect("record");
+        let v = &r.incident_v;
+        let (lo, _) = min_max(v.iter().copied());
+        let mut levels: Vec<f64> = v.clone();
+        levels.sort_by(f64::total_cmp);
+        levels.dedup();
+        let count = levels
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min);
+        let at_top = v.iter().filter(|&&x| x <= lo + 0.5 * count).count();
+        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        rows.push((s.number, lo, at_top, largest, count));
+    }
+    let list = |f: &dyn Fn(&(usize, f64, usize, f64, f64)) -> String| {
+        rows.iter().map(f).collect::<Vec<_>>().join(", ")
+    };
+    let top = rows.iter().fold(0.0f64, |m, r| m.max(-r.1));
+    let beyond = rows
+        .iter()
+        .filter(|r| r.3 > top)
+        .map(|r| {
+            format!(
+                "sample {}'s channel reaches {:.2} mV elsewhere in its record",
+                r.0,
+                1e3 * r.3
+            )
+        })
+        .collect::<Vec<_>>();
+    let beyond = if beyond.is_empty() {
+        String::new()
+    } else {
+        format!(", and {}, above every 15 psi top", beyond.join(" and "))
+    };
+    format!(
+        "Nor is the records' 15 psi top a limit of their signal chain: on samples {} the incident \
+         channel reaches its compressive extreme ({} mV) in {} sample(s) each (the digitiser's \
+         count is {:.3} mV), not in the flat run a clipped channel would show{beyond}.",
+        list(&|r| r.0.to_string()),
+        list(&|r| format!("{:.2}", 1e3 * r.1).replace('-', "−")),
+        list(&|r| r.2.to_string()),
+        1e3 * rows.first().map_or(f64::NAN, |r| r.4),
+    )
 }
 
 /// How far the exponential family's held-out errors move when its stated F0 is replaced by
