@@ -970,6 +970,14 @@ fn rise_and_plateau(
 /// the pulse: each record's extreme compressive incident voltage, how many samples lie within one
 /// digitiser count of it, and the record's largest magnitude on that channel (a sentence).
 fn unclipped_tops() -> String {
+    /// One record's top: sample, extreme voltage (V), samples at it, largest |V|, digitiser count (V).
+    struct Top {
+        sample: usize,
+        extreme_v: f64,
+        at_extreme: usize,
+        largest_v: f64,
+        count_v: f64,
+    }
     let root = common::repo_root();
     let mut rows = Vec::new();
     for s in SAMPLES.iter().filter(|s| s.psi == 15.0) {
@@ -985,15 +993,19 @@ fn unclipped_tops() -> String {
             .fold(f64::INFINITY, f64::min);
         let at_top = v.iter().filter(|&&x| x <= lo + 0.5 * count).count();
         let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        rows.push((s.number, lo, at_top, largest, count));
+        rows.push(Top {
+            sample: s.number,
+            extreme_v: lo,
+            at_extreme: at_top,
+            largest_v: largest,
+            count_v: count,
+        });
     }
-    let list = |f: &dyn Fn(&(usize, f64, usize, f64, f64)) -> String| {
-        rows.iter().map(f).collect::<Vec<_>>().join(", ")
-    };
-    let top = rows.iter().fold(0.0f64, |m, r| m.max(-r.1));
+    let list = |f: &dyn Fn(&Top) -> String| rows.iter().map(f).collect::<Vec<_>>().join(", ");
+    let top = rows.iter().fold(0.0f64, |m, r| m.max(-r.extreme_v));
     let beyond = rows
         .iter()
-        .filter(|r| r.3 > top)
+        .filter(|r| r.largest_v > top)
         .map(|r| {
             format!(
                 "sample {}'s channel reaches {:.2} mV elsewhere in its record",
@@ -1011,10 +1023,10 @@ fn unclipped_tops() -> String {
         "Nor is the records' 15 psi top a limit of their signal chain: on samples {} the incident \
          channel reaches its compressive extreme ({} mV) in {} sample(s) each (the digitiser's \
          count is {:.3} mV), not in the flat run a clipped channel would show{beyond}.",
-        list(&|r| r.0.to_string()),
-        list(&|r| format!("{:.2}", 1e3 * r.1).replace('-', "−")),
-        list(&|r| r.2.to_string()),
-        1e3 * rows.first().map_or(f64::NAN, |r| r.4),
+        list(&|r| r.sample.to_string()),
+        list(&|r| format!("{:.2}", 1e3 * r.extreme_v).replace('-', "−")),
+        list(&|r| r.at_extreme.to_string()),
+        1e3 * rows.first().map_or(f64::NAN, |r| r.count_v),
     )
 }
 
