@@ -1009,8 +1009,8 @@ fn unclipped_tops() -> String {
         .map(|r| {
             format!(
                 "sample {}'s channel reaches {:.2} mV elsewhere in its record",
-                r.0,
-                1e3 * r.3
+                r.sample,
+                1e3 * r.largest_v
             )
         })
         .collect::<Vec<_>>();
