@@ -7,8 +7,9 @@ Runs the SS440c 10 psi test (scenes/shpb-ss440c-10psi.toml) on ladders of bar ce
     bars whose transport is exact, so what remains at 1 mm is the joints' step
     (validation/perf/REPORT.md, issue-20 table),
   * the `love-rod` finite-difference chain (the `reference` before it: 0.125 mm) down to 1/64 mm,
-each under the default `dynamic` unloading, and the `pochhammer-chree` ladder again under
-`dynamic-continuous`; then compares every run with the finest run of its ladder and every run with
+each under the default `dynamic` unloading, and the `pochhammer-chree` and `love-rod` ladders again
+under `dynamic-continuous` (where the signals converge: like against like for the old and the new
+`reference`); then compares every run with the finest run of its ladder and every run with
 the next finer one (docs/physics.md §3, "A continuous turn"; validation/perf/REPORT.md).
 
 Metrics, each relative: peak contact force and the approach at it (parabola through the three
@@ -17,7 +18,7 @@ incident-gauge strain and the contact force over the run, each over its series' 
 (signals interpolated linearly onto the finer run's samples).
 
 Usage: reference_accuracy.py [--shpb target/release/shpb] [--out validation/perf/reference-accuracy.txt]
-Needs numpy and h5py; about 5 minutes on two cores (the 1/64 mm Love-rod chain takes most of it).
+Needs numpy and h5py; about 10 minutes on two cores (the 1/64 mm Love-rod chain takes most of it).
 """
 
 import argparse
@@ -36,6 +37,7 @@ LADDERS = [
     ("none", "dynamic", LADDER_MM),
     ("love-rod", "dynamic", LADDER_MM[3:]),
     ("pochhammer-chree", "dynamic-continuous", LADDER_MM),
+    ("love-rod", "dynamic-continuous", LADDER_MM[3:]),
 ]
 
 
