@@ -980,10 +980,10 @@ fn unclipped_tops() -> String {
     }
     let root = common::repo_root();
     let mut rows = Vec::new();
-    for s in SAMPLES.iter().filter(|s| s.psi == 15.0) {
+    for s in SAMPLES.iter().filter(|s| s.psi == PRESSURES_PSI[2]) {
         let r = RawRecord::read(&s.record_path(&root)).expect("record");
         let v = &r.incident_v;
-        let (lo, _) = min_max(v.iter().copied());
+        let (lo, hi) = min_max(v.iter().copied());
         let mut levels: Vec<f64> = v.clone();
         levels.sort_by(f64::total_cmp);
         levels.dedup();
@@ -992,12 +992,11 @@ fn unclipped_tops() -> String {
             .map(|w| w[1] - w[0])
             .fold(f64::INFINITY, f64::min);
         let at_top = v.iter().filter(|&&x| x <= lo + 0.5 * count).count();
-        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         rows.push(Top {
             sample: s.number,
             extreme_v: lo,
             at_extreme: at_top,
-            largest_v: largest,
+            largest_v: hi.max(-lo),
             count_v: count,
         });
     }
