@@ -122,11 +122,7 @@ impl Apparatus {
     /// `striker_velocity_m_s`, s: [`PulseShaper::onset_delay_s`] against the incident bar's
     /// impedance (docs/physics.md §6.5.3); a run's default end time adds it.
     pub fn shaper_onset_delay_s(&self, shaper: &PulseShaper, striker_velocity_m_s: f64) -> f64 {
-        let incident = Segment {
-            length_m: self.incident.length_m,
-            diameter_m: self.incident.diameter_m,
-            material: self.material,
-        };
+        let incident = self.bar_segment(self.incident);
         shaper.onset_delay_s(striker_velocity_m_s, incident.impedance_kg_s())
     }
 
@@ -135,6 +131,15 @@ impl Apparatus {
     pub fn striker_velocity_m_s(&self, p_pa: f64) -> Result<f64> {
         self.gun
             .striker_velocity_m_s(p_pa, self.striker_mass_kg(), self.striker.area_m2())
+    }
+
+    /// A bar of this set-up as one uniform segment of its material.
+    pub fn bar_segment(&self, g: BarGeometry) -> Segment {
+        Segment {
+            length_m: g.length_m,
+            diameter_m: g.diameter_m,
+            material: self.material,
+        }
     }
 
     /// A uniform bar spec of this set-up's material.
@@ -148,11 +153,7 @@ impl Apparatus {
     ) -> BarSpec {
         BarSpec {
             name: name.to_string(),
-            segments: vec![Segment {
-                length_m: g.length_m,
-                diameter_m: g.diameter_m,
-                material: self.material,
-            }],
+            segments: vec![self.bar_segment(g)],
             left_end: left,
             right_end: right,
             dispersion,
