@@ -95,6 +95,9 @@ pub struct CrushedDisc {
     pub face_modulus_pa: f64,
     /// Multiplier of the Boussinesq face compliance (1: two ideal flat punches).
     pub face_compliance_factor: f64,
+    /// An exponential cushion in series (the disc's seating on the faces, §6.5.4): its closure
+    /// λ ln(1 + F/F0) adds to the disc's at every force (None: none).
+    pub cushion: Option<ExponentialSpring>,
 }
 
 /// Pulse shaper: a copper disc of initial diameter d0 and thickness h0 and its force law.
@@ -148,7 +151,15 @@ impl CrushedDisc {
             friction: 0.0,
             face_modulus_pa: face_youngs_modulus_pa / (1.0 - face_poisson_ratio.powi(2)),
             face_compliance_factor: 1.0,
+            cushion: None,
         }
+    }
+}
+
+impl ExponentialSpring {
+    /// Closure at force `force_n`, m: λ ln(1 + F/F0) (the inverse of [`Self::force_n`]).
+    pub fn closure_m(&self, force_n: f64) -> f64 {
+        self.stiffening_length_m * (force_n.max(0.0) / self.onset_force_n).ln_1p()
     }
 }
 
@@ -192,11 +203,17 @@ impl PulseShaper {
     /// How much later than a disc this shaper's pulse may start, s: for the exponential law the
     /// time λ ln(1 + Z v/(2 F0))/v to close, at the striker's speed v, up to the force Z v/2 an
     /// unshaped striker gives the bar (impedance `impedance_kg_s`), which no shaped pulse
-    /// exceeds; 0 for the disc laws, whose force rises from the first contact. A run's default
-    /// end time adds it (docs/physics.md §6.5.3).
+    /// exceeds, and the same for a crushed disc's exponential cushion; 0 for the bare disc laws,
+    /// whose force rises from the first contact. A run's default end time adds it
+    /// (docs/physics.md §6.5.3).
     pub fn onset_delay_s(&self, striker_velocity_m_s: f64, impedance_kg_s: f64) -> f64 {
-        match self.model {
-            ShaperModel::Exponential(e) if striker_velocity_m_s > 0.0 => {
+        let spring = match self.model {
+            ShaperModel::Exponential(e) => Some(e),
+            ShaperModel::CrushedDisc(d) => d.cushion,
+            ShaperModel::Frew => None,
+        };
+        match spring {
+            Some(e) if striker_velocity_m_s > 0.0 => {
                 e.stiffening_length_m
                     * (impedance_kg_s * striker_velocity_m_s / (2.0 * e.onset_force_n)).ln_1p()
                     / striker_velocity_m_s
@@ -305,6 +322,9 @@ impl PulseShaper {
         closure_m: f64,
         dt_s: f64,
     ) -> f64 {
+        if let Some(cushion) = d.cushion {
+            return self.cushioned_force_n(d, &cushion, state, closure_m, dt_s);
+        }
         let p0 = state.plastic_closure_m;
         let spring = |p: f64| self.crushed_elastic_stiffness_n_per_m(d, p) * (closure_m - p);
         let elastic = spring(p0);
@@ -337,6 +357,60 @@ impl PulseShaper {
         spring(p)
     }
 
+    /// Crushed disc with an exponential cushion in series (§6.5.4): the closure c splits into the
+    /// plastic thinning p, the elastic disc and faces F/k_el(p) and the cushion λ ln(1 + F/F0).
+    /// Elastic while the force that closure gives stays below the flow force; else p solves
+    /// p + F/k_el(p) + λ ln(1 + F/F0) = c with F the flow force at rate (p − p⁰)/Δt.
+    fn cushioned_force_n(
+        &self,
+        d: &CrushedDisc,
+        cushion: &ExponentialSpring,
+        state: &mut ShaperState,
+        closure_m: f64,
+        dt_s: f64,
+    ) -> f64 {
+        let p0 = state.plastic_closure_m;
+        let tol = |lo: f64, hi: f64| hi - lo <= 1e-15 * self.thickness_m;
+        // Closure taken by the elastic parts at force F with the disc thinned by p.
+        let elastic_closure = |p: f64, f: f64| {
+            f / self.crushed_elastic_stiffness_n_per_m(d, p) + cushion.closure_m(f)
+        };
+        let available = closure_m - p0;
+        if available <= 0.0 {
+            return 0.0;
+        }
+        let flow0 = self.crushed_flow_force_n(d, p0, 0.0);
+        if available <= elastic_closure(p0, flow0) {
+            // Elastic: F in [0, flow0] with elastic_closure(p0, F) = c − p0 (g falls with F).
+            let g = |f: f64| available - elastic_closure(p0, f);
+            let tol_f = |lo: f64, hi: f64| hi - lo <= 1e-13 * flow0;
+            let (a, b) = crate::numeric::illinois(0.0, flow0, available, g(flow0), 200, tol_f, g);
+            return 0.5 * (a + b);
+        }
+        let p_max = closure_m.min((1.0 - MIN_THICKNESS_RATIO) * self.thickness_m);
+        // Plastic: h(p) = c − p − elastic_closure(p, flow(p)) falls from > 0 at p0.
+        let h = |p: f64| {
+            let f = self.crushed_flow_force_n(d, p, (p - p0) / dt_s);
+            closure_m - p - elastic_closure(p, f)
+        };
+        let (ha, hb) = (h(p0), h(p_max));
+        if hb >= 0.0 {
+            // The thinnest disc: what closure remains is elastic.
+            state.plastic_closure_m = p_max;
+            let rest = closure_m - p_max;
+            let g = |f: f64| rest - elastic_closure(p_max, f);
+            let k = self.crushed_elastic_stiffness_n_per_m(d, p_max);
+            let top = k * rest;
+            let tol_f = |lo: f64, hi: f64| hi - lo <= 1e-13 * top;
+            let (a, b) = crate::numeric::illinois(0.0, top, rest, g(top), 200, tol_f, g);
+            return 0.5 * (a + b);
+        }
+        let (a, b) = crate::numeric::illinois(p0, p_max, ha, hb, 200, tol, h);
+        let p = 0.5 * (a + b);
+        state.plastic_closure_m = p;
+        self.crushed_flow_force_n(d, p, (p - p0) / dt_s)
+    }
+
     /// Stiffness bound dF/dclosure used for the explicit stability limit, N/m: E A/(h0 (1−ε)²)
     /// (Frew), the series elastic stiffness at strain ε (crushed disc), or for the exponential
     /// law, which has no thickness, (F + F0)/λ at the closure ε λ.
@@ -359,6 +433,7 @@ impl PulseShaper {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use approx::assert_relative_eq;
 
     /// A 4 mm × 0.5 mm copper disc (E 117 GPa) between maraging-steel bars (192 GPa, ν 0.31).
     fn disc(friction: f64) -> (PulseShaper, CrushedDisc) {
@@ -496,5 +571,90 @@ mod tests {
         assert!(st.work_j.abs() < 1e-9 * exact, "{}", st.work_j);
         // Stiffness (F + F0)/λ.
         assert!((e.stiffness_n_per_m(3e-4) - (e.force_n(3e-4) + 100.0) / 1e-4).abs() < 1e-6);
+    }
+
+    /// The 4 mm × 0.5 mm disc of [`disc`] seated through a cushion of length `lambda_m`, F0 10 N.
+    fn cushioned(lambda_m: f64) -> (PulseShaper, CrushedDisc) {
+        let (mut sh, mut d) = disc(0.0);
+        d.cushion = Some(ExponentialSpring {
+            stiffening_length_m: lambda_m,
+            onset_force_n: 10.0,
+        });
+        sh.model = ShaperModel::CrushedDisc(d);
+        (sh, d)
+    }
+
+    #[test]
+    fn a_cushioned_disc_splits_its_closure_between_cushion_disc_faces_and_flow() {
+        // Loading at 7 m/s in 0.2 µs steps: at every step the closure is the plastic thinning,
+        // the elastic disc and faces F/k_el and the cushion λ ln(1 + F/F0) (to the solver's
+        // tolerance); the force stays at or below the flow force, and equals it once flowing.
+        let (sh, d) = cushioned(60e-6);
+        let cushion = d.cushion.unwrap();
+        let dt = 0.2e-6;
+        let mut st = ShaperState::default();
+        let (mut flowed, mut last_f) = (false, 0.0);
+        for k in 1..600 {
+            let c = 7.0 * dt * k as f64;
+            let p_before = st.plastic_closure_m;
+            let f = sh.force_n(&mut st, c, dt);
+            let p = st.plastic_closure_m;
+            let parts = p + f / sh.crushed_elastic_stiffness_n_per_m(&d, p) + cushion.closure_m(f);
+            assert_relative_eq!(parts, c, max_relative = 1e-9);
+            let flow = sh.crushed_flow_force_n(&d, p, (p - p_before) / dt);
+            if p > p_before {
+                flowed = true;
+                assert_relative_eq!(f, flow, max_relative = 1e-9);
+            } else {
+                assert!(
+                    f <= flow * (1.0 + 1e-12),
+                    "step {k}: {f} above the flow force {flow}"
+                );
+            }
+            assert!(
+                f >= last_f,
+                "loading at constant speed never unloads (step {k})"
+            );
+            last_f = f;
+        }
+        assert!(flowed, "the disc reaches its flow force within the run");
+        // Below the flow force the disc is elastic and its first stretch is the cushion's:
+        // at a closure of λ the force is F0 (e − 1) less what the stiff disc and faces take.
+        let mut fresh = ShaperState::default();
+        let f = sh.force_n(&mut fresh, 60e-6, dt);
+        assert!(f < 10.0 * (1f64.exp() - 1.0) && f > 0.99 * 10.0 * (1f64.exp() - 1.0));
+    }
+
+    #[test]
+    fn a_vanishing_cushion_gives_the_bare_disc_back() {
+        // λ = 1e-12 m: the cushion takes under 1e-10 m of closure at every force here, so the
+        // force along the same loading and unloading path is the bare disc's to that closure
+        // times the disc's stiffness (≈ 1e-10 m × 1e9 N/m = 0.1 N against kN forces).
+        let ((bare, _), (cush, _)) = (disc(0.0), cushioned(1e-12));
+        let (mut sb, mut sc) = (ShaperState::default(), ShaperState::default());
+        let dt = 0.2e-6;
+        for k in 1..500 {
+            let c = if k < 300 {
+                6.0
+            } else {
+                6.0 * (600 - k) as f64 / 300.0
+            } * dt
+                * k as f64;
+            let (fb, fc) = (bare.force_n(&mut sb, c, dt), cush.force_n(&mut sc, c, dt));
+            assert!(
+                (fb - fc).abs() <= 1e-4 * fb.abs().max(1e3),
+                "step {k}: {fb} vs {fc}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_cushioned_disc_starts_late_like_its_cushion() {
+        let (sh, d) = cushioned(60e-6);
+        let alone = PulseShaper::exponential(d.cushion.unwrap());
+        let (v, z) = (7.0, 1.0e4);
+        assert!(sh.onset_delay_s(v, z) > 0.0);
+        assert_eq!(sh.onset_delay_s(v, z), alone.onset_delay_s(v, z));
+        assert_eq!(disc(0.0).0.onset_delay_s(v, z), 0.0);
     }
 }

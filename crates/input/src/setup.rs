@@ -143,6 +143,23 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
             )
         })
     };
+    // The exponential law's two constants (also a crushed disc's cushion).
+    let spring = || -> Result<ExponentialSpring> {
+        Ok(ExponentialSpring {
+            stiffening_length_m: v.positive(
+                "stiffening_length_m",
+                need("stiffening_length_m", s.stiffening_length_m)?,
+                0.01,
+                "m",
+            )?,
+            onset_force_n: v.positive(
+                "onset_force_n",
+                need("onset_force_n", s.onset_force_n)?,
+                1e6,
+                "N",
+            )?,
+        })
+    };
     let model = match model_name {
         "frew" => ShaperModel::Frew,
         "crushed-disc" => {
@@ -162,6 +179,11 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
                 },
                 friction: v.in_range("friction", s.friction.unwrap_or(0.0), 0.0, 1.0, "")?,
                 face_modulus_pa,
+                cushion: if s.stiffening_length_m.is_some() || s.onset_force_n.is_some() {
+                    Some(spring()?)
+                } else {
+                    None
+                },
                 face_compliance_factor: v.in_range(
                     "face_compliance_factor",
                     s.face_compliance_factor.unwrap_or(1.0),
@@ -171,20 +193,7 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
                 )?,
             })
         }
-        "exponential" => ShaperModel::Exponential(ExponentialSpring {
-            stiffening_length_m: v.positive(
-                "stiffening_length_m",
-                need("stiffening_length_m", s.stiffening_length_m)?,
-                0.01,
-                "m",
-            )?,
-            onset_force_n: v.positive(
-                "onset_force_n",
-                need("onset_force_n", s.onset_force_n)?,
-                1e6,
-                "N",
-            )?,
-        }),
+        "exponential" => ShaperModel::Exponential(spring()?),
         other => {
             return Err(v.error(
                 "model",
@@ -229,11 +238,12 @@ fn shaper_from(s: &ShaperToml, face_modulus_pa: f64, v: &Validator) -> Result<Pu
         ("stiffening_length_m", s.stiffening_length_m),
         ("onset_force_n", s.onset_force_n),
     ] {
-        if given.is_some() {
+        // The crushed disc takes them as its cushion.
+        if given.is_some() && model_name != "crushed-disc" {
             return Err(v.error(
                 key,
                 format!("not a constant of model = \"{model_name}\""),
-                "model = \"exponential\"",
+                "model = \"exponential\" or \"crushed-disc\"",
             ));
         }
     }
@@ -530,9 +540,9 @@ pub struct ShaperOverride {
     pub friction: Option<f64>,
     /// Multiplier of the Boussinesq face compliance (crushed-disc).
     pub face_compliance_factor: Option<f64>,
-    /// Stiffening length λ, m (exponential).
+    /// Stiffening length λ, m (exponential; crushed-disc: its cushion).
     pub stiffening_length_m: Option<f64>,
-    /// Onset force F0, N (exponential).
+    /// Onset force F0, N (exponential; crushed-disc: its cushion).
     pub onset_force_n: Option<f64>,
 }
 
@@ -596,10 +606,11 @@ impl ShaperOverride {
         let disc_keys = model != "exponential";
         // The base's constants carry over only to a model that has them.
         let opt = |x: f64| (disc_keys && x.is_finite()).then_some(x);
-        let (disc, spring) = if disc_keys {
-            (disc, None)
-        } else {
-            (None, spring)
+        let (disc, spring) = match model.as_str() {
+            "exponential" => (None, spring),
+            // A crushed disc's cushion carries over to a crushed disc.
+            "crushed-disc" => (disc, disc.and_then(|d| d.cushion)),
+            _ => (disc, None),
         };
         let s = ShaperToml {
             diameter_m: self.diameter_m.or(opt(b.diameter_m)),
@@ -873,5 +884,58 @@ mod tests {
         };
         let e = back.apply(Some(x), 1e11, &v).unwrap_err().to_string();
         assert!(e.contains("`diameter_m`: missing"), "{e}");
+    }
+
+    #[test]
+    fn a_crushed_disc_takes_an_exponential_cushion_from_both_its_keys() {
+        let read = with_shaper;
+        let disc = "[shaper]\nmodel = \"crushed-disc\"\ndiameter_m = 6e-3\nthickness_m = 3e-4\n\
+                    youngs_modulus_pa = 117e9\n";
+        let bare = read(disc).unwrap().shaper.unwrap();
+        let ShaperModel::CrushedDisc(d) = bare.model else {
+            panic!("{:?}", bare.model)
+        };
+        assert_eq!(d.cushion, None);
+        let a = read(&format!(
+            "{disc}stiffening_length_m = 6e-5\nonset_force_n = 10\n"
+        ))
+        .unwrap();
+        let s = a.shaper.unwrap();
+        let ShaperModel::CrushedDisc(c) = s.model else {
+            panic!("{:?}", s.model)
+        };
+        let spring = ExponentialSpring {
+            stiffening_length_m: 6e-5,
+            onset_force_n: 10.0,
+        };
+        assert_eq!(c.cushion, Some(spring));
+        // One of the two is not a cushion.
+        let e = read(&format!("{disc}stiffening_length_m = 6e-5\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`shaper.onset_force_n`: missing"), "{e}");
+        // A scene's override of λ keeps the disc and its F0; switching to frew keeps the disc's
+        // geometry and drops the cushion.
+        let v = Validator::new("scene.toml");
+        let longer = ShaperOverride {
+            stiffening_length_m: Some(9e-5),
+            ..Default::default()
+        };
+        let y = longer.apply(Some(s), 1e11, &v).unwrap().unwrap();
+        let ShaperModel::CrushedDisc(yd) = y.model else {
+            panic!("{:?}", y.model)
+        };
+        assert_eq!(
+            yd.cushion.map(|e| (e.stiffening_length_m, e.onset_force_n)),
+            Some((9e-5, 10.0))
+        );
+        assert_eq!((y.diameter_m, y.thickness_m), (6e-3, 3e-4));
+        let to_frew = ShaperOverride {
+            model: Some("frew".into()),
+            ..Default::default()
+        };
+        let f = to_frew.apply(Some(s), 1e11, &v).unwrap().unwrap();
+        assert_eq!(f.model, ShaperModel::Frew);
+        assert_eq!((f.diameter_m, f.thickness_m), (6e-3, 3e-4));
     }
 }

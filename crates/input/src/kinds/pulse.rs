@@ -62,7 +62,7 @@ pub(super) const SHAPER: Key = Key {
     key: "shaper",
     unit: "",
     default: "the set-up's shaper",
-    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), model (frew, crushed-disc, exponential), diameter_m, thickness_m, sigma0_pa, n, m (frew), youngs_modulus_pa, friction, face_compliance_factor (crushed-disc), stiffening_length_m, onset_force_n (exponential)",
+    meaning: "overrides of the set-up's copper pulse shaper: enabled (false: none), model (frew, crushed-disc, exponential), diameter_m, thickness_m, sigma0_pa, n, m (frew), youngs_modulus_pa, friction, face_compliance_factor (crushed-disc), stiffening_length_m, onset_force_n (exponential; with crushed-disc: its cushion)",
 };
 
 /// `cell_size_m` (pulse and shpb).

@@ -116,6 +116,9 @@ enum Family {
     CrushedDiscFriction,
     /// The elastic exponential law F0 (exp(c/λ) − 1): λ free, F0 = [`ONSET_FORCE_N`].
     Exponential,
+    /// Crushed Johnson–Cook disc with ideal faces, seated through an exponential cushion in
+    /// series: diameter, thickness and λ free, F0 = [`ONSET_FORCE_N`].
+    CushionedDisc,
 }
 
 /// Onset force F0 of the exponential family, N: the law is scale-free (its time scales ∝ 1/v)
@@ -130,6 +133,7 @@ impl Family {
             Family::CrushedDisc => "crushed-disc (face compliance free)",
             Family::CrushedDiscFriction => "crushed-disc (friction free)",
             Family::Exponential => "exponential (λ free)",
+            Family::CushionedDisc => "crushed-disc + exponential cushion",
         }
     }
     /// The model's key in the fit cache.
@@ -139,6 +143,7 @@ impl Family {
             Family::CrushedDisc => "crushed-disc-face-compliance",
             Family::CrushedDiscFriction => "crushed-disc-friction",
             Family::Exponential => "exponential",
+            Family::CushionedDisc => "crushed-disc-cushion",
         }
     }
     /// Names of the free shaper parameters and their display scale and unit.
@@ -148,6 +153,7 @@ impl Family {
             Family::CrushedDisc => ("face_compliance_factor", 1.0, ""),
             Family::CrushedDiscFriction => ("friction", 1.0, ""),
             Family::Exponential => return vec![("stiffening_length_m", 1e6, "µm")],
+            Family::CushionedDisc => ("stiffening_length_m", 1e6, "µm"),
         };
         vec![("diameter_m", 1e3, "mm"), ("thickness_m", 1e3, "mm"), third]
     }
@@ -165,6 +171,16 @@ impl Family {
             Family::CrushedDisc => vec![3.0e-3, 0.6e-3, 5.0],
             Family::CrushedDiscFriction => vec![3.0e-3, 0.6e-3, 0.1],
             Family::Exponential => vec![100e-6],
+            Family::CushionedDisc => vec![3.0e-3, 0.6e-3, 60e-6],
+        }
+    }
+    /// Starting points of the fit: the cushioned disc's objective has several minima (two starts
+    /// land in different ones on some folds), so it is fitted from a second start as well and the
+    /// lower minimum kept.
+    fn starts(self) -> Vec<Vec<f64>> {
+        match self {
+            Family::CushionedDisc => vec![self.start(), vec![6.0e-3, 0.3e-3, 90e-6]],
+            _ => vec![self.start()],
         }
     }
     fn bounds(self) -> Vec<(f64, f64)> {
@@ -173,6 +189,7 @@ impl Family {
             Family::CrushedDisc => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (0.01, 1e3)],
             Family::CrushedDiscFriction => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (1e-3, 1.0)],
             Family::Exponential => vec![(10e-6, 1e-3)],
+            Family::CushionedDisc => vec![(1e-3, 19e-3), (0.1e-3, 8e-3), (1e-6, 1e-3)],
         }
     }
     fn shaper(self, a: &Apparatus, p: &[f64]) -> PulseShaper {
@@ -197,6 +214,17 @@ impl Family {
                 } else {
                     d.friction = p[2];
                 }
+                PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
+            }
+            Family::CushionedDisc => {
+                let mut d = CrushedDisc::ofhc_copper(
+                    a.material.youngs_modulus_pa,
+                    a.material.poisson_ratio,
+                );
+                d.cushion = Some(ExponentialSpring {
+                    stiffening_length_m: p[2],
+                    onset_force_n: ONSET_FORCE_N,
+                });
                 PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
             }
             Family::Exponential => PulseShaper::exponential(ExponentialSpring {
@@ -273,24 +301,31 @@ fn fit(a: &Apparatus, fam: Family, records: &[Record], train: &[usize], start_v:
             None => 1e9,
         }
     };
-    let mut x: Vec<f64> = vec![start_v[i].ln(), start_v[j].ln()];
-    x.extend(fam.start().iter().map(|y| y.ln()));
-    let mut best = f64::INFINITY;
-    for round in 0..4 {
-        let step = vec![if round == 0 { 0.2 } else { 0.05 }; x.len()];
-        let (xb, fb, n) = nelder_mead::nelder_mead(&mut f, &x, &step, EVALS_PER_ROUND, 1e-7);
-        eprintln!(
-            "{} train {:?}: round {round}, objective {fb:.4}, {n} evaluations",
-            fam.name(),
-            train
-        );
-        x = xb;
-        if best - fb < 1e-3 * best.max(1e-9) {
-            best = best.min(fb);
-            break;
+    let (mut x_best, mut best) = (Vec::new(), f64::INFINITY);
+    for start in fam.starts() {
+        let mut x: Vec<f64> = vec![start_v[i].ln(), start_v[j].ln()];
+        x.extend(start.iter().map(|y| y.ln()));
+        let mut reached = f64::INFINITY;
+        for round in 0..4 {
+            let step = vec![if round == 0 { 0.2 } else { 0.05 }; x.len()];
+            let (xb, fb, n) = nelder_mead::nelder_mead(&mut f, &x, &step, EVALS_PER_ROUND, 1e-7);
+            eprintln!(
+                "{} train {:?}: round {round}, objective {fb:.4}, {n} evaluations",
+                fam.name(),
+                train
+            );
+            x = xb;
+            if reached - fb < 1e-3 * reached.max(1e-9) {
+                reached = reached.min(fb);
+                break;
+            }
+            reached = fb;
         }
-        best = fb;
+        if reached < best {
+            (x_best, best) = (x, reached);
+        }
     }
+    let x = x_best;
     let (v, p) = unpack(&x).expect("the best point is inside the bounds");
     Fit {
         velocity_m_s: v,
@@ -318,11 +353,12 @@ struct ModelFits {
     all: Fit,
 }
 
-const FAMILIES: [Family; 4] = [
+const FAMILIES: [Family; 5] = [
     Family::Frew,
     Family::CrushedDisc,
     Family::CrushedDiscFriction,
     Family::Exponential,
+    Family::CushionedDisc,
 ];
 
 /// Fits `fam` on each pair of pressures and on all three.
@@ -508,6 +544,8 @@ fn main() {
         vec![Family::CrushedDisc]
     } else if args.iter().any(|s| s == "--exponential") {
         vec![Family::Exponential]
+    } else if args.iter().any(|s| s == "--cushion") {
+        vec![Family::CushionedDisc]
     } else {
         FAMILIES.to_vec()
     };
@@ -696,7 +734,10 @@ fn section(
          with either a multiplier of that face compliance or the Coulomb friction μ free beside diameter and \
          thickness; **exponential**, an elastic element F = F0 (exp(c/λ) − 1) of the closure c, unloading \
          along the same curve (docs/physics.md §6.5.3; an empirical law: a closure λ ln(F2/F1) passed at a \
-         closing speed that scales with the striker's gives rise times ∝ 1/v), λ free, F0 = {ONSET_FORCE_N} N.\n\n\
+         closing speed that scales with the striker's gives rise times ∝ 1/v), λ free, F0 = {ONSET_FORCE_N} N; \
+         **crushed-disc + exponential cushion**, the crushed disc with ideal faces seated through that \
+         exponential element in series (docs/physics.md §6.5.4), diameter, thickness and λ free, F0 as the \
+         exponential law's.\n\n\
          **Transmitted peak.** For every held-out record, the full virtual test of its specimen \
          (`validation/fig4-virtual-shpb/<material>-<psi>.toml`: the record's sphere pair, the Burgoyne–Daraio \
          contact law, the authors' bars) is run with the shaper and the striker velocity that the two-pressure fit \
@@ -922,11 +963,16 @@ fn rise_and_plateau(
          |---|---|---|---|\n",
     );
     let mut exponential_peak = (f64::NAN, f64::NAN);
+    let (mut cushion_rise, mut cushion_peak) = ((f64::NAN, f64::NAN), (f64::NAN, f64::NAN));
     for (m, f) in models.iter().zip(folds) {
         let (r0, r1) = held_out_range(f, 0, 1);
         let (p0, p1) = held_out_range(f, 2, 0);
         if m.fam == Family::Exponential {
             exponential_peak = (100.0 * p0, 100.0 * p1);
+        }
+        if m.fam == Family::CushionedDisc {
+            cushion_rise = (100.0 * r0, 100.0 * r1);
+            cushion_peak = (100.0 * p0, 100.0 * p1);
         }
         let _ = writeln!(
             t,
@@ -956,12 +1002,22 @@ fn rise_and_plateau(
          scratch fit). F0 itself, stated, matters little while it is small: {f0_line} What the \
          exponential law does not have is the records' plateau: an \
          elastic element gives a rounded top, and its peak at 15 psi comes out {:+.1} to {:+.1} % \
-         off, as frew's does. A law that has both (an elastic exponential rise and a plastic limit \
-         reached near 15 psi) would need the limit's level from the records at 15 psi itself, \
-         which the 10 and 12.5 psi records, below it, cannot give. Of these models only the crushed \
-         disc with its face compliance free comes near the 15 psi peak, at the price of the 10 psi \
-         rise. {clipping}\n\n",
-        exponential_peak.0, exponential_peak.1
+         off, as frew's does. A law that has both, the crushed disc seated through the exponential \
+         law as a cushion in series (*crushed-disc + exponential cushion*: the exponential rise, \
+         then Johnson–Cook flow of a disc that spreads; diameter, thickness and λ free, F0 as \
+         above; docs/physics.md §6.5.4), was fitted to test that (two starting points, the lower \
+         minimum kept): its 15 psi peak comes out {:+.1} to {:+.1} % off and its 10 psi rise \
+         {:+.1} to {:+.1} %, no better than the laws it combines. The reading we take from it (an \
+         inference): the 10 and 12.5 psi records, below the plateau, do not fix the level of a \
+         plastic limit, and once the disc flows its thinning sets a time scale of its own again. Of \
+         these models only the crushed disc with its face compliance free comes near the 15 psi \
+         peak, at the price of the 10 psi rise. {clipping}\n\n",
+        exponential_peak.0,
+        exponential_peak.1,
+        cushion_peak.0,
+        cushion_peak.1,
+        cushion_rise.0,
+        cushion_rise.1
     );
     t
 }
