@@ -55,30 +55,22 @@ def main():
         "each run against the 1/64 mm run of the same variant; columns: relative peak force, approach at",
         "peak, RMS of the transmission gauge, the incident gauge and the contact force (over their maxima)",
     ]
-    base_env = dict(os.environ)
     with tempfile.TemporaryDirectory() as work:
         for name, dispersion, env in VARIANTS:
-            os.environ.clear()
-            os.environ.update(base_env)
-            os.environ.update(env)
             for unloading in ["dynamic", "dynamic-continuous"]:
                 print(f"{name}, {unloading}", file=sys.stderr, flush=True)
                 sub = os.path.join(work, f"{len(lines)}")
                 os.makedirs(sub)
-                runs = {c: ra.run(args.shpb, sub, dispersion, unloading, c) for c in CELLS_MM}
+                runs = {
+                    c: ra.run(args.shpb, sub, dispersion, unloading, c, {**os.environ, **env})
+                    for c in CELLS_MM
+                }
                 lines.append("")
                 lines.append(f"{name} ({dispersion}), unloading = {unloading}")
-                lines.append("    cell_mm      peak     delta     trans       inc     force")
+                lines.append(ra.HEADER)
                 for c in CELLS_MM[:-1]:
-                    m = ra.compare(runs[c], runs[CELLS_MM[-1]])
-                    lines.append(f"  {c:9.6f} " + " ".join(f"{x:9.2e}" for x in m))
-    os.environ.clear()
-    os.environ.update(base_env)
-    text = "\n".join(lines) + "\n"
-    with open(args.out, "w") as f:
-        f.write(text)
-    sys.stdout.write(text)
-
+                    lines.append(ra.row(c, ra.compare(runs[c], runs[CELLS_MM[-1]])))
+    ra.write(args.out, lines)
 
 if __name__ == "__main__":
     main()

@@ -41,8 +41,8 @@ LADDERS = [
 ]
 
 
-def run(shpb, work, dispersion, unloading, cell_mm):
-    """Runs one rung; returns its series."""
+def run(shpb, work, dispersion, unloading, cell_mm, env=None):
+    """Runs one rung (with the environment `env`, default this process's); returns its series."""
     name = f"{dispersion}-{unloading}-{cell_mm}"
     scene = os.path.join(work, name + ".toml")
     out = os.path.join(work, name + ".h5")
@@ -52,7 +52,7 @@ def run(shpb, work, dispersion, unloading, cell_mm):
             f'law = "burgoyne-daraio"\nunloading = "{unloading}"\ndispersion = "{dispersion}"\n'
             f"cell_size_m = {cell_mm * 1e-3!r}\n[specimen]\npair = \"ss440c\"\n"
         )
-    subprocess.run([shpb, "run", scene, "-o", out, "--force", "-q"], check=True)
+    subprocess.run([shpb, "run", scene, "-o", out, "--force", "-q"], check=True, env=env)
     with h5py.File(out) as h:
         return {
             "t": h["time"][:],
@@ -96,6 +96,22 @@ def compare(a, b):
     )
 
 
+HEADER = "    cell_mm      peak     delta     trans       inc     force"
+
+
+def row(cell_mm, metrics):
+    """One line of a ladder's table: the cell and the metrics of `compare`."""
+    return f"  {cell_mm:9.6f} " + " ".join(f"{x:9.2e}" for x in metrics)
+
+
+def write(path, lines):
+    """Writes the report's lines to `path` and echoes them."""
+    text = "\n".join(lines) + "\n"
+    with open(path, "w") as f:
+        f.write(text)
+    sys.stdout.write(text)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--shpb", default=os.path.join(ROOT, "target", "release", "shpb"))
@@ -117,18 +133,13 @@ def main():
             lines.append("")
             lines.append(f"{dispersion}, unloading = {unloading}")
             lines.append(f"  against the finest run ({finest} mm):")
-            lines.append("    cell_mm      peak     delta     trans       inc     force")
+            lines.append(HEADER)
             for cell in ladder[:-1]:
-                m = compare(runs[cell], runs[finest])
-                lines.append(f"  {cell:9.6f} " + " ".join(f"{x:9.2e}" for x in m))
+                lines.append(row(cell, compare(runs[cell], runs[finest])))
             lines.append("  each run against the next finer one:")
             for a, b in zip(ladder[:-1], ladder[1:]):
-                m = compare(runs[a], runs[b])
-                lines.append(f"  {a:9.6f} " + " ".join(f"{x:9.2e}" for x in m))
-    text = "\n".join(lines) + "\n"
-    with open(args.out, "w") as f:
-        f.write(text)
-    sys.stdout.write(text)
+                lines.append(row(a, compare(runs[a], runs[b])))
+    write(args.out, lines)
 
 
 if __name__ == "__main__":
