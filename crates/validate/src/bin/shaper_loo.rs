@@ -10,11 +10,11 @@
 //! Run from the repository root: `cargo run --release -p shpb-validate --bin shaper_loo`.
 //! The fits are cached: a fitting run writes every fitted constant at full precision to
 //! `validation/pulse/shaper_loo_fits.toml`, and a run without `--refit` reads them from there and
-//! only evaluates (≈ 1 min on two cores instead of the fits' 20–30; it fits when the cache is
-//! missing or lacks a model). `-- --refit` fits again (≈ 5–20 min on two cores, depending on the load) and
-//! rewrites the cache; `-- --frew` / `-- --disc` restrict the run to one model (a refit of one
-//! model keeps the others' cached fits). `-- --probe d_mm h_mm factor mu v10 v12 v15` runs one
-//! crushed disc and prints its errors.
+//! only evaluates (it fits when the cache is missing or lacks a model). `-- --refit` fits again
+//! and rewrites the cache; `-- --frew` / `-- --disc` / `-- --exponential` / `-- --cushion`
+//! restrict the run to one model (a refit of one model keeps the others' cached fits).
+//! `-- --probe d_mm h_mm factor mu v10 v12 v15` runs one crushed disc and prints its errors.
+//! Times on two cores: the report's last line.
 
 #![warn(missing_docs)]
 
