@@ -585,6 +585,28 @@ fn set_up_files_read_inserts_with_the_bar_material_by_default() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Work the shaper holds at the end of a run (its last `/energy/shaper` value), J.
+fn shaper_work_j(o: &shpb::run::RunOutput) -> f64 {
+    *o.energy
+        .iter()
+        .find(|(n, _)| n == "shaper")
+        .unwrap()
+        .1
+        .last()
+        .unwrap()
+}
+
+/// The whole incident pulse lies inside the run: its gauge is back within 2 % of its peak at the end.
+fn assert_whole_pulse_in_run(o: &shpb::run::RunOutput) {
+    let g = &o.gauges[0];
+    let peak = g.strain.iter().cloned().fold(0.0, f64::min);
+    assert!(
+        g.strain.last().unwrap().abs() < 0.02 * peak.abs(),
+        "{:e} at the end against a peak of {peak:e}",
+        g.strain.last().unwrap()
+    );
+}
+
 /// The exponential shaper (docs/physics.md §6.5.3) in a `pulse` scene: elastic (the energy
 /// identity holds and the shaper keeps no work at the end), its default run long enough for the
 /// whole pulse, and scale-free while F0 ≪ the pulse's force: a tenfold smaller F0 only delays
@@ -604,30 +626,15 @@ fn the_exponential_shaper_is_elastic_and_its_onset_force_only_moves_the_foot() {
     let (a, b) = (p10.run().unwrap(), p1.run().unwrap());
     let get = |o: &shpb::run::RunOutput, k: &str| o.summary_value(k).unwrap();
     assert!(get(&a, "energy_balance_max_relative_error") < 1e-9);
-    let shaper_work = |o: &shpb::run::RunOutput| {
-        *o.energy
-            .iter()
-            .find(|(n, _)| n == "shaper")
-            .unwrap()
-            .1
-            .last()
-            .unwrap()
-    };
     // Elastic: whatever the shaper held is given back once striker and bar part, up to the
     // discrete work's second-order error in the closure step (a plastic disc keeps ≈ 10 %).
     assert!(
-        shaper_work(&a).abs() < 1e-5 * get(&a, "striker_energy"),
+        shaper_work_j(&a).abs() < 1e-5 * get(&a, "striker_energy"),
         "{}",
-        shaper_work(&a)
+        shaper_work_j(&a)
     );
-    // The whole pulse inside the default run: the incident gauge is back near zero at the end.
-    let g = &a.gauges[0];
-    let peak = g.strain.iter().cloned().fold(0.0, f64::min);
-    assert!(
-        g.strain.last().unwrap().abs() < 0.02 * peak.abs(),
-        "{:e} at the end against a peak of {peak:e}",
-        g.strain.last().unwrap()
-    );
+    // The whole pulse inside the default run.
+    assert_whole_pulse_in_run(&a);
     // Shape unchanged by F0 (to 0.5 %: the "−1" of F0 (e^{c/λ} − 1) is 1e-3 of the force at
     // the 10 % foot), foot later by ≈ λ ln 10 / v (the closing speed is v until the force rises).
     for k in [
@@ -670,27 +677,12 @@ fn a_cushioned_crushed_disc_dissipates_and_closes_the_energy_ledger() {
         .unwrap();
     let get = |o: &shpb::run::RunOutput, k: &str| o.summary_value(k).unwrap();
     assert!(get(&cushioned, "energy_balance_max_relative_error") < 1e-9);
-    let shaper_work = |o: &shpb::run::RunOutput| {
-        *o.energy
-            .iter()
-            .find(|(n, _)| n == "shaper")
-            .unwrap()
-            .1
-            .last()
-            .unwrap()
-    };
-    let kept = shaper_work(&cushioned) / get(&cushioned, "striker_energy");
+    let kept = shaper_work_j(&cushioned) / get(&cushioned, "striker_energy");
     assert!(
         kept > 0.01 && kept < 1.0,
         "the disc keeps {kept} of the striker's energy"
     );
-    let g = &cushioned.gauges[0];
-    let peak = g.strain.iter().cloned().fold(0.0, f64::min);
-    assert!(
-        g.strain.last().unwrap().abs() < 0.02 * peak.abs(),
-        "{:e} at the end against a peak of {peak:e}",
-        g.strain.last().unwrap()
-    );
+    assert_whole_pulse_in_run(&cushioned);
     // λ = 1 nm: the cushion takes under 1e-8 m of closure at the pulse's forces, against a
     // closure of ~0.3 mm; the pulse is the bare disc's to well within 1e-3.
     let (tiny, bare) = (
