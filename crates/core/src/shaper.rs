@@ -38,6 +38,11 @@ impl ExponentialSpring {
         }
     }
 
+    /// Closure at force `force_n`, m: λ ln(1 + F/F0) (the inverse of [`Self::force_n`]).
+    pub fn closure_m(&self, force_n: f64) -> f64 {
+        self.stiffening_length_m * (force_n.max(0.0) / self.onset_force_n).ln_1p()
+    }
+
     /// Stiffness dF/dc at closure `closure_m`, N/m: (F + F0)/λ.
     pub fn stiffness_n_per_m(&self, closure_m: f64) -> f64 {
         (self.force_n(closure_m) + self.onset_force_n) / self.stiffening_length_m
@@ -153,13 +158,6 @@ impl CrushedDisc {
             face_compliance_factor: 1.0,
             cushion: None,
         }
-    }
-}
-
-impl ExponentialSpring {
-    /// Closure at force `force_n`, m: λ ln(1 + F/F0) (the inverse of [`Self::force_n`]).
-    pub fn closure_m(&self, force_n: f64) -> f64 {
-        self.stiffening_length_m * (force_n.max(0.0) / self.onset_force_n).ln_1p()
     }
 }
 
@@ -370,10 +368,17 @@ impl PulseShaper {
         dt_s: f64,
     ) -> f64 {
         let p0 = state.plastic_closure_m;
-        let tol = |lo: f64, hi: f64| hi - lo <= 1e-15 * self.thickness_m;
         // Closure taken by the elastic parts at force F with the disc thinned by p.
         let elastic_closure = |p: f64, f: f64| {
             f / self.crushed_elastic_stiffness_n_per_m(d, p) + cushion.closure_m(f)
+        };
+        // The force in [0, top] at which the elastic parts of a disc thinned by p take `rest`
+        // (elastic_closure(p, top) ≥ rest; rest − elastic_closure falls with F).
+        let elastic_force = |p: f64, rest: f64, top: f64| {
+            let g = |f: f64| rest - elastic_closure(p, f);
+            let converged = |lo: f64, hi: f64| hi - lo <= 1e-13 * top;
+            let (a, b) = crate::numeric::illinois(0.0, top, rest, g(top), 200, converged, g);
+            0.5 * (a + b)
         };
         let available = closure_m - p0;
         if available <= 0.0 {
@@ -381,11 +386,8 @@ impl PulseShaper {
         }
         let flow0 = self.crushed_flow_force_n(d, p0, 0.0);
         if available <= elastic_closure(p0, flow0) {
-            // Elastic: F in [0, flow0] with elastic_closure(p0, F) = c − p0 (g falls with F).
-            let g = |f: f64| available - elastic_closure(p0, f);
-            let tol_f = |lo: f64, hi: f64| hi - lo <= 1e-13 * flow0;
-            let (a, b) = crate::numeric::illinois(0.0, flow0, available, g(flow0), 200, tol_f, g);
-            return 0.5 * (a + b);
+            // Elastic: below the flow force, at the thinning already reached.
+            return elastic_force(p0, available, flow0);
         }
         let p_max = closure_m.min((1.0 - MIN_THICKNESS_RATIO) * self.thickness_m);
         // Plastic: h(p) = c − p − elastic_closure(p, flow(p)) falls from > 0 at p0.
@@ -395,16 +397,17 @@ impl PulseShaper {
         };
         let (ha, hb) = (h(p0), h(p_max));
         if hb >= 0.0 {
-            // The thinnest disc: what closure remains is elastic.
+            // The thinnest disc: what closure remains is elastic (the linear parts alone would
+            // give k_el · rest, an upper bound).
             state.plastic_closure_m = p_max;
             let rest = closure_m - p_max;
-            let g = |f: f64| rest - elastic_closure(p_max, f);
-            let k = self.crushed_elastic_stiffness_n_per_m(d, p_max);
-            let top = k * rest;
-            let tol_f = |lo: f64, hi: f64| hi - lo <= 1e-13 * top;
-            let (a, b) = crate::numeric::illinois(0.0, top, rest, g(top), 200, tol_f, g);
-            return 0.5 * (a + b);
+            return elastic_force(
+                p_max,
+                rest,
+                self.crushed_elastic_stiffness_n_per_m(d, p_max) * rest,
+            );
         }
+        let tol = |lo: f64, hi: f64| hi - lo <= 1e-15 * self.thickness_m;
         let (a, b) = crate::numeric::illinois(p0, p_max, ha, hb, 200, tol, h);
         let p = 0.5 * (a + b);
         state.plastic_closure_m = p;

@@ -204,27 +204,21 @@ impl Family {
                 model: ShaperModel::Frew,
                 calibrated_pressure_pa: None,
             },
-            Family::CrushedDisc | Family::CrushedDiscFriction => {
+            Family::CrushedDisc | Family::CrushedDiscFriction | Family::CushionedDisc => {
                 let mut d = CrushedDisc::ofhc_copper(
                     a.material.youngs_modulus_pa,
                     a.material.poisson_ratio,
                 );
-                if self == Family::CrushedDisc {
-                    d.face_compliance_factor = p[2];
-                } else {
-                    d.friction = p[2];
+                match self {
+                    Family::CrushedDisc => d.face_compliance_factor = p[2],
+                    Family::CrushedDiscFriction => d.friction = p[2],
+                    _ => {
+                        d.cushion = Some(ExponentialSpring {
+                            stiffening_length_m: p[2],
+                            onset_force_n: ONSET_FORCE_N,
+                        })
+                    }
                 }
-                PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
-            }
-            Family::CushionedDisc => {
-                let mut d = CrushedDisc::ofhc_copper(
-                    a.material.youngs_modulus_pa,
-                    a.material.poisson_ratio,
-                );
-                d.cushion = Some(ExponentialSpring {
-                    stiffening_length_m: p[2],
-                    onset_force_n: ONSET_FORCE_N,
-                });
                 PulseShaper::crushed_disc(p[0], p[1], COPPER_MODULUS_PA, d)
             }
             Family::Exponential => PulseShaper::exponential(ExponentialSpring {
