@@ -3060,7 +3060,12 @@ fn seating_paragraph(w: &mut String, rows: &[Row], c0: f64, d_t_stated_m: f64, d
          §6.11): across a gap of {:.0} µm at the contact, or pressed by a static preload of \
          {:.0} N before the wave arrives. Residual − record at {} % of the transmitted peak, and \
          in brackets the spread of the four (largest − smallest): a spread near zero is a pulse \
-         of the record's shape, late or early by the residual.\n",
+         of the record's shape, late or early by the residual. The preloaded column is known \
+         to a few tenths of a µs only: the pair waits at rest, and where the wave arrives the \
+         rate-dependent law takes its static or its rate-hardened branch from approach rates of \
+         order 1e-10 m a step, so the force may hop by 5 % for a step and back (measured \
+         2026-11-25: a change of the contact solve that left every shipped scene within 5e-12 \
+         moved sample 1's preloaded crossings by up to 0.4 µs).\n",
         PROBE_GAP_M * 1e6,
         PROBE_PRELOAD_N,
         RISE_LEVELS
