@@ -1,7 +1,8 @@
 //! The `shpb` command line (clap derive): the subcommands' options, [`main`] and [`dispatch`];
 //! each subcommand is implemented in its own file of [`crate::cmd`]. Errors go to stderr with a
 //! non-zero exit code (2 bad input, 3 numerical instability, 4 a design search without a
-//! solution, 5 a design whose solutions violate a `--require`, 1 other failures).
+//! solution, 5 a design whose solutions violate a `--require`, 130/143 stopped by SIGINT/SIGTERM,
+//! 1 other failures).
 
 use crate::cmd;
 use clap::{Args, Parser, Subcommand, ValueEnum};

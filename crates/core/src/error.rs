@@ -1,5 +1,5 @@
-//! Typed errors of the physics core: a parameter outside the range where a model holds, or a run
-//! that became numerically unstable. They name the physical quantity, never a file or key: the
+//! Typed errors of the physics core: a parameter outside the range where a model holds, a run
+//! that became numerically unstable, or a run its progress callback cancelled. They name the physical quantity, never a file or key: the
 //! input layer (`shpb-input`) maps them to the file and key the user wrote.
 
 /// An error of the physics core.

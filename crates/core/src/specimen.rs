@@ -1,5 +1,6 @@
 //! The specimen: two (possibly dissimilar) spheres and their effective contact properties
-//! (paper Sec. II: E*, r; docs/physics.md §1).
+//! (paper Sec. II: E*, r; docs/physics.md §1), a chain of N spheres ([`SphereChain`], §8), and
+//! how they sit before the test ([`Seating`]: touching, a gap or a preload; §6.11).
 
 use crate::material::{JohnsonCook, Material};
 

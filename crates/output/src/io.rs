@@ -1,5 +1,6 @@
 //! Input and output: CSV tables in, HDF5 and CSV results out, written atomically
-//! (temporary name, then rename; never overwriting without `--force`).
+//! (temporary name, then a hard link that never replaces an existing file, or a rename with
+//! `--force`; [`crate::atomic`]).
 
 use shpb_core::run::{ChainSeries, RunOutput};
 use shpb_core::solver::ContactSeries;

@@ -2,10 +2,11 @@
 //!
 //! A thin binding of the library calls the `shpb` command line makes (`shpb_study::api`, the
 //! writers of `shpb-output`): no physics here. The pure-Python package `shpb`
-//! (`python/shpb/__init__.py`) wraps these functions into `Run` and `Table` objects with numpy
-//! arrays. Every error is a Python exception with the command line's message: exit-code-2 errors
-//! raise `InputError` (a `ValueError`), an unstable run `InstabilityError` (a `RuntimeError`),
-//! I/O and HDF5 failures `OSError`; a panic is caught and raised as `RuntimeError`.
+//! (`python/shpb/__init__.py`) wraps these functions into `Run`, `Table` and `Study` objects
+//! with numpy arrays. Every error is a Python exception with the command line's message:
+//! exit-code-2 errors raise `InputError` (a `ValueError`), an unstable run `InstabilityError` (a
+//! `RuntimeError`), I/O and HDF5 failures `OSError`; a panic is caught and raised as
+//! `RuntimeError`.
 
 use numpy::PyArray1;
 use pyo3::create_exception;

@@ -1,6 +1,8 @@
 //! What a chain run keeps: recorders sample the bodies and joints while it runs (gauges,
-//! energies, the sphere contact, x–t stress snapshots). A new output is a new [`Recorder`],
-//! not a new field in the solver.
+//! energies, the sphere contact, x–t stress snapshots, every sphere of a chain, the progress
+//! line). On dispersive delay-line bars the gauges and snapshots are evaluated after the run from
+//! the bars' whole histories through the transit filters (`finish`; docs/physics.md §6.2.1). A
+//! new output is a new [`Recorder`], not a new field in the solver.
 
 use super::body::Body;
 use super::joint::JointState;
