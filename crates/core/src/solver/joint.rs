@@ -229,10 +229,11 @@ impl JointPrediction {
 /// picks another at the peak of the ss440c test, 5 % off in force). Bisection first narrows the
 /// bracket to 2⁻¹² of the force, so Illinois runs where bisection would have gone on and finds
 /// its crossing unless two crossings lie that close (a preloaded pair's, 5 % apart where the
-/// wave arrives, were not isolated by a bracket 2⁻¹² of its first width). The several crossings are the default
-/// `dynamic` unloading's: its curve starts above the loading force once the rate has fallen, so
-/// turning early is self-consistent; under `dynamic-continuous` only the rate's zero turns
-/// (docs/physics.md §3, "A continuous turn").
+/// wave arrives, were not isolated by a bracket 2⁻¹² of its first width). Crossings at the
+/// turn are the default `dynamic` unloading's: its curve starts above the loading force once
+/// the rate has fallen, so turning early is self-consistent; under `dynamic-continuous` only the
+/// rate's zero turns (docs/physics.md §3, "A continuous turn"); a preloaded pair at rest has
+/// them too (§6.11).
 fn solve_force(lo: f64, law: impl Fn(f64) -> f64) -> f64 {
     let hi = law(lo);
     if hi <= lo {
