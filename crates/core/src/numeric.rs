@@ -325,26 +325,32 @@ pub fn spectral_filter(
     }
     fft_plan(m, false).process(&mut buf);
     let df = 1.0 / (m as f64 * dt);
+    // The factors of the bins k = 0..=m/2; a negative frequency −k takes its twin's conjugate
+    // (the same (delay, gain) and the phase negated: the same numbers a direct evaluation gives).
+    let half = m / 2;
+    let factors: Vec<Complex<f64>> = (0..=half)
+        .map(|k| {
+            let f = k as f64 * df;
+            let (delay, gain) = factor(FftBin {
+                index: k,
+                length: m,
+                frequency_hz: f,
+            });
+            let phase = -2.0 * std::f64::consts::PI * f * delay;
+            if k == half {
+                // Nyquist bin: keep the signal real.
+                Complex::new(gain * phase.cos(), 0.0)
+            } else {
+                Complex::from_polar(gain, phase)
+            }
+        })
+        .collect();
     for (k, z) in buf.iter_mut().enumerate() {
-        let kk = if k <= m / 2 {
-            k as f64
+        *z *= if k <= half {
+            factors[k]
         } else {
-            k as f64 - m as f64
+            factors[m - k].conj()
         };
-        let f = kk * df;
-        let (delay, gain) = factor(FftBin {
-            index: kk.abs() as usize,
-            length: m,
-            frequency_hz: f.abs(),
-        });
-        let phase = -2.0 * std::f64::consts::PI * f * delay;
-        let factor = if 2 * k == m {
-            // Nyquist bin: keep the signal real.
-            Complex::new(gain * phase.cos(), 0.0)
-        } else {
-            Complex::from_polar(gain, phase)
-        };
-        *z *= factor;
     }
     fft_plan(m, true).process(&mut buf);
     buf.iter().take(n).map(|z| z.re / m as f64).collect()

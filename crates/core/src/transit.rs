@@ -67,6 +67,22 @@ pub struct TransitDesign {
     gain: Vec<f64>,
     /// Filters designed so far, by half cells ([`TransitDesign::shared_filter`]).
     filters: Mutex<HashMap<usize, Arc<SharedFilter>>>,
+    /// The per-bin factors of [`TransitDesign::stretch_history`] by transform length.
+    bin_tables: Mutex<HashMap<usize, Arc<BinTables>>>,
+}
+
+/// The factors of [`TransitDesign::stretch_history`] that depend only on its design and its
+/// transform length n, made once per process (a sweep's or a notebook's runs share them).
+#[derive(Debug)]
+struct BinTables {
+    /// z = e^{−i(Ω + φ)}, one cell's phase factor, bins 0..=n/2.
+    z: Vec<Complex64>,
+    /// The band's weight times the half cell's dispersion, g e^{−iφ/2}, bins 0..=n/2.
+    carry: Vec<Complex64>,
+    /// The one-step delay e^{−iΩ}, bins 0..=n/2.
+    delay: Vec<Complex64>,
+    /// e^{2πij/n}, j = 0..n: the phase turns of the sampled times.
+    roots: Vec<Complex64>,
 }
 
 /// A transit filter kept by its design, with its taps also oldest first (for a dot product with
@@ -199,6 +215,7 @@ impl TransitDesign {
             phase: Vec::new(),
             gain: Vec::new(),
             filters: Mutex::new(HashMap::new()),
+            bin_tables: Mutex::new(HashMap::new()),
         }
     }
 
@@ -351,6 +368,31 @@ fn progression(times: &[usize]) -> Option<(usize, usize)> {
 }
 
 impl TransitDesign {
+    /// The per-bin factors of [`TransitDesign::stretch_history`] for transform length `n`, made
+    /// on first use and kept by the design.
+    fn bin_tables(&self, n: usize) -> Arc<BinTables> {
+        let mut cache = self.bin_tables.lock().unwrap_or_else(|e| e.into_inner());
+        Arc::clone(cache.entry(n).or_insert_with(|| {
+            let (mut z, mut carry, mut delay) = (Vec::new(), Vec::new(), Vec::new());
+            for k in 0..=n / 2 {
+                let w = 2.0 * PI * k as f64 / n as f64;
+                let (phi, g) = self.phase_and_gain(w);
+                z.push(Complex64::from_polar(1.0, -(w + phi)));
+                carry.push(Complex64::from_polar(g, -0.5 * phi));
+                delay.push(Complex64::from_polar(1.0, -w));
+            }
+            let roots = (0..n)
+                .map(|j| Complex64::from_polar(1.0, 2.0 * PI * j as f64 / n as f64))
+                .collect();
+            Arc::new(BinTables {
+                z,
+                carry,
+                delay,
+                roots,
+            })
+        }))
+    }
+
     /// Stretches of a dispersive delay line of `elements` elements at `points`, at the history
     /// indices `times`, from its whole histories (module docs, "After the run"): `right[i]` and
     /// `left[i]` are the increments injected at index i (i from the start of the histories,
@@ -415,20 +457,12 @@ impl TransitDesign {
         // dispersion of the half cell between an element's centre and its end of the bar, and
         // the history spectra times the one-step delay (the left one carried over the whole
         // bar, z^{N−1}).
-        let mut z = Vec::with_capacity(half + 1);
-        let mut carry = Vec::with_capacity(half + 1);
-        let mut u = Vec::with_capacity(half + 1);
-        let mut v = Vec::with_capacity(half + 1);
-        for k in 0..=half {
-            let w = 2.0 * PI * k as f64 / n as f64;
-            let (phi, g) = self.phase_and_gain(w);
-            let zk = Complex64::from_polar(1.0, -(w + phi));
-            let delay = Complex64::from_polar(1.0, -w);
-            z.push(zk);
-            carry.push(Complex64::from_polar(g, -0.5 * phi));
-            u.push(fa[k] * delay);
-            v.push(fb[k] * delay * zk.powu(last as u32));
-        }
+        let tables = self.bin_tables(n);
+        let (z, carry) = (tables.z.as_slice(), tables.carry.as_slice());
+        let u: Vec<Complex64> = (0..=half).map(|k| fa[k] * tables.delay[k]).collect();
+        let v: Vec<Complex64> = (0..=half)
+            .map(|k| fb[k] * tables.delay[k] * z[k].powu(last as u32))
+            .collect();
         // Times relative to the transform's start; sampled every `fold` from `offset`.
         let local: Vec<usize> = times.iter().map(|&t| t - start).collect();
         let (offset, m) = (local[0] % fold, n / fold);
@@ -437,108 +471,131 @@ impl TransitDesign {
         let mut scratch = vec![Complex64::new(0.0, 0.0); inverse.get_inplace_scratch_len()];
         // y(offset + fold·q) = (1/n) Σ_k Y_k e^{2πik·offset/n} e^{2πikq/m}, over each k ≤ n/2
         // and its mirror n − k (Y_{n−k} = conj Y_k): the two phase turns and folded slots.
-        let turn =
-            |k: usize| Complex64::from_polar(1.0, 2.0 * PI * ((k * offset) % n) as f64 / n as f64);
+        let turn = |k: usize| tables.roots[(k * offset) % n];
         let turns: Vec<(Complex64, Complex64)> =
             (0..=half).map(|k| (turn(k), turn(n - k))).collect();
         // The usual point inside the bar, in separate real arrays ([`InteriorBins`]).
-        let interior = InteriorBins::new(&u, &v, &carry, &turns, &z, half);
+        let interior = InteriorBins::new(&u, &v, carry, &turns, z, half);
         let mut pw: Vec<Complex64> = vec![Complex64::new(1.0, 0.0); half + 1];
         let mut pw_element = 0usize;
         let mut z_stride: (usize, Vec<Complex64>) = (0, Vec::new());
-        let mut folded = vec![Complex64::new(0.0, 0.0); m];
         let mut sums = FoldSums::new(m);
-        points
-            .iter()
-            .map(|p| {
-                let Some(&(first, _)) = p.first() else {
-                    return vec![0.0; times.len()];
-                };
-                let e0 = first.min(last);
-                let ends = p.iter().any(|&(e, _)| e == 0 || e >= last);
-                // The usual point inside the bar: one element, or two neighbours.
-                let pair = match p.as_slice() {
-                    [(_, w0)] if !ends => Some((*w0, 0.0)),
-                    [(e0, w0), (e1, w1)] if !ends && *e1 == e0 + 1 => Some((*w0, *w1)),
-                    _ => None,
-                };
-                // z^Δ for this stride, kept while points come at the same spacing.
-                let stride = e0.checked_sub(pw_element).filter(|&s| s > 0);
-                if let Some(stride) = stride
-                    && stride != z_stride.0
-                {
-                    z_stride = (stride, z.iter().map(|c| c.powu(stride as u32)).collect());
+        // A point's folded spectrum (a real series', Hermitian) into `folded`; returns the
+        // constant the histories' first values add, or None for a point with no terms.
+        let mut fold_point = |p: &StretchPoint, folded: &mut [Complex64]| -> Option<f64> {
+            let &(first, _) = p.first()?;
+            let e0 = first.min(last);
+            let ends = p.iter().any(|&(e, _)| e == 0 || e >= last);
+            // The usual point inside the bar: one element, or two neighbours.
+            let pair = match p.as_slice() {
+                [(_, w0)] if !ends => Some((*w0, 0.0)),
+                [(e0, w0), (e1, w1)] if !ends && *e1 == e0 + 1 => Some((*w0, *w1)),
+                _ => None,
+            };
+            // z^Δ for this stride, kept while points come at the same spacing.
+            let stride = e0.checked_sub(pw_element).filter(|&s| s > 0);
+            if let Some(stride) = stride
+                && stride != z_stride.0
+            {
+                z_stride = (stride, z.iter().map(|c| c.powu(stride as u32)).collect());
+            }
+            if e0 < pw_element {
+                for (c, zk) in pw.iter_mut().zip(z) {
+                    *c = zk.powu(e0 as u32);
                 }
-                if e0 < pw_element {
-                    for (c, zk) in pw.iter_mut().zip(&z) {
-                        *c = zk.powu(e0 as u32);
-                    }
+            }
+            pw_element = e0;
+            if let Some((w0, w1)) = pair {
+                // Bins 1..half in one pass (advancing z^e by the stride on the way), then DC
+                // and Nyquist.
+                let step = stride.map(|_| z_stride.1.as_slice());
+                sums.interior(&interior, &mut pw, step, (w0, w1), m);
+                sums.write_to(folded);
+                for k in [0, half] {
+                    let h_r = pw[k] * Complex64::new(w0 + w1 * z[k].re, w1 * z[k].im);
+                    let value = (u[k] * h_r + v[k] * h_r.conj()) * carry[k];
+                    folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
                 }
-                pw_element = e0;
-                if let Some((w0, w1)) = pair {
-                    // Bins 1..half in one pass (advancing z^e by the stride on the way), then DC
-                    // and Nyquist.
-                    let step = stride.map(|_| z_stride.1.as_slice());
-                    sums.interior(&interior, &mut pw, step, (w0, w1), m);
-                    sums.write_to(&mut folded);
-                    for k in [0, half] {
-                        let h_r = pw[k] * Complex64::new(w0 + w1 * z[k].re, w1 * z[k].im);
-                        let value = (u[k] * h_r + v[k] * h_r.conj()) * carry[k];
-                        folded[k % m] += Complex64::new(value.re, 0.0) * turns[k].0;
-                    }
-                    hermitian_completion(&mut folded);
-                    inverse.process_with_scratch(&mut folded, &mut scratch);
-                    let dc: f64 = (a0 + b0) * (w0 + w1);
-                    return local
-                        .iter()
-                        .map(|&t| folded[(t - offset) / fold].re / n as f64 + dc)
-                        .collect();
+                hermitian_completion(folded);
+                return Some((a0 + b0) * (w0 + w1));
+            }
+            folded.fill(Complex64::new(0.0, 0.0));
+            if stride.is_some() {
+                for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
+                    *c *= zk;
                 }
-                folded.fill(Complex64::new(0.0, 0.0));
-                if stride.is_some() {
-                    for (c, zk) in pw.iter_mut().zip(&z_stride.1) {
-                        *c *= zk;
+            }
+            for k in 0..=half {
+                let g = carry[k];
+                // The right- and left-going sums h_r and h_l (each term's wave undispersed
+                // over its first cell).
+                let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
+                let mut h_l = h_r;
+                let mut at = e0;
+                for &(e, weight) in p {
+                    let e = e.min(last);
+                    while at < e {
+                        zr *= z[k];
+                        at += 1;
                     }
+                    // R_e: dispersion over e + ½ cells (none for e = 0); L_e: over
+                    // N − e − ½ (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e), the
+                    // half cell in g.
+                    let one = Complex64::new(1.0, 0.0);
+                    let gr = if e == 0 { one } else { g };
+                    let gl = if e == last { one } else { g };
+                    h_r += zr * gr * weight;
+                    h_l += zr.conj() * gl * weight;
                 }
-                for k in 0..=half {
-                    let g = carry[k];
-                    // The right- and left-going sums h_r and h_l (each term's wave undispersed
-                    // over its first cell).
-                    let (mut zr, mut h_r) = (pw[k], Complex64::new(0.0, 0.0));
-                    let mut h_l = h_r;
-                    let mut at = e0;
-                    for &(e, weight) in p {
-                        let e = e.min(last);
-                        while at < e {
-                            zr *= z[k];
-                            at += 1;
-                        }
-                        // R_e: dispersion over e + ½ cells (none for e = 0); L_e: over
-                        // N − e − ½ (none for e = N − 1): z^{N−1−e} = z^{N−1} conj(z^e), the
-                        // half cell in g.
-                        let one = Complex64::new(1.0, 0.0);
-                        let gr = if e == 0 { one } else { g };
-                        let gl = if e == last { one } else { g };
-                        h_r += zr * gr * weight;
-                        h_l += zr.conj() * gl * weight;
-                    }
-                    let value = u[k] * h_r + v[k] * h_l;
-                    let (t_k, t_mirror) = turns[k];
-                    if k == 0 || 2 * k == n {
-                        folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
-                    } else {
-                        folded[k % m] += value * t_k;
-                        folded[(n - k) % m] += value.conj() * t_mirror;
-                    }
+                let value = u[k] * h_r + v[k] * h_l;
+                let (t_k, t_mirror) = turns[k];
+                if k == 0 || 2 * k == n {
+                    folded[k % m] += Complex64::new(value.re, 0.0) * t_k;
+                } else {
+                    folded[k % m] += value * t_k;
+                    folded[(n - k) % m] += value.conj() * t_mirror;
                 }
-                inverse.process_with_scratch(&mut folded, &mut scratch);
-                let dc: f64 = (a0 + b0) * p.iter().map(|&(_, w)| w).sum::<f64>();
-                local
-                    .iter()
-                    .map(|&t| folded[(t - offset) / fold].re / n as f64 + dc)
-                    .collect()
-            })
-            .collect()
+            }
+            Some((a0 + b0) * p.iter().map(|&(_, w)| w).sum::<f64>())
+        };
+        // The points' series are real, so two go through one inverse transform: the spectrum
+        // of the first plus i times that of the second gives the first as the real part and the
+        // second as the imaginary part.
+        let read = |y: &[Complex64], part: fn(&Complex64) -> f64, dc: f64| -> Vec<f64> {
+            local
+                .iter()
+                .map(|&t| part(&y[(t - offset) / fold]) / n as f64 + dc)
+                .collect()
+        };
+        let mut rows: Vec<Vec<f64>> = vec![Vec::new(); points.len()];
+        let mut held: Option<(usize, f64)> = None;
+        let mut spare = vec![Complex64::new(0.0, 0.0); m];
+        let mut folded = vec![Complex64::new(0.0, 0.0); m];
+        for (j, p) in points.iter().enumerate() {
+            let Some(dc) = fold_point(p, &mut folded) else {
+                rows[j] = vec![0.0; times.len()];
+                continue;
+            };
+            match held.take() {
+                None => {
+                    std::mem::swap(&mut spare, &mut folded);
+                    held = Some((j, dc));
+                }
+                Some((i, dc_i)) => {
+                    for (a, b) in spare.iter_mut().zip(&folded) {
+                        *a += Complex64::new(-b.im, b.re);
+                    }
+                    inverse.process_with_scratch(&mut spare, &mut scratch);
+                    rows[i] = read(&spare, |c| c.re, dc_i);
+                    rows[j] = read(&spare, |c| c.im, dc);
+                }
+            }
+        }
+        if let Some((i, dc_i)) = held {
+            inverse.process_with_scratch(&mut spare, &mut scratch);
+            rows[i] = read(&spare, |c| c.re, dc_i);
+        }
+        rows
     }
 }
 
