@@ -970,6 +970,56 @@ mod tests {
         );
     }
 
+    /// Points evaluated together (two series through one inverse transform, the factors kept
+    /// by the design) equal each point evaluated alone, to rounding, for both models, at ends
+    /// and inside, with a time stride (x–t snapshots) and without (gauges).
+    #[test]
+    fn points_evaluated_together_equal_points_evaluated_alone() {
+        let elements = 120;
+        let right: Vec<f64> = (0..900)
+            .map(|i| 0.1 + (-((i as f64 - 150.0) / 25.0).powi(2)).exp())
+            .collect();
+        let left: Vec<f64> = (0..900)
+            .map(|i| -0.05 + 0.3 * (-((i as f64 - 400.0) / 40.0).powi(2)).exp())
+            .collect();
+        let points: Vec<StretchPoint> = vec![
+            vec![(0, 1.0)],
+            vec![(7, 0.25), (8, 0.5)],
+            vec![(12, 2.0)],
+            vec![(60, 0.5), (61, 0.5)],
+            vec![],
+            vec![(119, 1.0)],
+            vec![(90, 1.0)],
+        ];
+        for model in [TransitModel::PochhammerChree, TransitModel::RayleighLove] {
+            let design = TransitDesign::new(model, 0.29, 9.525e-3, 1e-3, 2 * elements);
+            for times in [(0..900).step_by(5).collect::<Vec<_>>(), (0..900).collect()] {
+                let together = design.stretch_history(&right, &left, elements, &points, &times);
+                let peak = together
+                    .iter()
+                    .flatten()
+                    .fold(0.0f64, |a, &x| a.max(x.abs()));
+                for (p, row) in points.iter().zip(&together) {
+                    let alone = &design.stretch_history(
+                        &right,
+                        &left,
+                        elements,
+                        std::slice::from_ref(p),
+                        &times,
+                    )[0];
+                    let worst = row
+                        .iter()
+                        .zip(alone)
+                        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                    assert!(
+                        worst <= 1e-14 * peak,
+                        "{model:?} {p:?}: {worst:e} of {peak:e}"
+                    );
+                }
+            }
+        }
+    }
+
     /// A filter's DFT is exp(−i d φ) in its band (at the design's bins), and its taps sum to one.
     #[test]
     fn filters_are_the_all_pass_transit_of_each_model() {
