@@ -231,6 +231,10 @@ pub enum Command {
         /// `_m` keys in mm/um/m), e.g. pressure=5psi:20psi:16. Repeat for a product.
         #[arg(long = "set", required = true)]
         set: Vec<String>,
+        /// Fidelity preset of every run, as `shpb run --fidelity` (the same as `--set
+        /// fidelity=NAME`, whose column the summary then carries).
+        #[arg(long, value_enum)]
+        fidelity: Option<FidelityArg>,
         /// Worker threads (`-j`).
         #[command(flatten)]
         jobs: Jobs,
@@ -574,7 +578,8 @@ pub fn dispatch(cli: Cli) -> Result<()> {
         } => cmd::bench::bench(&scene, repeats, report.as_deref(), force),
         Command::Sweep {
             scene,
-            set,
+            mut set,
+            fidelity,
             jobs,
             shard,
             output,
@@ -584,7 +589,10 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             force,
         } => cmd::sweep::sweep(
             &scene,
-            &set,
+            {
+                set.extend(fidelity.map(|f| format!("fidelity={}", Fidelity::from(f).name())));
+                &set
+            },
             jobs.jobs,
             shard.as_deref(),
             (output.as_deref(), csv.as_deref(), plot.as_deref()),

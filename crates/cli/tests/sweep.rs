@@ -230,3 +230,91 @@ fn killed_sweep_resumes_and_shards_merge_to_the_whole() {
         summary(&dir.path().join("whole.h5"))
     );
 }
+
+/// `shpb sweep --fidelity NAME` is `--set fidelity=NAME`: the same table, its `fidelity` column
+/// included; given with `--set fidelity=…` as well, the key is reported as given twice.
+#[test]
+fn the_fidelity_flag_is_a_one_value_fidelity_axis() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let scene = scene();
+    let scene = scene.to_str().unwrap();
+    let flag = shpb(
+        dir.path(),
+        &[
+            "sweep",
+            scene,
+            "--fidelity",
+            "fast",
+            "--set",
+            "pressure=9psi,11psi",
+            "--csv",
+            "a.csv",
+        ],
+    );
+    assert!(
+        flag.status.success(),
+        "{}",
+        String::from_utf8_lossy(&flag.stderr)
+    );
+    let set = shpb(
+        dir.path(),
+        &[
+            "sweep",
+            scene,
+            "--set",
+            "pressure=9psi,11psi",
+            "--set",
+            "fidelity=fast",
+            "--csv",
+            "b.csv",
+        ],
+    );
+    assert!(
+        set.status.success(),
+        "{}",
+        String::from_utf8_lossy(&set.stderr)
+    );
+    let (a, b) = (
+        std::fs::read_to_string(dir.path().join("a.csv")).unwrap(),
+        std::fs::read_to_string(dir.path().join("b.csv")).unwrap(),
+    );
+    let rows = |t: &str| -> Vec<Vec<String>> {
+        let mut lines = t.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let mut order: Vec<usize> = (0..header.len()).collect();
+        order.sort_by_key(|&i| header[i]);
+        std::iter::once(header.join(","))
+            .chain(lines.map(str::to_string))
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                order.iter().map(|&i| cells[i].to_string()).collect()
+            })
+            .collect()
+    };
+    assert_eq!(rows(&a), rows(&b));
+    assert!(
+        a.lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .any(|c| c == "fidelity")
+    );
+    assert!(a.lines().skip(1).all(|l| l.split(',').any(|c| c == "fast")));
+    let both = shpb(
+        dir.path(),
+        &[
+            "sweep",
+            scene,
+            "--fidelity",
+            "fast",
+            "--set",
+            "fidelity=standard",
+            "--set",
+            "pressure=9psi",
+            "--csv",
+            "c.csv",
+        ],
+    );
+    assert_eq!(both.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&both.stderr).contains("fidelity"));
+}
