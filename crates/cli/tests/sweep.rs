@@ -237,83 +237,43 @@ fn killed_sweep_resumes_and_shards_merge_to_the_whole() {
 fn the_fidelity_flag_is_a_one_value_fidelity_axis() {
     let dir = tempfile::TempDir::new().unwrap();
     let scene = scene();
-    let scene = scene.to_str().unwrap();
-    let flag = shpb(
-        dir.path(),
-        &[
-            "sweep",
-            scene,
-            "--fidelity",
-            "fast",
-            "--set",
-            "pressure=9psi,11psi",
-            "--csv",
-            "a.csv",
-        ],
-    );
+    // A sweep of two pressures with the extra arguments `how`, its exit code and its CSV's
+    // rows with the columns in name order.
+    let sweep = |how: &str, csv: &str| {
+        let mut args = vec!["sweep", scene.to_str().unwrap(), "--csv", csv];
+        args.extend(how.split(' '));
+        let out = shpb(dir.path(), &args);
+        let text = std::fs::read_to_string(dir.path().join(csv)).unwrap_or_default();
+        let lines: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+        let mut order: Vec<usize> = (0..lines.first().map_or(0, Vec::len)).collect();
+        order.sort_by_key(|&i| lines[0][i]);
+        let rows: Vec<Vec<String>> = lines
+            .iter()
+            .map(|l| order.iter().map(|&i| l[i].to_string()).collect())
+            .collect();
+        (out, rows)
+    };
+    let (flag, a) = sweep("--fidelity fast --set pressure=9psi,11psi", "a.csv");
     assert!(
         flag.status.success(),
         "{}",
         String::from_utf8_lossy(&flag.stderr)
     );
-    let set = shpb(
-        dir.path(),
-        &[
-            "sweep",
-            scene,
-            "--set",
-            "pressure=9psi,11psi",
-            "--set",
-            "fidelity=fast",
-            "--csv",
-            "b.csv",
-        ],
-    );
+    let (set, b) = sweep("--set pressure=9psi,11psi --set fidelity=fast", "b.csv");
     assert!(
         set.status.success(),
         "{}",
         String::from_utf8_lossy(&set.stderr)
     );
-    let (a, b) = (
-        std::fs::read_to_string(dir.path().join("a.csv")).unwrap(),
-        std::fs::read_to_string(dir.path().join("b.csv")).unwrap(),
-    );
-    let rows = |t: &str| -> Vec<Vec<String>> {
-        let mut lines = t.lines();
-        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-        let mut order: Vec<usize> = (0..header.len()).collect();
-        order.sort_by_key(|&i| header[i]);
-        std::iter::once(header.join(","))
-            .chain(lines.map(str::to_string))
-            .map(|l| {
-                let cells: Vec<&str> = l.split(',').collect();
-                order.iter().map(|&i| cells[i].to_string()).collect()
-            })
-            .collect()
-    };
-    assert_eq!(rows(&a), rows(&b));
-    assert!(
-        a.lines()
-            .next()
-            .unwrap()
-            .split(',')
-            .any(|c| c == "fidelity")
-    );
-    assert!(a.lines().skip(1).all(|l| l.split(',').any(|c| c == "fast")));
-    let both = shpb(
-        dir.path(),
-        &[
-            "sweep",
-            scene,
-            "--fidelity",
-            "fast",
-            "--set",
-            "fidelity=standard",
-            "--set",
-            "pressure=9psi",
-            "--csv",
-            "c.csv",
-        ],
+    assert_eq!(a, b);
+    let column = a[0]
+        .iter()
+        .position(|c| c == "fidelity")
+        .expect("a fidelity column");
+    assert!(a[1..].iter().all(|row| row[column] == "fast"));
+    let (both, _) = sweep(
+        "--fidelity fast --set fidelity=standard --set pressure=9psi",
+        "c.csv",
     );
     assert_eq!(both.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&both.stderr).contains("fidelity"));
