@@ -587,18 +587,19 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             plot,
             resume,
             force,
-        } => cmd::sweep::sweep(
-            &scene,
-            {
-                set.extend(fidelity.map(|f| format!("fidelity={}", Fidelity::from(f).name())));
-                &set
-            },
-            jobs.jobs,
-            shard.as_deref(),
-            (output.as_deref(), csv.as_deref(), plot.as_deref()),
-            resume,
-            force,
-        ),
+        } => {
+            // `--fidelity NAME` is the one-value axis `--set fidelity=NAME`.
+            set.extend(fidelity.map(|f| format!("fidelity={}", Fidelity::from(f).name())));
+            cmd::sweep::sweep(
+                &scene,
+                &set,
+                jobs.jobs,
+                shard.as_deref(),
+                (output.as_deref(), csv.as_deref(), plot.as_deref()),
+                resume,
+                force,
+            )
+        }
         Command::Study {
             scene,
             samples,

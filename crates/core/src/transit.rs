@@ -79,9 +79,8 @@ struct BinTables {
     z: Vec<Complex64>,
     /// The band's weight times the half cell's dispersion, g e^{−iφ/2}, bins 0..=n/2.
     carry: Vec<Complex64>,
-    /// The one-step delay e^{−iΩ}, bins 0..=n/2.
-    delay: Vec<Complex64>,
-    /// e^{2πij/n}, j = 0..n: the phase turns of the sampled times.
+    /// e^{2πij/n}, j = 0..n: the phase turns of the sampled times; the one-step delay e^{−iΩ}
+    /// of bin k is the conjugate of the k-th.
     roots: Vec<Complex64>,
 }
 
@@ -373,23 +372,17 @@ impl TransitDesign {
     fn bin_tables(&self, n: usize) -> Arc<BinTables> {
         let mut cache = self.bin_tables.lock().unwrap_or_else(|e| e.into_inner());
         Arc::clone(cache.entry(n).or_insert_with(|| {
-            let (mut z, mut carry, mut delay) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut z, mut carry) = (Vec::new(), Vec::new());
             for k in 0..=n / 2 {
                 let w = 2.0 * PI * k as f64 / n as f64;
                 let (phi, g) = self.phase_and_gain(w);
                 z.push(Complex64::from_polar(1.0, -(w + phi)));
                 carry.push(Complex64::from_polar(g, -0.5 * phi));
-                delay.push(Complex64::from_polar(1.0, -w));
             }
             let roots = (0..n)
                 .map(|j| Complex64::from_polar(1.0, 2.0 * PI * j as f64 / n as f64))
                 .collect();
-            Arc::new(BinTables {
-                z,
-                carry,
-                delay,
-                roots,
-            })
+            Arc::new(BinTables { z, carry, roots })
         }))
     }
 
@@ -459,9 +452,10 @@ impl TransitDesign {
         // bar, z^{N−1}).
         let tables = self.bin_tables(n);
         let (z, carry) = (tables.z.as_slice(), tables.carry.as_slice());
-        let u: Vec<Complex64> = (0..=half).map(|k| fa[k] * tables.delay[k]).collect();
+        let delay = |k: usize| tables.roots[k].conj();
+        let u: Vec<Complex64> = (0..=half).map(|k| fa[k] * delay(k)).collect();
         let v: Vec<Complex64> = (0..=half)
-            .map(|k| fb[k] * tables.delay[k] * z[k].powu(last as u32))
+            .map(|k| fb[k] * delay(k) * z[k].powu(last as u32))
             .collect();
         // Times relative to the transform's start; sampled every `fold` from `offset`.
         let local: Vec<usize> = times.iter().map(|&t| t - start).collect();
