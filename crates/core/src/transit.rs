@@ -105,6 +105,17 @@ impl SharedFilter {
         dot(&self.oldest_first, &s[lo..=newest + lead])
     }
 
+    /// The first `m` taps alone: Σ_{j<m} h_j s[newest − j + lead] (the head of a filter whose
+    /// other taps a [`BlockConvolver`] applies).
+    #[inline]
+    pub fn apply_head(&self, s: &[f64], newest: usize, m: usize) -> f64 {
+        let last = newest + self.filter.lead;
+        dot(
+            &self.oldest_first[self.oldest_first.len() - m..],
+            &s[last + 1 - m..=last],
+        )
+    }
+
     /// max |H|² of the filter as truncated ([`max_power_gain`]).
     pub fn max_power_gain(&self) -> f64 {
         *self
@@ -816,7 +827,7 @@ impl std::fmt::Debug for BlockConvolver {
 }
 
 /// Smallest block worth the transforms (below it a direct sum is as quick).
-const MIN_BLOCK: usize = 64;
+pub const MIN_BLOCK: usize = 64;
 /// Largest block (longer ones save little and delay nothing).
 const MAX_BLOCK: usize = 1024;
 
