@@ -418,7 +418,8 @@ class Study:
                 "S": dict(zip(keys, first)),
             }
         self.inputs: List[str] = list(spec)
-        """The study's description: each input's distribution, the seed and the samples."""
+        """The study's description: the samples and the seed, the fidelity preset if given, each
+        input's distribution."""
 
     def __repr__(self) -> str:
         return f"<shpb.Study: {len(self.runs)} samples of {', '.join(self.runs.keys_swept) or 'no input'}>"
@@ -432,6 +433,7 @@ def study(
     gun_scatter: bool = True,
     client: Any = None,
     shards: Optional[int] = None,
+    fidelity: Optional[str] = None,
 ) -> Study:
     """Propagates the scene's uncertainties (``shpb study SCENE --samples N --seed S``): its
     distributions (``pressure = { mean = "12.5psi", sd = "0.6psi" }``) and, with ``gun_scatter``,
@@ -441,21 +443,33 @@ def study(
     ``client``: a ``dask.distributed.Client``; the samples are then run in ``shards`` shards
     (default one per worker, every n-th sample as ``--shard k/n`` cuts a sweep), and the study is
     the one ``shpb study`` gives, bit for bit. Workers must see the scene at the same path.
+
+    ``fidelity``: ``"fast"``, ``"standard"`` or ``"reference"`` for every run, in place of the
+    scene's (``shpb study --fidelity``).
     """
     path = os.path.abspath(os.fspath(scene))
-    args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter))
+    args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter), fidelity)
     if client is None:
         rows = _study_shard(*args, 1, 1)
     else:
         rows = [r for part in _on_cluster(client, _study_shard, shards, *args) for r in part]
-    return Study(_shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows))
+    return Study(
+        _shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows, fidelity)
+    )
 
 
 def _study_shard(
-    scene: str, samples: int, seed: int, jobs: int, gun_scatter: bool, k: int, n: int
+    scene: str,
+    samples: int,
+    seed: int,
+    jobs: int,
+    gun_scatter: bool,
+    fidelity: Optional[str],
+    k: int,
+    n: int,
 ) -> List[Any]:
     """Shard ``k`` of ``n`` of a study, run where a Dask worker calls it."""
-    return _shpb.study_runs(scene, samples, seed, jobs, gun_scatter, (k, n))
+    return _shpb.study_runs(scene, samples, seed, jobs, gun_scatter, (k, n), fidelity)
 
 
 def _sweep_shard(

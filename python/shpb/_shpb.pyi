@@ -72,6 +72,7 @@ def study_runs(
     jobs: int = 1,
     gun_scatter: bool = True,
     shard: Tuple[int, int] = (1, 1),
+    fidelity: Optional[str] = None,
 ) -> Rows: ...
 def study_table(
     scene: str,
@@ -79,6 +80,7 @@ def study_table(
     seed: int,
     gun_scatter: bool,
     rows: Rows,
+    fidelity: Optional[str] = None,
 ) -> Tuple[Any, List[Tuple[str, str, int, float, float, Tuple[float, float, float], List[float]]], List[str]]: ...
 def version() -> str: ...
 def is_hdf5(path: str) -> bool: ...

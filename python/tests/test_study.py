@@ -64,3 +64,24 @@ def test_rows_of_another_study_are_refused():
     rows = shpb._shpb.study_runs(SCENE, SAMPLES, SEED, 1, True, (1, 2))
     with pytest.raises(shpb.InputError, match="exactly once"):
         shpb._shpb.study_table(SCENE, SAMPLES, SEED, True, rows)
+
+
+def test_fidelity_equals_the_command_and_names_the_preset(cli):
+    """``fidelity=`` is ``shpb study --fidelity``: the same statistics bit for bit, on a Dask
+    cluster too, and the study's description says which preset every run took; an unknown one
+    is refused."""
+    args = ("--samples", 4, "--seed", SEED, "--fidelity", "fast", "--json")
+    out = json.loads(cli("study", SCENE, *args).stdout)
+    s = shpb.study(SCENE, samples=4, seed=SEED, fidelity="fast")
+    stats_equal(s, out["quantities"])
+    assert s.inputs == out["study"]
+    assert any("fidelity fast" in line for line in s.inputs), s.inputs
+    default = shpb.study(SCENE, samples=4, seed=SEED)
+    assert default.stats["peak_force"]["mean"] != s.stats["peak_force"]["mean"]
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        d = shpb.study(SCENE, samples=4, seed=SEED, fidelity="fast", client=client)
+        assert same(d.stats, s.stats)
+    with pytest.raises(shpb.InputError, match="fidelity"):
+        shpb.study(SCENE, samples=4, seed=SEED, fidelity="quick")

@@ -279,6 +279,10 @@ pub enum Command {
         /// applied by default when the scene's pressure is one value).
         #[arg(long)]
         no_gun_scatter: bool,
+        /// Fidelity preset of every run, as `shpb run --fidelity` (wins over the scene's
+        /// `fidelity`; explicit knobs in the scene win over both).
+        #[arg(long, value_enum)]
+        fidelity: Option<FidelityArg>,
         /// HDF5 output: the runs (/summary table, /runs/<index>), the study in its `sweep` attribute.
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -606,6 +610,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             seed,
             jobs,
             no_gun_scatter,
+            fidelity,
             output,
             csv,
             summary,
@@ -613,10 +618,13 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             force,
         } => cmd::study::study(
             &scene,
-            samples,
-            seed,
+            &shpb_study::uq::StudyPlan {
+                samples,
+                seed,
+                gun_scatter: !no_gun_scatter,
+                fidelity: fidelity.map(Fidelity::from),
+            },
             jobs.jobs,
-            !no_gun_scatter,
             cmd::study::StudyOutputs {
                 output: output.as_deref(),
                 csv: csv.as_deref(),

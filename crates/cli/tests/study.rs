@@ -31,6 +31,15 @@ fn scene(dir: &Path, name: &str, pressure: &str) -> PathBuf {
     path
 }
 
+/// A study plan of `samples` samples drawn with `seed`, the gun scatter as `gun_scatter`, the
+/// scene's fidelity.
+fn plan(samples: usize, seed: u64, gun_scatter: bool) -> shpb::uq::StudyPlan {
+    shpb::uq::StudyPlan {
+        gun_scatter,
+        ..shpb::uq::StudyPlan::new(samples, seed)
+    }
+}
+
 /// The statistics CSV's row `quantity` as (name → cell).
 fn stats_row(text: &str, quantity: &str) -> std::collections::HashMap<String, String> {
     let mut lines = text.lines();
@@ -51,7 +60,7 @@ fn a_study_of_fixed_inputs_equals_one_run() {
     let dir = tempfile::TempDir::new().unwrap();
     let path = scene(dir.path(), "fixed.toml", "\"10psi\"");
     let one = summarise(0, vec![], &Params::from_file(&path).unwrap().run().unwrap());
-    let study = study_rows(&path, 3, 7, 2, false, false, |_| {}).unwrap();
+    let study = study_rows(&path, &plan(3, 7, false), 2, false, |_| {}).unwrap();
     assert!(study.inputs.is_empty());
     for row in &study.rows {
         let (a, b) = (row.values(), one.values());
@@ -87,9 +96,66 @@ fn a_study_of_fixed_inputs_equals_one_run() {
     assert_eq!(row["sd"].parse::<f64>().unwrap(), 0.0, "{text}");
     assert_eq!(row["mean"].parse::<f64>().unwrap(), one.peak_force_n);
     // The default: the gun's shot-to-shot scatter on the fixed pressure.
-    let scattered = study_rows(&path, 4, 7, 2, true, false, |_| {}).unwrap();
+    let scattered = study_rows(&path, &plan(4, 7, true), 2, false, |_| {}).unwrap();
     assert_eq!(scattered.keys(), ["pressure"]);
     assert!(scattered.statistics()[0].sd > 0.0);
+}
+
+/// `--fidelity` runs every sample at that preset, as `shpb run --fidelity` runs the scene: a
+/// study of fixed inputs at `standard` (the scene says `fast`) is the one run at `standard` bit
+/// for bit, not the scene's own; the study's description names the preset; `shpb study
+/// --fidelity` gives the same mean.
+#[test]
+fn the_fidelity_flag_runs_every_sample_at_that_preset() {
+    use shpb::fidelity::Fidelity;
+    let dir = tempfile::TempDir::new().unwrap();
+    let path = scene(dir.path(), "fixed.toml", "\"10psi\"");
+    let one = |f: Option<Fidelity>| {
+        let params = Params::from_file_with(&path, f).unwrap();
+        summarise(0, vec![], &params.run().unwrap())
+    };
+    let (standard, fast) = (one(Some(Fidelity::Standard)), one(None));
+    assert_ne!(standard.values(), fast.values(), "the presets differ here");
+    let at_standard = shpb::uq::StudyPlan {
+        fidelity: Some(Fidelity::Standard),
+        ..plan(2, 7, false)
+    };
+    let study = study_rows(&path, &at_standard, 2, false, |_| {}).unwrap();
+    for row in &study.rows {
+        for (x, y) in row.values().iter().zip(&standard.values()) {
+            assert_eq!(x.to_bits(), y.to_bits(), "{row:?} vs {standard:?}");
+        }
+    }
+    assert!(
+        study
+            .specification()
+            .iter()
+            .any(|l| l.contains("fidelity standard")),
+        "{:?}",
+        study.specification()
+    );
+    let out = shpb(
+        dir.path(),
+        &[
+            "study",
+            "fixed.toml",
+            "--samples",
+            "2",
+            "--no-gun-scatter",
+            "--fidelity",
+            "standard",
+            "--summary",
+            "standard.csv",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.path().join("standard.csv")).unwrap();
+    let mean: f64 = stats_row(&text, "peak_force")["mean"].parse().unwrap();
+    assert_eq!(mean, standard.peak_force_n, "{text}");
 }
 
 /// The drawn pressure is itself a linear test quantity (Y = X): its mean and percentiles must be
@@ -267,19 +333,19 @@ fn shards_of_a_study_join_into_the_whole_study() {
         "uncertain.toml",
         "{ mean = \"10psi\", sd = \"0.5psi\" }",
     );
-    let whole = study_rows(&path, 5, 11, 1, false, false, |_| {}).unwrap();
+    let whole = study_rows(&path, &plan(5, 11, false), 1, false, |_| {}).unwrap();
     let mut rows = Vec::new();
     for k in [2, 1] {
-        let part =
-            shpb::uq::study_shard_rows(&path, 5, 11, 1, false, false, (k, 2), |_| {}).unwrap();
+        let part = shpb::uq::study_shard_rows(&path, &plan(5, 11, false), 1, false, (k, 2), |_| {})
+            .unwrap();
         assert!(part.rows.iter().all(|r| r.index % 2 == k - 1));
         rows.extend(part.rows);
     }
     let first = rows[..2].to_vec();
-    let joined = shpb::uq::Study::from_rows(&path, 5, 11, false, rows).unwrap();
+    let joined = shpb::uq::Study::from_rows(&path, &plan(5, 11, false), rows).unwrap();
     assert_eq!(joined.rows, whole.rows);
     assert_eq!(joined.statistics_csv(), whole.statistics_csv());
-    let e = shpb::uq::Study::from_rows(&path, 5, 11, false, first).unwrap_err();
+    let e = shpb::uq::Study::from_rows(&path, &plan(5, 11, false), first).unwrap_err();
     assert!(e.to_string().contains("exactly once"), "{e}");
 }
 

@@ -679,10 +679,27 @@ fn arrived(rows: StudyRows) -> Vec<shpb_study::sweep::RunSummary> {
 /// summary values in the order of `SUMMARY_COLUMNS`).
 type StudyRows = Vec<(usize, Vec<String>, [f64; 5])>;
 
+/// The plan of a study (`shpb study --samples --seed [--no-gun-scatter] [--fidelity]`).
+fn study_plan(
+    samples: usize,
+    seed: u64,
+    gun_scatter: bool,
+    fidelity: Option<&str>,
+) -> PyResult<shpb_study::uq::StudyPlan> {
+    Ok(shpb_study::uq::StudyPlan {
+        samples,
+        seed,
+        gun_scatter,
+        fidelity: self::fidelity(fidelity)?,
+    })
+}
+
 /// Runs shard `k` of `n` (`shard`) of the study of `scene` (`shpb study`: `samples` Latin-
-/// hypercube samples drawn with `seed`, the gun scatter with `gun_scatter`) on `jobs` threads.
+/// hypercube samples drawn with `seed`, the gun scatter with `gun_scatter`, every run at
+/// `fidelity` if given) on `jobs` threads.
 #[pyfunction]
-#[pyo3(signature = (scene, samples, seed = 1, jobs = 1, gun_scatter = true, shard = (1, 1)))]
+#[pyo3(signature = (scene, samples, seed = 1, jobs = 1, gun_scatter = true, shard = (1, 1), fidelity = None))]
+#[allow(clippy::too_many_arguments)] // Python keyword arguments, each with its default
 fn study_runs(
     py: Python<'_>,
     scene: PathBuf,
@@ -691,18 +708,11 @@ fn study_runs(
     jobs: usize,
     gun_scatter: bool,
     shard: (usize, usize),
+    fidelity: Option<&str>,
 ) -> PyResult<StudyRows> {
+    let plan = study_plan(samples, seed, gun_scatter, fidelity)?;
     let study = detached(py, || {
-        shpb_study::uq::study_shard_rows(
-            &scene,
-            samples,
-            seed,
-            jobs,
-            gun_scatter,
-            false,
-            shard,
-            |_| {},
-        )
+        shpb_study::uq::study_shard_rows(&scene, &plan, jobs, false, shard, |_| {})
     })?;
     Ok(travelling(&study.rows))
 }
@@ -714,6 +724,7 @@ type StudyStat = (String, String, usize, f64, f64, [f64; 3], Vec<f64>);
 /// The study of `scene` from the rows of all its shards (`study_runs`): its table (as `sweep`
 /// returns one), its statistics (`shpb study --summary`) and the description of its inputs.
 #[pyfunction]
+#[pyo3(signature = (scene, samples, seed, gun_scatter, rows, fidelity = None))]
 fn study_table(
     py: Python<'_>,
     scene: PathBuf,
@@ -721,11 +732,11 @@ fn study_table(
     seed: u64,
     gun_scatter: bool,
     rows: StudyRows,
+    fidelity: Option<&str>,
 ) -> PyResult<(SweepTable, Vec<StudyStat>, Vec<String>)> {
     let rows = arrived(rows);
-    let study = detached(py, || {
-        shpb_study::uq::Study::from_rows(&scene, samples, seed, gun_scatter, rows)
-    })?;
+    let plan = study_plan(samples, seed, gun_scatter, fidelity)?;
+    let study = detached(py, || shpb_study::uq::Study::from_rows(&scene, &plan, rows))?;
     let stats = study
         .statistics()
         .into_iter()

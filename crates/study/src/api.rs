@@ -671,18 +671,16 @@ pub fn sweep_shard_rows(
     Ok((axes, rows))
 }
 
-/// A whole uncertainty study of `scene` (`shpb study` without outputs): `samples` runs drawn by
-/// a Latin hypercube seeded with `seed` from the scene's distributions and, with `gun_scatter`,
-/// the set-up's gun scatter, run on `jobs` threads ([`crate::uq::study_rows`]);
+/// A whole uncertainty study of `scene` (`shpb study` without outputs): the plan's samples drawn
+/// by a Latin hypercube seeded with its seed from the scene's distributions and, with its gun
+/// scatter, the set-up's, run at its fidelity on `jobs` threads ([`crate::uq::study_rows`]);
 /// [`crate::uq::Study::statistics`] gives each quantity's mean, sd, percentiles and indices.
 pub fn study_rows(
     scene: &Path,
-    samples: usize,
-    seed: u64,
+    plan: &crate::uq::StudyPlan,
     jobs: usize,
-    gun_scatter: bool,
 ) -> Result<crate::uq::Study> {
-    crate::uq::study_rows(scene, samples, seed, jobs, gun_scatter, false, |_| {})
+    crate::uq::study_rows(scene, plan, jobs, false, |_| {})
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use rand_xoshiro::Xoshiro256StarStar;
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
+use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::distribution::{Distribution, Uncertain, find_distributions};
 use shpb_input::prelude::*;
@@ -450,32 +451,55 @@ pub struct Study {
     pub traces: Vec<RunTraces>,
     /// The seed.
     pub seed: u64,
+    /// The fidelity preset every run took in place of the scene's (`--fidelity`), if given.
+    pub fidelity: Option<Fidelity>,
 }
 
-/// Runs a study of `scene`: `n` samples (≥ 2) drawn with `seed` from its inputs
+/// What a study draws and how each sample runs (`shpb study`'s `--samples`, `--seed`,
+/// `--no-gun-scatter` and `--fidelity`): every shard of a study and their join take the same.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StudyPlan {
+    /// Samples (runs), 2 to 1,000,000.
+    pub samples: usize,
+    /// Seed of the Latin hypercube.
+    pub seed: u64,
+    /// Whether the set-up's shot-to-shot gun scatter is drawn on a fixed pressure.
+    pub gun_scatter: bool,
+    /// The fidelity preset of every run in place of the scene's (as `shpb run --fidelity`).
+    pub fidelity: Option<Fidelity>,
+}
+
+impl StudyPlan {
+    /// `samples` samples drawn with `seed`, the gun scatter on, the scene's fidelity.
+    pub fn new(samples: usize, seed: u64) -> StudyPlan {
+        StudyPlan {
+            samples,
+            seed,
+            gun_scatter: true,
+            fidelity: None,
+        }
+    }
+}
+
+/// Runs a study of `scene`: the plan's samples (≥ 2) drawn with its seed from the scene's inputs
 /// ([`study_inputs`]), each sample validated before the first run, then run on `jobs` threads
-/// (each a normal run of the scene with the sample's values), `done` called as each finishes;
-/// traces kept with `keep_traces` (of the first [`MAX_TRACED_SAMPLES`]).
+/// (each a normal run of the scene with the sample's values, at the plan's fidelity), `done`
+/// called as each finishes; traces kept with `keep_traces` (of the first [`MAX_TRACED_SAMPLES`]).
 pub fn study_rows(
     scene: &Path,
-    n: usize,
-    seed: u64,
+    plan: &StudyPlan,
     jobs: usize,
-    gun_scatter: bool,
     keep_traces: bool,
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Study> {
-    study_shard_rows(scene, n, seed, jobs, gun_scatter, keep_traces, (1, 1), done)
+    study_shard_rows(scene, plan, jobs, keep_traces, (1, 1), done)
 }
 
-/// The inputs and samples of a study of `scene` (`n` samples drawn with `seed`): what each shard
-/// of the study, and the join of their rows, recompute identically.
-fn study_draw(
-    scene: &Path,
-    n: usize,
-    seed: u64,
-    gun_scatter: bool,
-) -> Result<(Vec<StudyInput>, Samples)> {
+/// The inputs and samples of a study of `scene` (the plan's samples drawn with its seed, each
+/// sample's overrides ending with the plan's fidelity): what each shard of the study, and the
+/// join of their rows, recompute identically.
+fn study_draw(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Samples)> {
+    let (n, seed) = (plan.samples, plan.seed);
     crate::sweep::require_scene(scene)?;
     if !(2..=1_000_000).contains(&n) {
         return Err(Error::Input {
@@ -485,20 +509,25 @@ fn study_draw(
             allowed: "2 to 1000000 samples".into(),
         });
     }
-    let inputs = study_inputs(scene, gun_scatter)?;
-    let samples = draw(&inputs, n, seed)?;
+    let inputs = study_inputs(scene, plan.gun_scatter)?;
+    let mut samples = draw(&inputs, n, seed)?;
+    // (`fidelity` is a name, never drawn: distributions are of quantities.)
+    if let Some(f) = plan.fidelity {
+        let preset = (
+            "fidelity".to_string(),
+            shpb_input::scene::Value::String(f.name().into()),
+        );
+        for o in &mut samples.overrides {
+            o.push(preset.clone());
+        }
+    }
     Ok((inputs, samples))
 }
 
 /// [`study_draw`] with every sample validated before the first run (a bad draw fails fast,
 /// naming its value).
-fn study_samples(
-    scene: &Path,
-    n: usize,
-    seed: u64,
-    gun_scatter: bool,
-) -> Result<(Vec<StudyInput>, Samples)> {
-    let (inputs, samples) = study_draw(scene, n, seed, gun_scatter)?;
+fn study_samples(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Samples)> {
+    let (inputs, samples) = study_draw(scene, plan)?;
     for (i, o) in samples.overrides.iter().enumerate() {
         Params::from_file_overridden(scene, o).map_err(|e| match e {
             // A drawn value of the wrong type (a number where the key takes a quantity with its
@@ -524,23 +553,21 @@ fn study_samples(
     Ok((inputs, samples))
 }
 
-/// Shard `k` of `m` of a study ([`study_rows`]): the same `n` samples drawn with `seed`, of which
-/// only those with index ≡ k − 1 (mod m) are run (as `shpb sweep --shard k/m` cuts a sweep), so
+/// Shard `k` of `m` of a study ([`study_rows`]): the same samples of the same plan, of which only
+/// those with index ≡ k − 1 (mod m) are run (as `shpb sweep --shard k/m` cuts a sweep), so
 /// shards run anywhere (a Dask worker, a job array) and [`Study::from_rows`] joins their rows into
 /// the study [`study_rows`] gives.
-#[allow(clippy::too_many_arguments)]
 pub fn study_shard_rows(
     scene: &Path,
-    n: usize,
-    seed: u64,
+    plan: &StudyPlan,
     jobs: usize,
-    gun_scatter: bool,
     keep_traces: bool,
     (k, m): (usize, usize),
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Study> {
     let (k, m) = crate::sweep::check_shard(k, m)?;
-    let (inputs, samples) = study_samples(scene, n, seed, gun_scatter)?;
+    let n = plan.samples;
+    let (inputs, samples) = study_samples(scene, plan)?;
     let pool = crate::sweep::thread_pool(jobs)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
     let results: Vec<(RunSummary, RunTraces)> = pool.install(|| {
@@ -585,22 +612,18 @@ pub fn study_shard_rows(
         } else {
             Vec::new()
         },
-        seed,
+        seed: plan.seed,
+        fidelity: plan.fidelity,
     })
 }
 
 impl Study {
     /// The study of `scene` (`n` samples drawn with `seed`) from the rows of its shards
     /// ([`study_shard_rows`]), in any order: each sample's row exactly once, or an error.
-    pub fn from_rows(
-        scene: &Path,
-        n: usize,
-        seed: u64,
-        gun_scatter: bool,
-        mut rows: Vec<RunSummary>,
-    ) -> Result<Study> {
+    pub fn from_rows(scene: &Path, plan: &StudyPlan, mut rows: Vec<RunSummary>) -> Result<Study> {
+        let (n, seed) = (plan.samples, plan.seed);
         // The shards validated and ran the samples; the join only needs them drawn again.
-        let (inputs, samples) = study_draw(scene, n, seed, gun_scatter)?;
+        let (inputs, samples) = study_draw(scene, plan)?;
         rows.sort_by_key(|r| r.index);
         let complete = rows.len() == n
             && rows
@@ -624,6 +647,7 @@ impl Study {
             rows,
             traces: Vec::new(),
             seed,
+            fidelity: plan.fidelity,
         })
     }
 
@@ -757,6 +781,9 @@ impl Study {
             self.rows.len(),
             self.seed
         )];
+        if let Some(f) = self.fidelity {
+            spec.push(format!("every run at fidelity {} (--fidelity)", f.name()));
+        }
         spec.extend(self.inputs.iter().map(StudyInput::describe));
         spec
     }

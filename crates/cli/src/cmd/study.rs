@@ -5,7 +5,7 @@
 use super::common::{finite, quiet_mode, report, warn, wrote};
 use shpb_input::{Error, Result};
 use shpb_output::io::check_output;
-use shpb_study::uq::{RunTraces, Study, Trace, bands};
+use shpb_study::uq::{RunTraces, Study, StudyPlan, Trace, bands};
 use std::path::Path;
 
 /// The outputs of `shpb study`.
@@ -21,15 +21,13 @@ pub struct StudyOutputs<'a> {
     pub plot: Option<&'a Path>,
 }
 
-/// `shpb study`: checks the outputs, draws `samples` samples with `seed`, runs them on `jobs`
-/// threads with a progress bar, prints the statistics (mean, sd, 5/50/95 %, first-order
-/// indices) and writes the outputs atomically (an existing file only with `force`).
+/// `shpb study`: checks the outputs, draws the plan's samples, runs them on `jobs` threads with a
+/// progress bar, prints the statistics (mean, sd, 5/50/95 %, first-order indices) and writes the
+/// outputs atomically (an existing file only with `force`).
 pub fn study(
     scene: &Path,
-    samples: usize,
-    seed: u64,
+    plan: &StudyPlan,
     jobs: usize,
-    gun_scatter: bool,
     outputs: StudyOutputs,
     force: bool,
 ) -> Result<()> {
@@ -37,7 +35,7 @@ pub fn study(
     for p in paths.into_iter().flatten() {
         check_output(p, force)?;
     }
-    let bar = indicatif::ProgressBar::new(samples as u64);
+    let bar = indicatif::ProgressBar::new(plan.samples as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{elapsed_precise} [{bar:40}] {pos}/{len} samples, ETA {eta}",
@@ -45,15 +43,8 @@ pub fn study(
         .expect("valid template")
         .progress_chars("=> "),
     );
-    let study = shpb_study::uq::study_rows(
-        scene,
-        samples,
-        seed,
-        jobs,
-        gun_scatter,
-        outputs.plot.is_some(),
-        |_| bar.inc(1),
-    )?;
+    let study =
+        shpb_study::uq::study_rows(scene, plan, jobs, outputs.plot.is_some(), |_| bar.inc(1))?;
     bar.finish_and_clear();
     let spec = study.specification();
     if study.inputs.is_empty() {
