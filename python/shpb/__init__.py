@@ -359,6 +359,7 @@ def sweep(
     jobs: int = 1,
     client: Any = None,
     shards: Optional[int] = None,
+    fidelity: Optional[str] = None,
 ) -> Table:
     """Runs ``scene`` over the Cartesian product of the values in ``set`` (``shpb sweep``),
     on ``jobs`` threads (the GIL is released), and returns the summary :class:`Table`.
@@ -372,6 +373,9 @@ def sweep(
     (``jobs`` threads there) and the rows are put back in sweep order: the table is the one
     ``shpb sweep`` gives. Workers must see the scene and the files it names at the same path
     (a shared file system).
+
+    ``fidelity``: the preset of every run (``shpb sweep --fidelity``), the same as
+    ``set={"fidelity": [fidelity]}``; a key given both ways is refused.
     """
     specs = []
     for key, values in set.items():
@@ -379,6 +383,9 @@ def sweep(
             specs.append(f"{key}={values}")
         else:
             specs.append(f"{key}={','.join(_label(v) for v in values)}")
+    if fidelity is not None:
+        # `--fidelity NAME` is the one-value axis `--set fidelity=NAME`, after the others.
+        specs.append(f"fidelity={fidelity}")
     path = os.path.abspath(os.fspath(scene))
     if client is None:
         keys, rows = _sweep_shard(path, specs, int(jobs), 1, 1)

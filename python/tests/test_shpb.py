@@ -485,6 +485,29 @@ def test_ctrl_c_stops_a_long_run_cleanly():
     assert r.summary["restitution"] > 0
 
 
+def test_sweep_fidelity_is_the_command_s_flag(cli, tmp_path):
+    """``fidelity=`` is ``shpb sweep --fidelity``: the table of ``set={"fidelity": [...]}``
+    (its ``fidelity`` column included), each row the run at that preset, the command's CSV
+    value for value; the key given both ways is refused, naming it."""
+    scene = "scenes/shpb-ss440c-10psi.toml"
+    grid = {"pressure": ["9psi", "11psi"]}
+    flag = shpb.sweep(scene, set=grid, fidelity="fast")
+    axis = shpb.sweep(scene, set={**grid, "fidelity": ["fast"]})
+    assert flag.keys() == axis.keys() and "fidelity" in flag.keys_swept
+    for k in flag.keys():
+        assert same(flag[k], axis[k]), k
+    r = shpb.run(scene, fidelity="fast", set={"pressure": "11psi"})
+    assert same(flag["peak_force"][1], r.summary["peak_contact_force"])
+    assert not same(flag["peak_force"][1], shpb.run(scene, set={"pressure": "11psi"}).summary["peak_contact_force"])
+    out = tmp_path / "fast.csv"
+    cli("sweep", scene, "--set", "pressure=9psi,11psi", "--fidelity", "fast", "--csv", out)
+    head, *rows = [line.split(",") for line in out.read_text().splitlines()]
+    column = [float(row[head.index("peak_force_N")]) for row in rows]
+    assert same(list(flag["peak_force"]), column)
+    with pytest.raises(shpb.InputError, match="fidelity"):
+        shpb.sweep(scene, set={**grid, "fidelity": ["standard"]}, fidelity="fast")
+
+
 def test_a_sweep_too_large_for_the_machine_is_refused_before_it_allocates():
     """As `shpb sweep`: 10^10 runs are refused with the estimate and the limit (InputError)."""
     grid = {"pressure": "7psi:22psi:100000", "shaper.thickness_m": "0.1mm:1mm:100000"}
