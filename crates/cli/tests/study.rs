@@ -40,6 +40,22 @@ fn plan(samples: usize, seed: u64, gun_scatter: bool) -> shpb::uq::StudyPlan {
     }
 }
 
+/// `shpb study ARGS --summary stats.csv` in `dir`, which must succeed: what it printed and the
+/// statistics CSV it wrote.
+fn study_summary(dir: &Path, args: &[&str]) -> (String, String) {
+    let mut all = vec!["study"];
+    all.extend(args);
+    all.extend(["--summary", "stats.csv", "--force"]);
+    let out = shpb(dir, &all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("stats.csv")).unwrap();
+    (String::from_utf8(out.stdout).unwrap(), csv)
+}
+
 /// The statistics CSV's row `quantity` as (name → cell).
 fn stats_row(text: &str, quantity: &str) -> std::collections::HashMap<String, String> {
     let mut lines = text.lines();
@@ -68,30 +84,15 @@ fn a_study_of_fixed_inputs_equals_one_run() {
             assert_eq!(x.to_bits(), y.to_bits(), "{row:?} vs {one:?}");
         }
     }
-    let out = shpb(
+    let (printed, text) = study_summary(
         dir.path(),
-        &[
-            "study",
-            "fixed.toml",
-            "--samples",
-            "2",
-            "--no-gun-scatter",
-            "--summary",
-            "fixed.csv",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &["fixed.toml", "--samples", "2", "--no-gun-scatter"],
     );
     // The printed table names every quantity.
-    let printed = String::from_utf8(out.stdout).unwrap();
     assert!(
         printed.contains("peak_force") && printed.contains("p95"),
         "{printed}"
     );
-    let text = std::fs::read_to_string(dir.path().join("fixed.csv")).unwrap();
     let row = stats_row(&text, "peak_force");
     assert_eq!(row["sd"].parse::<f64>().unwrap(), 0.0, "{text}");
     assert_eq!(row["mean"].parse::<f64>().unwrap(), one.peak_force_n);
@@ -134,26 +135,17 @@ fn the_fidelity_flag_runs_every_sample_at_that_preset() {
         "{:?}",
         study.specification()
     );
-    let out = shpb(
+    let (_, text) = study_summary(
         dir.path(),
         &[
-            "study",
             "fixed.toml",
             "--samples",
             "2",
             "--no-gun-scatter",
             "--fidelity",
             "standard",
-            "--summary",
-            "standard.csv",
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(dir.path().join("standard.csv")).unwrap();
     let mean: f64 = stats_row(&text, "peak_force")["mean"].parse().unwrap();
     assert_eq!(mean, standard.peak_force_n, "{text}");
 }
@@ -173,25 +165,7 @@ fn a_linear_quantity_has_the_analytic_mean_and_percentiles() {
         "normal.toml",
         "{ mean = \"12.5psi\", sd = \"0.6psi\" }",
     );
-    let out = shpb(
-        dir.path(),
-        &[
-            "study",
-            "normal.toml",
-            "--samples",
-            "16",
-            "-j",
-            "2",
-            "--summary",
-            "stats.csv",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(dir.path().join("stats.csv")).unwrap();
+    let (_, text) = study_summary(dir.path(), &["normal.toml", "--samples", "16", "-j", "2"]);
     let psi = shpb::units::PSI_PA;
     let (mean, sd, n) = (12.5 * psi, 0.6 * psi, 16.0f64);
     let row = stats_row(&text, "input pressure");
