@@ -1159,6 +1159,15 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
     }
     let _ = writeln!(s, "{head}\n{rule}");
     let mut misses: Vec<Miss> = Vec::new();
+    // What the targets leave a prediction at each pressure: |p/r − 1| ≤ tol on every record r
+    // there is p in [max r (1 − tol), min r (1 + tol)], a property of the records alone.
+    let mut windows = String::from(
+        "\n**What the targets leave a prediction.** A prediction p meets a target tol on every record r at its \
+         pressure at once only inside [max r · (1 − tol), min r · (1 + tol)]: the records and the targets alone \
+         fix that window, whatever the model. Its width is given relative to the records' mean; where it is \
+         narrow, a model must predict the pressure to a small part of its own records' scatter.\n\n\
+         | psi | metric | target | records' spread | window | width (of the mean) |\n|---|---|---|---|---|---|\n",
+    );
     for (held, &psi) in PRESSURES_PSI.iter().enumerate() {
         let recs: Vec<&Record> = records.iter().filter(|r| r.psi == psi).collect();
         let samples: Vec<String> = recs.iter().map(|r| r.sample.to_string()).collect();
@@ -1170,6 +1179,24 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
             let mean = vals.iter().sum::<f64>() / vals.len() as f64;
             let (lo, hi) = min_max(vals.iter().copied());
             let spread = (hi - lo) / mean;
+            let (w_lo, w_hi) = (hi * (1.0 - TOL[j]), lo * (1.0 + TOL[j]));
+            let d2 = dec + 1;
+            let _ = writeln!(
+                windows,
+                "| {psi} | {name} | {:.0} % | {:.1} % | {} | {} |",
+                100.0 * TOL[j],
+                100.0 * spread,
+                if w_lo <= w_hi {
+                    format!("{:.d2$}–{:.d2$} {unit}", w_lo * scale, w_hi * scale)
+                } else {
+                    "none".to_string()
+                },
+                if w_lo <= w_hi {
+                    format!("{:.1} %", 100.0 * (w_hi - w_lo) / mean)
+                } else {
+                    "—".to_string()
+                }
+            );
             let shown: Vec<String> = vals
                 .iter()
                 .map(|v| format!("{:.dec$}", v * scale))
@@ -1210,6 +1237,7 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
             let _ = writeln!(s, "{row}");
         }
     }
+    s.push_str(&windows);
     let _ = writeln!(
         s,
         "\n**The misses against that scatter.** Every held-out record outside its target, with the prediction's \
