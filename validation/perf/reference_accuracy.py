@@ -11,6 +11,9 @@ each under the default `dynamic` unloading, and the `pochhammer-chree` and `love
 under `dynamic-continuous` (where the signals converge: like against like for the old and the new
 `reference`); then compares every run with the finest run of its ladder and every run with
 the next finer one (docs/physics.md §3, "A continuous turn"; validation/perf/REPORT.md).
+Last, under each unloading, the old and the new `reference` and `standard` against one converged
+solution, the finest `pochhammer-chree` run (the first mode of the elastic cylinder, exact
+dispersion): the accuracy a user gets, model error and discretisation together.
 
 Metrics, each relative: peak contact force and the approach at it (parabola through the three
 samples around the largest force before the largest approach), and the RMS differences of the transmission-gauge strain, the
@@ -38,6 +41,14 @@ LADDERS = [
     ("love-rod", "dynamic", LADDER_MM[3:]),
     ("pochhammer-chree", "dynamic-continuous", LADDER_MM),
     ("love-rod", "dynamic-continuous", LADDER_MM[3:]),
+]
+
+
+# The presets compared with the converged solution: (label, dispersion, cell in mm).
+CROSS = [
+    ("reference (pochhammer-chree, 1 mm)", "pochhammer-chree", 1.0),
+    ("old reference (love-rod, 0.125 mm)", "love-rod", 0.125),
+    ("standard (none, 1 mm)", "none", 1.0),
 ]
 
 
@@ -123,6 +134,7 @@ def main():
         "columns: relative peak force, approach at peak, RMS of the transmission gauge, the incident gauge",
         "and the contact force (each over its series' largest magnitude)",
     ]
+    kept = {}
     with tempfile.TemporaryDirectory() as work:
         for dispersion, unloading, ladder in LADDERS:
             runs = {}
@@ -139,6 +151,20 @@ def main():
             lines.append("  each run against the next finer one:")
             for a, b in zip(ladder[:-1], ladder[1:]):
                 lines.append(row(a, compare(runs[a], runs[b])))
+            kept[(dispersion, unloading)] = runs
+        for unloading in ("dynamic", "dynamic-continuous"):
+            exact = kept[("pochhammer-chree", unloading)]
+            converged = exact[LADDER_MM[-1]]
+            lines.append("")
+            lines.append(
+                f"against the converged solution (pochhammer-chree at {LADDER_MM[-1]} mm), "
+                f"unloading = {unloading}:"
+            )
+            lines.append("  preset                                " + HEADER.strip())
+            for label, dispersion, cell in CROSS:
+                if (dispersion, unloading) in kept:
+                    r = kept[(dispersion, unloading)][cell]
+                    lines.append(f"  {label:<36}" + row(cell, compare(r, converged)))
     write(args.out, lines)
 
 
