@@ -151,10 +151,11 @@ def main():
             lines.append("  each run against the next finer one:")
             for a, b in zip(ladder[:-1], ladder[1:]):
                 lines.append(row(a, compare(runs[a], runs[b])))
-            kept[(dispersion, unloading)] = runs
-        for unloading in ("dynamic", "dynamic-continuous"):
-            exact = kept[("pochhammer-chree", unloading)]
-            converged = exact[LADDER_MM[-1]]
+            # Only the runs the cross table reads: the converged one and the presets'.
+            needed = {ladder[-1]} | {cell for _, d, cell in CROSS if d == dispersion}
+            kept[(dispersion, unloading)] = {c: runs[c] for c in needed if c in runs}
+        for unloading in dict.fromkeys(u for _, u, _ in LADDERS):
+            converged = kept[("pochhammer-chree", unloading)][LADDER_MM[-1]]
             lines.append("")
             lines.append(
                 f"against the converged solution (pochhammer-chree at {LADDER_MM[-1]} mm), "

@@ -1181,21 +1181,19 @@ fn scatter_section(records: &[Record], models: &[ModelFits], folds: &[Vec<Fold>]
             let spread = (hi - lo) / mean;
             let (w_lo, w_hi) = (hi * (1.0 - TOL[j]), lo * (1.0 + TOL[j]));
             let d2 = dec + 1;
+            let (window, width) = if w_lo <= w_hi {
+                (
+                    format!("{:.d2$}–{:.d2$} {unit}", w_lo * scale, w_hi * scale),
+                    format!("{:.1} %", 100.0 * (w_hi - w_lo) / mean),
+                )
+            } else {
+                ("none".to_string(), "—".to_string())
+            };
             let _ = writeln!(
                 windows,
-                "| {psi} | {name} | {:.0} % | {:.1} % | {} | {} |",
+                "| {psi} | {name} | {:.0} % | {:.1} % | {window} | {width} |",
                 100.0 * TOL[j],
                 100.0 * spread,
-                if w_lo <= w_hi {
-                    format!("{:.d2$}–{:.d2$} {unit}", w_lo * scale, w_hi * scale)
-                } else {
-                    "none".to_string()
-                },
-                if w_lo <= w_hi {
-                    format!("{:.1} %", 100.0 * (w_hi - w_lo) / mean)
-                } else {
-                    "—".to_string()
-                }
             );
             let shown: Vec<String> = vals
                 .iter()
