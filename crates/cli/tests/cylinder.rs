@@ -17,8 +17,8 @@
 
 use shpb::prelude::*;
 use shpb::scene::{Params, SceneParams};
-use shpb_core::apparatus::CylinderSpecimen;
 use shpb_core::reduce_cylinder::{CylinderGeometry, MODULUS_WINDOW, WaveAnalysis, loading_modulus};
+use shpb_core::specimen::CylinderSpecimen;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -30,10 +30,15 @@ const SCENE: &str = "scenes/shpb-cylinder-al.toml";
 
 /// The scene's cylinder (the input the reduction must give back).
 fn cylinder_of(params: &Params) -> CylinderSpecimen {
-    let SceneParams::Pulse { options, .. } = &params.params else {
-        panic!("not a bar scene")
-    };
-    options.cylinder.expect("a cylinder specimen")
+    assert!(
+        matches!(params.params, SceneParams::Pulse { .. }),
+        "not a bar scene"
+    );
+    *params
+        .specimen
+        .as_ref()
+        .and_then(|s| s.cylinder())
+        .expect("a cylinder specimen")
 }
 
 fn summary(out: &shpb::run::RunOutput, key: &str) -> f64 {

@@ -221,8 +221,9 @@ fn run_with_step(params: &Params, divide: f64) -> solver::ForceDrivenResult {
     };
     let mut s = setup.clone();
     s.dt_s /= divide;
-    let law = params.contact_law();
-    solver::force_driven(law.as_ref(), &params.pair, &s).unwrap()
+    let (pair, law) = params.pair_and_law().unwrap();
+    let law = law.build(pair.contact_properties());
+    solver::force_driven(law.as_ref(), &pair, &s).unwrap()
 }
 
 fn at_peak(r: &solver::ForceDrivenResult) -> (f64, f64) {
@@ -279,8 +280,9 @@ fn force_driven_energy_balances() {
     let SceneParams::ForceDriven { setup, .. } = &params.params else {
         unreachable!()
     };
-    let law = params.contact_law();
-    let r = solver::force_driven(law.as_ref(), &params.pair, setup).unwrap();
+    let (pair, law) = params.pair_and_law().unwrap();
+    let law = law.build(pair.contact_properties());
+    let r = solver::force_driven(law.as_ref(), &pair, setup).unwrap();
     let e = r.energy;
     let balance = e.contact_work_j + e.radiated_j + r.kinetic_energy_j;
     assert!(

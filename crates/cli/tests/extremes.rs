@@ -418,7 +418,7 @@ fn very_soft_on_very_stiff_spheres_with_modulus_ratio_1000() {
                 [specimen.sphere2]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n";
     let params = Params::from_toml(text, "soft-on-stiff.toml", &dir).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
-    assert_eq!(params.pair, soft_on_stiff);
+    assert_eq!(params.sphere_pair().unwrap().0, soft_on_stiff);
     summary_finite(&params.run().unwrap(), "soft-on-stiff scene");
 }
 
@@ -478,12 +478,13 @@ fn force_driven_time_step_at_0_99_runs_and_at_1_01_is_refused() {
     let SceneParams::ForceDriven { setup, .. } = &base.params else {
         unreachable!()
     };
-    let limit = solver::stability_limit(&base.pair, setup.drive.peak_n());
+    let limit = solver::stability_limit(&base.sphere_pair().unwrap().0, setup.drive.peak_n());
     let p = scene(&format!("time_step_s = {:e}\n", 0.99 * limit)).unwrap();
     let SceneParams::ForceDriven { setup, .. } = &p.params else {
         unreachable!()
     };
-    let r = solver::force_driven(p.contact_law().as_ref(), &p.pair, setup).unwrap();
+    let pair = p.sphere_pair().unwrap().0;
+    let r = solver::force_driven(p.contact_law().unwrap().as_ref(), &pair, setup).unwrap();
     let e = r.energy;
     println!(
         "0.99 of {limit:e} s: {} steps, W_ext {:e} J, ledger error {:e}",
@@ -722,7 +723,8 @@ fn a_10_ms_force_driven_run_stays_finite_and_conserves_energy() {
         unreachable!()
     };
     let start = std::time::Instant::now();
-    let r = solver::force_driven(p.contact_law().as_ref(), &p.pair, setup).unwrap();
+    let pair = p.sphere_pair().unwrap().0;
+    let r = solver::force_driven(p.contact_law().unwrap().as_ref(), &pair, setup).unwrap();
     let e = r.energy;
     let closure = (e.external_work_j - r.kinetic_energy_j - e.contact_work_j - e.radiated_j).abs();
     println!(
@@ -759,7 +761,7 @@ fn a_10_ms_force_driven_run_stays_finite_and_conserves_energy() {
     let speed = (d[k] - d[k - 1]) / (t[k] - t[k - 1]);
     let earlier = (d[k - 1] - d[k - 2]) / (t[k - 1] - t[k - 2]);
     assert!(rel(speed, earlier) < 1e-6, "{speed} vs {earlier} m/s");
-    let ke1 = 0.5 * p.pair.sphere1.mass_kg * speed * speed;
+    let ke1 = 0.5 * p.sphere_pair().unwrap().0.sphere1.mass_kg * speed * speed;
     assert!(
         rel(ke1, r.kinetic_energy_j) < 1e-6,
         "{ke1:e} vs {:e} J",

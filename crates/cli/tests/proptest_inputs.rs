@@ -325,9 +325,10 @@ fn run_if_cheap(p: &Params) -> Result<(), TestCaseError> {
             *points <= 200_000
         }
         SceneParams::Collision(setup) => {
-            let c = p.pair.contact_properties();
+            let pair = p.sphere_pair().unwrap().0;
+            let c = pair.contact_properties();
             let tc = shpb::solver::hertz_impact_duration(
-                p.pair.reduced_mass_kg(),
+                pair.reduced_mass_kg(),
                 c.e_star_pa,
                 c.radius_m,
                 setup.velocity1_m_s - setup.velocity2_m_s,

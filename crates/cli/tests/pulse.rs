@@ -348,19 +348,25 @@ fn most_pulse_energy_follows_momentum_and_energy_conservation() {
     }
 }
 
-/// A `kind` scene of the authors' set-up with `extra` keys: its apparatus and bar-run options.
-fn bar_run(kind: &str, extra: &str) -> (Apparatus, shpb::apparatus::PulseOptions) {
+/// A `kind` scene of the authors' set-up with `extra` keys: its apparatus, bar-run options and
+/// specimen.
+fn bar_run(
+    kind: &str,
+    extra: &str,
+) -> (
+    Apparatus,
+    shpb::apparatus::PulseOptions,
+    Option<shpb_core::specimen::Specimen>,
+) {
     let text = format!(
         "kind = \"{kind}\"\nbars = \"{}\"\n{extra}",
         root().join("bars/authors.toml").display()
     );
-    match Params::from_toml(&text, "insert-test.toml", Path::new("."))
-        .unwrap()
-        .params
-    {
+    let params = Params::from_toml(&text, "insert-test.toml", Path::new(".")).unwrap();
+    match params.params {
         SceneParams::Pulse {
             apparatus, options, ..
-        } => (*apparatus, *options),
+        } => (*apparatus, *options, params.specimen),
         _ => unreachable!(),
     }
 }
@@ -369,8 +375,9 @@ fn bar_run(kind: &str, extra: &str) -> (Apparatus, shpb::apparatus::PulseOptions
 fn gauge_strains(
     a: &Apparatus,
     o: &shpb::apparatus::PulseOptions,
+    specimen: Option<&shpb_core::specimen::Specimen>,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let setup = a.pulse_chain(o);
+    let setup = a.pulse_chain(o, specimen);
     let r = shpb::solver::simulate_chain(&setup).unwrap();
     let k = |n: &str| setup.gauges.iter().position(|g| g.name == n).unwrap();
     (
@@ -403,18 +410,18 @@ fn insert_only_delays(length_m: f64, tolerance: f64) {
     // meet no impedance change, so the incident pulse is unchanged and the reflected and
     // transmitted pulses are the same as without inserts, later by the extra path
     // 2 L/c0 (reflected: in and out of the incident insert; transmitted: through both inserts).
-    let (mut a, o) = bar_run(
+    let (mut a, o, sp) = bar_run(
         "shpb",
         "pressure = \"10psi\"\nend_time_s = 620e-6\n[specimen]\npair = \"ss440c\"\n",
     );
-    let (t, inc0, tra0) = gauge_strains(&a, &o);
+    let (t, inc0, tra0) = gauge_strains(&a, &o, sp.as_ref());
     let ins = shpb::apparatus::Insert {
         length_m,
         ..quarter_inch_insert(&a)
     };
     a.inserts.incident = Some(ins);
     a.inserts.transmission = Some(ins);
-    let (t1, inc1, tra1) = gauge_strains(&a, &o);
+    let (t1, inc1, tra1) = gauge_strains(&a, &o, sp.as_ref());
     assert_eq!(t, t1);
     let c0 = a.material.wave_speed_m_s();
     let delay = 2.0 * ins.length_m / c0;
@@ -471,7 +478,7 @@ fn an_insert_of_another_impedance_transmits_and_reflects_as_impedance_theory_say
     // pulse in the transmission bar has crossed two interfaces: force ratio
     // T = 2Z2/(Z1+Z2) · 2Z1/(Z1+Z2) = 4 Z1 Z2/(Z1+Z2)² = 0.64; the incident gauge sees the
     // reflection R = (Z2 − Z1)/(Z1 + Z2) = −0.6 of the incident force (tension).
-    let (mut a, o) = bar_run(
+    let (mut a, o, sp) = bar_run(
         "pulse",
         "pressure = \"10psi\"\nincident_end = \"transmission\"\nend_time_s = 450e-6\n[shaper]\nenabled = false\n",
     );
@@ -481,7 +488,7 @@ fn an_insert_of_another_impedance_transmits_and_reflects_as_impedance_theory_say
         length_m: 0.3,
     };
     a.inserts.incident = Some(ins);
-    let (t, inc, tra) = gauge_strains(&a, &o);
+    let (t, inc, tra) = gauge_strains(&a, &o, sp.as_ref());
     let (z1, z2) = (1.0, 0.25);
     let t_expected = 4.0 * z1 * z2 / ((z1 + z2) * (z1 + z2));
     let r_expected = (z2 - z1) / (z1 + z2);
@@ -531,22 +538,22 @@ fn an_insert_of_another_impedance_transmits_and_reflects_as_impedance_theory_say
 fn an_insert_shorter_than_a_cell_is_a_rigid_mass() {
     // 0.5 mm at 1 mm cells: one rigid body of ρAL. The chain runs and the insert's mass shows in
     // the setup; its transit (0.1 µs) is below one step.
-    let (mut a, o) = bar_run(
+    let (mut a, o, sp) = bar_run(
         "shpb",
         "pressure = \"10psi\"\nend_time_s = 100e-6\n[specimen]\npair = \"ss440c\"\n",
     );
     let mut ins = quarter_inch_insert(&a);
     ins.length_m = 0.5e-3;
     a.inserts.incident = Some(ins);
-    let setup = a.pulse_chain(&o);
+    let setup = a.pulse_chain(&o, sp.as_ref());
     let mass = setup.bodies.iter().find_map(|b| match b {
         shpb::solver::BodySpec::Mass(m) if m.name == "incident insert" => Some(m.mass_kg),
         _ => None,
     });
     // The first sphere sits on the rigid insert, so its mass is the insert's plus the sphere's.
-    let sphere = match &o.specimen {
-        Some(s) => s.spheres.spheres[0].mass_kg,
-        None => unreachable!(),
+    let sphere = match &sp {
+        Some(shpb_core::specimen::Specimen::Spheres(s)) => s.chain.spheres[0].mass_kg,
+        _ => unreachable!(),
     };
     assert!(rel(mass.unwrap(), ins.mass_kg() + sphere) < 1e-12);
     shpb::solver::simulate_chain(&setup).unwrap();

@@ -20,7 +20,9 @@ fn reduction_of_simulated_records_recovers_the_true_contact() {
         let input = ReductionInput::from_noise_free_gauges(&out).unwrap();
         let options = ReductionOptions {
             dispersion: shpb::reduce::DispersionCorrection::None,
-            specimen_radii_m: Some((params.pair.sphere1.radius_m, params.pair.sphere2.radius_m)),
+            specimen_radii_m: params
+                .sphere_pair()
+                .map(|(p, _)| (p.sphere1.radius_m, p.sphere2.radius_m)),
             ..Default::default()
         };
         let r = reduce(

@@ -174,88 +174,9 @@ pub enum IncidentEnd {
     Specimen,
 }
 
-/// The specimen of a full test: two or more spheres in a line and their contact law.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SpecimenSetup {
-    /// The spheres (sphere 1 on the incident bar, the last on the transmission bar; a pair is
-    /// the chain of two).
-    pub spheres: crate::specimen::SphereChain,
-    /// Contact law.
-    pub law: crate::contact::LawKind,
-    /// Form of region II of the loading law.
-    pub region2: crate::contact::Region2Form,
-    /// Unloading rule of the contact law.
-    pub unloading: crate::contact::Unloading,
-    /// How the spheres sit between the bars before the test (every contact).
-    pub seating: crate::specimen::Seating,
-}
-
-/// Fewest cells the chain gives a cylindrical specimen (docs/physics.md §6.9): its lowest
-/// longitudinal mode (half a wavelength over L_s) on ≥ 4 cells, and its Courant number
-/// n c_s Δt/L_s ≥ 0.8, so its ring-up (a few transits L_s/c_s) is resolved in time and space.
-pub const CYLINDER_MIN_CELLS: usize = 4;
-
-/// An elastic cylindrical specimen between the bars (docs/physics.md §6.9): a bar segment of its
-/// own material and diameter, pressed on both bars (or inserts) by compression-only butt joints.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CylinderSpecimen {
-    /// Material (E, ν, ρ), as for bars and inserts.
-    pub material: BarMaterial,
-    /// Diameter d_s, m.
-    pub diameter_m: f64,
-    /// Length L_s along the bar axis, m.
-    pub length_m: f64,
-}
-
-impl CylinderSpecimen {
-    /// The specimen as one uniform bar segment.
-    pub fn segment(&self) -> Segment {
-        Segment {
-            length_m: self.length_m,
-            diameter_m: self.diameter_m,
-            material: self.material,
-        }
-    }
-
-    /// Cross-section A_s = π d_s²/4, m².
-    pub fn area_m2(&self) -> f64 {
-        self.segment().area_m2()
-    }
-
-    /// One-way wave transit L_s/c_s, s (c_s = √(E_s/ρ_s), docs/physics.md §6.9).
-    pub fn transit_s(&self) -> f64 {
-        self.length_m / self.material.wave_speed_m_s()
-    }
-
-    /// Cells the chain gives the specimen at time step `dt_s`: ⌊L_s/(c_s Δt)⌋ (Courant ≤ 1, as
-    /// every bar segment, docs/physics.md §6.2).
-    pub fn cells_at(&self, dt_s: f64) -> usize {
-        let s = self.segment();
-        crate::bar::BarSpec {
-            name: "specimen".into(),
-            segments: vec![s],
-            left_end: EndCondition::Free,
-            right_end: EndCondition::Free,
-            dispersion: Dispersion::None,
-        }
-        .cells_for_time_step(dt_s)[0]
-    }
-
-    /// Largest bar cell (Δx = c0 Δt, Courant 1 in bars of speed `bar_wave_speed_m_s`) that gives
-    /// the specimen at least `cells` cells: c0 L_s/(c_s · cells), m.
-    pub fn largest_bar_cell_m(&self, bar_wave_speed_m_s: f64, cells: usize) -> f64 {
-        bar_wave_speed_m_s * self.transit_s() / cells as f64
-    }
-}
-
 /// Options of a bar run (what a `pulse` or `shpb` scene sets).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PulseOptions {
-    /// The sphere specimen, when `end` is `IncidentEnd::Specimen` (None with a cylinder).
-    pub specimen: Option<SpecimenSetup>,
-    /// A cylindrical specimen instead of spheres, when `end` is `IncidentEnd::Specimen`
-    /// (docs/physics.md §6.9).
-    pub cylinder: Option<CylinderSpecimen>,
     /// Striker impact velocity, m/s.
     pub striker_velocity_m_s: f64,
     /// Pulse shaper (None: striker on bar).
@@ -361,8 +282,13 @@ impl IncidentDrive {
 }
 
 impl Apparatus {
-    /// The chain striker → (shaper) → incident (→ transmission) at Courant 1 in the bars.
-    pub fn pulse_chain(&self, o: &PulseOptions) -> crate::solver::ChainSetup {
+    /// The chain striker → (shaper) → incident (→ specimen) (→ transmission) at Courant 1 in the
+    /// bars; `specimen` sits between the bars when `o.end` is [`IncidentEnd::Specimen`].
+    pub fn pulse_chain(
+        &self,
+        o: &PulseOptions,
+        specimen: Option<&crate::specimen::Specimen>,
+    ) -> crate::solver::ChainSetup {
         use crate::solver::{ChainSetup, GaugeProbe, Joint};
         let c0 = self.material.wave_speed_m_s();
         let dt = o.cell_size_m / c0;
@@ -447,9 +373,6 @@ impl Apparatus {
                 bodies.push(insert_body("incident insert", i));
                 joints.push(Joint::Butt);
             }
-            // The body the specimen (or the transmission side) presses on first.
-            let front = bodies.len() - 1;
-            let mut sphere_masses = Vec::new();
             let mut tail = Vec::new();
             let mut tail_joints = Vec::new();
             if let Some(i) = &self.inserts.transmission {
@@ -457,48 +380,16 @@ impl Apparatus {
                 tail_joints.push(Joint::Butt);
             }
             tail.push(transmission.into());
-            match &o.specimen {
+            // The specimen brings its own bodies and joints (docs/physics.md §6.9, §8).
+            let sphere_masses = match specimen {
                 Some(sp) if end == IncidentEnd::Specimen => {
-                    // The first and last spheres' masses join the end nodes of the bodies they
-                    // touch (the paper's DEM); the spheres between are rigid masses, every two
-                    // neighbours joined by a contact (docs/physics.md §8).
-                    let n = sp.spheres.len();
-                    for k in 0..n - 1 {
-                        joints.push(Joint::Spheres {
-                            props: sp.spheres.contact_properties(k),
-                            law: sp.law,
-                            region2: sp.region2,
-                            unloading: sp.unloading,
-                            seating: sp.seating,
-                        });
-                        if k + 2 < n {
-                            bodies.push(crate::solver::BodySpec::Mass(crate::solver::MassSpec {
-                                name: format!("sphere {}", k + 2),
-                                mass_kg: sp.spheres.spheres[k + 1].mass_kg,
-                            }));
-                        }
-                    }
-                    let back = bodies.len();
-                    sphere_masses.push((front, true, sp.spheres.spheres[0].mass_kg));
-                    sphere_masses.push((back, false, sp.spheres.spheres[n - 1].mass_kg));
+                    join_specimen(sp, &mut bodies, &mut joints)
                 }
-                _ => match &o.cylinder {
-                    // A cylinder is a bar segment of its own between two butt joints, as an
-                    // insert (docs/physics.md §6.9).
-                    Some(c) if end == IncidentEnd::Specimen => {
-                        bodies.push(crate::solver::BodySpec::Bar(BarSpec {
-                            name: "specimen".to_string(),
-                            segments: vec![c.segment()],
-                            left_end: EndCondition::Free,
-                            right_end: EndCondition::Free,
-                            dispersion: Dispersion::None,
-                        }));
-                        joints.push(Joint::Butt);
-                        joints.push(Joint::Butt);
-                    }
-                    _ => joints.push(Joint::Butt),
-                },
-            }
+                _ => {
+                    joints.push(Joint::Butt);
+                    Vec::new()
+                }
+            };
             bodies.extend(tail);
             // A sphere on a rigid insert adds to its mass; on a bar, to its end node.
             for (k, right, m) in sphere_masses {
@@ -647,20 +538,21 @@ impl Apparatus {
                 "a set-up with an incident gauge",
             )
         })?;
-        let setup = self.pulse_chain(&PulseOptions {
-            specimen: None,
-            cylinder: None,
-            striker_velocity_m_s,
-            shaper,
-            end: IncidentEnd::Transmission,
-            cell_size_m,
-            dispersion: Dispersion::None,
-            end_time_s,
-            gauge_length_m,
-            snapshot_interval_s: None,
-            reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
-            incident_drive: None,
-        });
+        let setup = self.pulse_chain(
+            &PulseOptions {
+                striker_velocity_m_s,
+                shaper,
+                end: IncidentEnd::Transmission,
+                cell_size_m,
+                dispersion: Dispersion::None,
+                end_time_s,
+                gauge_length_m,
+                snapshot_interval_s: None,
+                reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
+                incident_drive: None,
+            },
+            None,
+        );
         let k = setup
             .gauges
             .iter()
@@ -756,5 +648,58 @@ mod tests {
         assert_eq!(d.stress_at_pa(-1e-9), 0.0);
         assert_eq!(d.stress_at_pa(2.5e-6), 0.0);
         assert_eq!(d.stress_at_pa(f64::NAN), 0.0);
+    }
+}
+
+/// Puts a specimen into a bar chain after the last of `bodies` (the incident bar or its insert)
+/// and before the transmission side; returns the masses to add to the end nodes of bodies, as
+/// (body index, right end, mass in kg).
+fn join_specimen(
+    specimen: &crate::specimen::Specimen,
+    bodies: &mut Vec<crate::solver::BodySpec>,
+    joints: &mut Vec<crate::solver::Joint>,
+) -> Vec<(usize, bool, f64)> {
+    use crate::solver::{BodySpec, Joint, MassSpec};
+    use crate::specimen::Specimen;
+    match specimen {
+        // The first and last spheres' masses join the end nodes of the bodies they touch (the
+        // paper's DEM); the spheres between are rigid masses, every two neighbours joined by a
+        // contact (docs/physics.md §8).
+        Specimen::Spheres(sp) => {
+            let front = bodies.len() - 1;
+            let n = sp.chain.len();
+            for k in 0..n - 1 {
+                joints.push(Joint::Spheres {
+                    props: sp.chain.contact_properties(k),
+                    law: sp.law,
+                    seating: sp.seating,
+                });
+                if k + 2 < n {
+                    bodies.push(BodySpec::Mass(MassSpec {
+                        name: format!("sphere {}", k + 2),
+                        mass_kg: sp.chain.spheres[k + 1].mass_kg,
+                    }));
+                }
+            }
+            let back = bodies.len();
+            vec![
+                (front, true, sp.chain.spheres[0].mass_kg),
+                (back, false, sp.chain.spheres[n - 1].mass_kg),
+            ]
+        }
+        // A cylinder is a bar segment of its own between two butt joints, as an insert
+        // (docs/physics.md §6.9).
+        Specimen::Cylinder(c) => {
+            bodies.push(BodySpec::Bar(BarSpec {
+                name: "specimen".to_string(),
+                segments: vec![c.segment()],
+                left_end: EndCondition::Free,
+                right_end: EndCondition::Free,
+                dispersion: Dispersion::None,
+            }));
+            joints.push(Joint::Butt);
+            joints.push(Joint::Butt);
+            Vec::new()
+        }
     }
 }

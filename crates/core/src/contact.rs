@@ -3,7 +3,6 @@
 //!
 //! Sign convention (docs/physics.md): approach δ and contact force F are positive in compression.
 
-use crate::specimen::ContactProperties;
 use std::f64::consts::PI;
 
 /// The constant 1.6 of the yield onset, from maximising J2 below a Hertz contact (paper Sec. II).
@@ -904,6 +903,52 @@ impl ContactLaw for BurgoyneDaraio {
 
     fn is_rate_dependent(&self) -> bool {
         self.rate_dependent && self.props.rate.c != 0.0
+    }
+}
+
+/// Effective properties of a pair as used by the contact law (paper Sec. II; authors' code for
+/// dissimilar spheres: the yield stress and rate hardening of the weaker sphere).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactProperties {
+    /// Effective modulus E* = [(1−ν1²)/E1 + (1−ν2²)/E2]⁻¹, Pa.
+    pub e_star_pa: f64,
+    /// Effective radius r = (1/r1 + 1/r2)⁻¹, m.
+    pub radius_m: f64,
+    /// r1 + r2, the length in the global strain rate of paper Eq. 3, m.
+    pub sum_of_radii_m: f64,
+    /// Quasi-static yield stress min(σy1, σy2), Pa.
+    pub yield_stress_pa: f64,
+    /// Rate hardening of the sphere with the smaller yield stress (paper Eq. 2).
+    pub rate: crate::material::JohnsonCook,
+    /// Bar wave speed c0 = √(E/ρ) of the slower sphere, m/s (vibration loss, docs/physics.md §3).
+    pub wave_speed_m_s: f64,
+}
+
+/// A contact law with its own parameters (docs/physics.md §1–§3): the law, the form of region II
+/// and the unloading rule (the last two ignored by Hertz). One value travels from the scene to
+/// every contact built from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LawSpec {
+    /// The law (`law` scene key).
+    pub kind: LawKind,
+    /// Form of region II of the loading law (`region2`).
+    pub region2: Region2Form,
+    /// Unloading rule (`unloading`).
+    pub unloading: Unloading,
+}
+
+impl LawSpec {
+    /// The law `kind` with the default region II (smooth) and unloading (dynamic).
+    pub fn of(kind: LawKind) -> LawSpec {
+        LawSpec {
+            kind,
+            ..LawSpec::default()
+        }
+    }
+
+    /// Builds the law with its memory for a pair's effective properties.
+    pub fn build(self, props: ContactProperties) -> Box<dyn Contact> {
+        self.kind.build_options(props, self.region2, self.unloading)
     }
 }
 

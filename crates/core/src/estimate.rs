@@ -26,6 +26,7 @@
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::scene::{Params, SceneParams};
 use crate::solver::BodySpec;
+use crate::specimen::Specimen;
 
 /// Bytes of one stored number.
 const F64: f64 = 8.0;
@@ -123,7 +124,7 @@ impl Params {
             }
             SceneParams::Pulse {
                 apparatus, options, ..
-            } => bar_run(apparatus, options),
+            } => bar_run(apparatus, options, self.specimen.as_ref()),
             SceneParams::Chain(setup) => {
                 // Every output_every-th step of N − 1 forces and approaches, N velocities, the
                 // time, the first contact's 5 series and 3 end series, allocated once.
@@ -144,10 +145,14 @@ impl Params {
     }
 }
 
-/// The estimate of a `pulse` or `shpb` run of `apparatus` with `options` (module docs), before
-/// its bars are built.
-pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
-    let chain = apparatus.pulse_chain(options);
+/// The estimate of a `pulse` or `shpb` run of `apparatus` with `options` and `specimen` (module
+/// docs), before its bars are built.
+pub fn bar_run(
+    apparatus: &Apparatus,
+    options: &PulseOptions,
+    specimen: Option<&Specimen>,
+) -> RunEstimate {
+    let chain = apparatus.pulse_chain(options, specimen);
     let dt = chain.dt_s;
     let steps = (options.end_time_s / dt).ceil();
     let mut nodes = 0.0;
@@ -174,7 +179,8 @@ pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
     // ledger (4 series, growing), the contact (5 series, allocated once).
     let recorded = (steps / chain.record_every as f64).floor() + 2.0;
     let gauges = chain.gauges.len() as f64;
-    let contact = if options.specimen.is_some() { 5.0 } else { 0.0 };
+    let spheres = specimen.is_some_and(|s| s.spheres().is_some());
+    let contact = if spheres { 5.0 } else { 0.0 };
     let recorders = recorded * F64 * ((gauges + 1.0) + 4.0 * GROWTH + contact);
     // x–t snapshots: one row per bar per snapshot.
     let snapshots = chain
@@ -190,7 +196,7 @@ pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
         .fold(0.0, f64::max);
     let digitised = (options.end_time_s * rate).floor();
     let post = digitised * F64 * (DIGITISED_SERIES + 3.0 * gauges);
-    let reduction = if options.specimen.is_some() || options.cylinder.is_some() {
+    let reduction = if specimen.is_some() {
         // /reduction: 15 series at most of the window's length (shorter than the record).
         15.0 * digitised
     } else {
@@ -213,7 +219,7 @@ pub fn bar_run(apparatus: &Apparatus, options: &PulseOptions) -> RunEstimate {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{LawKind, Region2Form, Unloading};
+    use crate::contact::{LawKind, LawSpec};
     use crate::fidelity::Fidelity;
     use crate::solver::{CollisionSetup, ForceDrivenSetup, ForceHistory};
 
@@ -222,11 +228,11 @@ mod tests {
             source: "test.toml".into(),
             text: String::new(),
             kind: "test".into(),
-            pair: crate::fixtures::ss440c_pair(),
-            law: LawKind::BurgoyneDaraio,
+            specimen: Some(Specimen::Spheres(crate::specimen::SphereSpecimen::pair(
+                &crate::fixtures::ss440c_pair(),
+                LawSpec::of(LawKind::BurgoyneDaraio),
+            ))),
             fidelity: Fidelity::Standard,
-            region2: Region2Form::Smooth,
-            unloading: Unloading::default(),
             params: p,
         }
     }

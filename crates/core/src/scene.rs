@@ -1,18 +1,17 @@
-//! A validated virtual test ([`Params`]: specimen, contact law, fidelity and the kind-specific
+//! A validated virtual test ([`Params`]: specimen with its contact law, fidelity and the kind-specific
 //! [`SceneParams`]) and how it runs into a [`RunOutput`]. Scene files are parsed into it by
 //! `shpb-input`; nothing here reads a file.
 
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::bar::Dispersion;
-use crate::contact::{Contact, Degenerate, LawKind, LoadingCurve, Region2Form, Unloading};
+use crate::contact::{Contact, Degenerate, LawKind, LawSpec, LoadingCurve};
 use crate::error::{Result, format_si};
 use crate::fidelity::Fidelity;
 use crate::material::JOHNSON_COOK_RATE_LIMIT_PER_S;
 use crate::numeric::resample;
 use crate::run::{RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
-use crate::specimen::MODEL_APPROACH_LIMIT_OF_RADIUS;
-use crate::specimen::SpherePair;
+use crate::specimen::{MODEL_APPROACH_LIMIT_OF_RADIUS, Specimen, SpherePair};
 
 /// Impedance Z = ρ c0 A of the authors' transmission bar (ρ 8110 kg/m³, c0 4865.5 m/s,
 /// radius 9.525 mm; docs/physics.md §5), kg/s.
@@ -71,30 +70,46 @@ pub struct Params {
     pub text: String,
     /// Scene kind name.
     pub kind: String,
-    /// The specimen.
-    pub pair: SpherePair,
-    /// The contact law selected.
-    pub law: LawKind,
+    /// The specimen with its own model (spheres with their contact law, or a cylinder); None
+    /// for a `pulse` scene, which has none.
+    pub specimen: Option<Specimen>,
     /// The fidelity preset the numerical knobs were taken from (explicit keys win).
     pub fidelity: Fidelity,
-    /// Form of region II of the loading law (`smooth` C¹ default, or `published`).
-    pub region2: Region2Form,
-    /// Unloading rule of the contact law (`dynamic` default, `static`, `authors`).
-    pub unloading: Unloading,
     /// Kind-specific parameters.
     pub params: SceneParams,
 }
 
 impl Params {
-    /// The contact law of this scene.
-    pub fn contact_law(&self) -> Box<dyn Contact> {
-        self.law
-            .build_options(self.pair.contact_properties(), self.region2, self.unloading)
+    /// The first pair of a sphere specimen and its contact law (None for a cylinder or no
+    /// specimen).
+    pub fn sphere_pair(&self) -> Option<(SpherePair, LawSpec)> {
+        let sp = self.specimen.as_ref()?.spheres()?;
+        Some((sp.first_pair(), sp.law))
+    }
+
+    /// The first pair and law of a sphere scene, or an error naming the scene.
+    pub fn pair_and_law(&self) -> Result<(SpherePair, LawSpec)> {
+        self.sphere_pair().ok_or_else(|| {
+            crate::error::Named::new(self.source.clone()).error(
+                "specimen",
+                format!("a `{}` scene needs two spheres", self.kind),
+                "a pair of spheres",
+            )
+        })
+    }
+
+    /// The contact law of this scene's first pair of spheres (None without spheres).
+    pub fn contact_law(&self) -> Option<Box<dyn Contact>> {
+        self.sphere_pair()
+            .map(|(pair, law)| law.build(pair.contact_properties()))
     }
 
     /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).
     pub fn warnings(&self) -> Vec<String> {
-        let p = self.pair.contact_properties();
+        let Some((pair, _)) = self.sphere_pair() else {
+            return vec![];
+        };
+        let p = pair.contact_properties();
         let c = LoadingCurve::new(p.e_star_pa, p.radius_m, p.yield_stress_pa);
         let q = p.e_star_pa / p.yield_stress_pa;
         match c.degenerate {
@@ -169,13 +184,17 @@ impl Params {
                         apparatus.source,
                     ));
                 }
-                match &options.specimen {
-                    Some(sp) => (&sp.spheres.pair(0), sp.law),
+                match self.sphere_pair() {
+                    Some(p) => p,
                     None => return w,
                 }
             }
-            _ => (&self.pair, self.law),
+            _ => match self.sphere_pair() {
+                Some(p) => p,
+                None => return w,
+            },
         };
+        let law = law.kind;
         let Some(contact) = &out.contact else {
             return w;
         };
@@ -224,16 +243,24 @@ impl Params {
 
     /// Runs the scene's kind (without the validity warnings).
     fn run_kind(&self, progress: &mut dyn FnMut(f64) -> bool) -> Result<RunOutput> {
-        let law = self.contact_law();
-        let law = law.as_ref();
+        let contact = || -> Result<(SpherePair, Box<dyn Contact>)> {
+            let (pair, law) = self.pair_and_law()?;
+            let built = law.build(pair.contact_properties());
+            Ok((pair, built))
+        };
         match &self.params {
             SceneParams::Quasistatic {
                 max_displacement_m,
                 points,
                 strain_rate_per_s,
             } => {
-                let s =
-                    solver::loading_curve(law, *max_displacement_m, *points, *strain_rate_per_s);
+                let (_, law) = contact()?;
+                let s = solver::loading_curve(
+                    law.as_ref(),
+                    *max_displacement_m,
+                    *points,
+                    *strain_rate_per_s,
+                );
                 let summary = vec![item("max_force", *s.force_n.last().unwrap_or(&0.0), "N")];
                 Ok(RunOutput::contact_only(s, summary))
             }
@@ -242,9 +269,10 @@ impl Params {
                 max_displacement_m,
                 points,
             } => {
+                let (pair, law) = contact()?;
                 let s = solver::constant_rate(
-                    law,
-                    &self.pair,
+                    law.as_ref(),
+                    &pair,
                     *strain_rate_per_s,
                     *max_displacement_m,
                     *points,
@@ -253,18 +281,18 @@ impl Params {
                     item("max_force", *s.force_n.last().unwrap_or(&0.0), "N"),
                     item(
                         "approach_speed",
-                        strain_rate_per_s
-                            * (self.pair.sphere1.radius_m + self.pair.sphere2.radius_m),
+                        strain_rate_per_s * (pair.sphere1.radius_m + pair.sphere2.radius_m),
                         "m/s",
                     ),
                 ];
                 Ok(RunOutput::contact_only(s, summary))
             }
             SceneParams::Collision(setup) => {
-                let r = solver::collision(law, &self.pair, setup)?;
-                let p = self.pair.contact_properties();
+                let (pair, law) = contact()?;
+                let r = solver::collision(law.as_ref(), &pair, setup)?;
+                let p = pair.contact_properties();
                 let tc = solver::hertz_impact_duration(
-                    self.pair.reduced_mass_kg(),
+                    pair.reduced_mass_kg(),
                     p.e_star_pa,
                     p.radius_m,
                     setup.velocity1_m_s - setup.velocity2_m_s,
@@ -287,13 +315,20 @@ impl Params {
                 apparatus,
                 pressure_pa,
                 options,
-            } => run_pulse(apparatus, *pressure_pa, options, progress),
+            } => run_pulse(
+                apparatus,
+                *pressure_pa,
+                options,
+                self.specimen.as_ref(),
+                progress,
+            ),
             SceneParams::Chain(setup) => run_free_chain(setup, progress),
             SceneParams::ForceDriven {
                 setup,
                 measured_displacement_m,
             } => {
-                let r = solver::force_driven(law, &self.pair, setup)?;
+                let (pair, law) = contact()?;
+                let r = solver::force_driven(law.as_ref(), &pair, setup)?;
                 let mut summary = force_driven_summary(
                     &r.series,
                     &setup.drive,
@@ -418,14 +453,17 @@ fn run_pulse(
     apparatus: &Apparatus,
     pressure_pa: f64,
     options: &PulseOptions,
+    specimen: Option<&Specimen>,
     progress: &mut dyn FnMut(f64) -> bool,
 ) -> Result<RunOutput> {
-    let chain = apparatus.pulse_chain(options);
+    let chain = apparatus.pulse_chain(options, specimen);
+    let spheres_specimen = specimen.and_then(Specimen::spheres);
+    let cylinder = specimen.and_then(Specimen::cylinder);
     let steps = (chain.end_time_s / chain.dt_s).ceil() as usize;
     let mut report = crate::solver::record::Progress::new(steps, progress);
     // A chain specimen of three or more spheres also gets its `/chain` series (a pair's output
     // stays as it was: `/contact` holds its one contact).
-    let spheres = options.specimen.as_ref().map_or(0, |sp| sp.spheres.len());
+    let spheres = spheres_specimen.map_or(0, |sp| sp.chain.len());
     let mut spheres_rec = (spheres >= 3).then(|| {
         crate::solver::record::SphereChainRecorder::new(
             &chain.joints,
@@ -462,7 +500,7 @@ fn run_pulse(
     summary.push(item("time_step", chain.dt_s, "s"));
     // A seated specimen says how (§6.11): with a preload, `/contact` holds the whole force and
     // the gauges and the reduction the change from it.
-    match options.specimen.as_ref().map(|sp| sp.seating) {
+    match spheres_specimen.map(|sp| sp.seating) {
         Some(crate::specimen::Seating::Gap { gap_m }) => {
             summary.push(item("seating_gap", gap_m, "m"));
         }
@@ -564,16 +602,13 @@ fn run_pulse(
     energy.push(("total".into(), total));
     let mut warnings = Vec::new();
     // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.8).
-    let radii = options
-        .specimen
-        .as_ref()
-        .map(|spec| specimen_radii_m(&spec.spheres));
-    let reduction = match (radii, &options.cylinder) {
+    let radii = spheres_specimen.map(|sp| sp.strain_rate_radii_m());
+    let reduction = match (radii, cylinder) {
         (Some(_), _) | (None, Some(_)) => {
             match reduce_simulated_records(apparatus, options, radii, &t, &gauges) {
                 Ok(red) => {
                     summary.extend(reduced_summary(&red));
-                    if let Some(c) = &options.cylinder {
+                    if let Some(c) = cylinder {
                         summary.push(item("specimen_cells", c.cells_at(chain.dt_s) as f64, "1"));
                         match reduced_cylinder_summary(apparatus, c, &red) {
                             Ok(items) => summary.extend(items),
@@ -744,20 +779,12 @@ fn reduce_simulated_records(
     )
 }
 
-/// The two lengths whose sum divides the reduced approach rate into the global strain rate:
-/// (r1, r2) of a pair; for a longer chain (r1, r2 + … + rN), so that the rate is δ̇/Σ rᵢ over
-/// the whole specimen (docs/physics.md §8).
-pub fn specimen_radii_m(chain: &crate::specimen::SphereChain) -> (f64, f64) {
-    let r = &chain.spheres;
-    (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
-}
-
 /// Summary items of a simulated cylinder's reduction (docs/physics.md §7.8): 1-wave peak
 /// stress, strain at peak, mean strain rate, and the modulus fitted to the 3-wave curve on
 /// 30–90 % of its peak (`reduce_cylinder::MODULUS_WINDOW`).
 fn reduced_cylinder_summary(
     apparatus: &Apparatus,
-    c: &crate::apparatus::CylinderSpecimen,
+    c: &crate::specimen::CylinderSpecimen,
     red: &crate::reduce::Reduction,
 ) -> Result<Vec<SummaryItem>> {
     use crate::reduce_cylinder::{CylinderGeometry, loading_modulus, reduce_cylinder};

@@ -4,7 +4,6 @@
 use crate::error::{Error, Result, Validator};
 use crate::kinds;
 use crate::toml_file::parse_as;
-use shpb_core::contact::Unloading;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::Params;
 use std::path::{Path, PathBuf};
@@ -64,33 +63,12 @@ impl SceneFile for Params {
                 kinds::allowed(),
             ));
         };
-        let (pair, law, region2, params) = (scene_kind.parse)(text, file, base_dir, fidelity, &v)?;
-        // Every sphere kind declares `unloading` (its parser has refused an unknown rule).
-        let unloading = match table.get("unloading") {
-            None => Unloading::default(),
-            Some(value) => {
-                let name = value.as_str().unwrap_or_default();
-                Unloading::ALL
-                    .iter()
-                    .find(|(n, _)| *n == name)
-                    .map(|&(_, u)| u)
-                    .ok_or_else(|| {
-                        v.error(
-                            "unloading",
-                            format!("unknown rule `{value}`"),
-                            Unloading::ALL.map(|(n, _)| n).join(", "),
-                        )
-                    })?
-            }
-        };
+        let (specimen, params) = (scene_kind.parse)(text, file, base_dir, fidelity, &v)?;
         let params = Params {
             source: file.to_string(),
             text: text.to_string(),
             kind,
-            pair,
-            law,
-            region2,
-            unloading,
+            specimen,
             fidelity,
             params,
         };

@@ -251,7 +251,7 @@ impl SpecimenSpec {
         &self,
         base_dir: &Path,
         v: &Validator,
-    ) -> Result<shpb_core::apparatus::CylinderSpecimen> {
+    ) -> Result<shpb_core::specimen::CylinderSpecimen> {
         self.refuse_seating_keys(v)?;
         for (key, given) in [
             ("pair", self.pair.is_some()),
@@ -296,7 +296,7 @@ impl SpecimenSpec {
                 ));
             }
         };
-        Ok(shpb_core::apparatus::CylinderSpecimen {
+        Ok(shpb_core::specimen::CylinderSpecimen {
             material,
             length_m: v.positive("length_m", length, 0.1, "m")?,
             diameter_m: v.positive("diameter_m", diameter, 0.1, "m")?,

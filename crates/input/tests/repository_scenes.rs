@@ -147,10 +147,7 @@ fn every_repository_scene_parses_with_the_values_of_its_file() {
                         assert!(options.incident_drive.is_some());
                     }
                 }
-                assert_eq!(
-                    options.specimen.is_some() || options.cylinder.is_some(),
-                    kind == "shpb"
-                );
+                assert_eq!(p.specimen.is_some(), kind == "shpb");
                 match kind {
                     "shpb" => assert_eq!(options.end, IncidentEnd::Specimen),
                     _ => assert_ne!(options.end, IncidentEnd::Specimen),

@@ -578,7 +578,10 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
     }
     if let Some(contact) = &out.contact {
         let mut curves = vec![Curve {
-            label: format!("shpb ({})", params.contact_law().name()),
+            label: match params.contact_law() {
+                Some(law) => format!("shpb ({})", law.name()),
+                None => "shpb".to_string(),
+            },
             x: &contact.displacement_m,
             y: &contact.force_n,
             measured: false,

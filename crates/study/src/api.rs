@@ -603,16 +603,14 @@ fn run_setup(
     // The run's own scene, inputs and fidelity, as `shpb run RUN.h5` reruns it.
     let (params, _) = load_scene(Scene::File(record), None, &[], String::new())?;
     Ok(match params.params {
-        SceneParams::Pulse {
-            apparatus, options, ..
-        } => {
+        SceneParams::Pulse { apparatus, .. } => {
             // A chain specimen's strain rate is δ̇/Σ rᵢ, as the run's own reduction took it.
-            let radii = match &options.specimen {
-                Some(sp) => shpb_core::scene::specimen_radii_m(&sp.spheres),
-                None => (params.pair.sphere1.radius_m, params.pair.sphere2.radius_m),
-            };
-            let cylinder = options
-                .cylinder
+            let specimen = params.specimen.as_ref();
+            let radii = specimen
+                .and_then(shpb_core::specimen::Specimen::spheres)
+                .map_or(PAPER_SPHERE_RADII_M, |sp| sp.strain_rate_radii_m());
+            let cylinder = specimen
+                .and_then(shpb_core::specimen::Specimen::cylinder)
                 .map(|c| shpb_core::reduce_cylinder::CylinderGeometry {
                     length_m: c.length_m,
                     diameter_m: c.diameter_m,

@@ -194,7 +194,7 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
         Params::from_file_overridden(path, &set)
     };
     let base = load(Fidelity::Standard, &[])?;
-    if !matches!(&base.params, SceneParams::Pulse { options, .. } if options.specimen.is_some()) {
+    if !(matches!(&base.params, SceneParams::Pulse { .. }) && base.sphere_pair().is_some()) {
         return Err(Error::Input {
             file: base.source.clone(),
             key: "kind".into(),

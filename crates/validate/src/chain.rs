@@ -6,7 +6,7 @@
 use crate::figure::{Figure, Legend, Panel, Series, Style};
 use crate::{CaseResult, Check, Context, Unit};
 use rayon::prelude::*;
-use shpb_core::contact::{LawKind, Region2Form, Unloading};
+use shpb_core::contact::{LawKind, LawSpec, Region2Form, Unloading};
 use shpb_core::material::Material;
 use shpb_core::solver::solitary::{
     self, LENGTH_FORCE_FRACTION, WaveMeasurement, WaveProbe, hertz_chain, identical_contact,
@@ -89,9 +89,11 @@ fn strike_free(material: &Material, speed_m_s: f64) -> Result<(f64, f64, f64, f6
         chain: SphereChain {
             spheres: vec![sphere; COUNT],
         },
-        law: LawKind::Hertz,
-        region2: Region2Form::Smooth,
-        unloading: Unloading::Static,
+        law: LawSpec {
+            kind: LawKind::Hertz,
+            region2: Region2Form::Smooth,
+            unloading: Unloading::Static,
+        },
         velocity1_m_s: speed_m_s,
         striker: None,
         wall: None,

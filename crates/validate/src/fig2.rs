@@ -100,7 +100,7 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
             .as_ref()
             .expect("quasistatic scenes have a contact series");
         let model = resample(&c.displacement_m, &c.force_n, &d);
-        let p = params.pair.contact_properties();
+        let p = params.pair_and_law()?.0.contact_properties();
         let published = LoadingCurve::with_form(
             p.e_star_pa,
             p.radius_m,

@@ -59,7 +59,7 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
             .contact
             .as_ref()
             .expect("constant-rate scenes have a contact series");
-        let law = BurgoyneDaraio::new(params.pair.contact_properties(), true);
+        let law = BurgoyneDaraio::new(params.pair_and_law()?.0.contact_properties(), true);
         let curve = law.curve_at(rate);
         runs.push(Run {
             rate,

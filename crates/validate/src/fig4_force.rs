@@ -102,8 +102,9 @@ fn run_scene(ctx: &Context, stem: &str) -> Result<(LawRun, ForceHistory, Vec<f64
             problem: "the force history has no `displacement_m` column to compare with".into(),
             allowed: "a CSV with time_s, force_N and displacement_m".into(),
         })?;
-    let law = params.contact_law();
-    let r = solver::force_driven(law.as_ref(), &params.pair, setup)?;
+    let (pair, law) = params.pair_and_law()?;
+    let law = law.build(pair.contact_properties());
+    let r = solver::force_driven(law.as_ref(), &pair, setup)?;
     let s = &r.series;
     let c = compare_fig4(s, &setup.drive, &measured);
     // Loading branch: from t = 0 to the measured peak force.

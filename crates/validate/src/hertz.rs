@@ -80,10 +80,11 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
                 allowed: "collision".into(),
             });
         };
-        let law = params.contact_law();
-        let r = solver::collision(law.as_ref(), &params.pair, setup)?;
-        let p = params.pair.contact_properties();
-        let m = params.pair.reduced_mass_kg();
+        let (pair, law_spec) = params.pair_and_law()?;
+        let law = law_spec.build(pair.contact_properties());
+        let r = solver::collision(law.as_ref(), &pair, setup)?;
+        let p = pair.contact_properties();
+        let m = pair.reduced_mass_kg();
         let v = setup.velocity1_m_s - setup.velocity2_m_s;
         let d_star = solver::hertz_max_approach(m, p.e_star_pa, p.radius_m, v);
         let t_c = solver::hertz_impact_duration(m, p.e_star_pa, p.radius_m, v);
@@ -108,7 +109,7 @@ pub fn run(ctx: &Context) -> Result<CaseResult> {
                 limit,
             ));
         }
-        let ratio = if params.law == shpb_core::contact::LawKind::Hertz {
+        let ratio = if law_spec.kind == shpb_core::contact::LawKind::Hertz {
             "—".to_string()
         } else {
             format!("{:.2}", d_star / dy)

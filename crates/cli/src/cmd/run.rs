@@ -119,16 +119,14 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
         ),
         _ => (String::new(), serde_json::Value::Null),
     };
-    let mut text = if matches!(&params.params, SceneParams::Pulse { options, .. } if options.specimen.is_none())
-    {
-        format!("scene: {} (kind {}{bars})\n", params.source, params.kind)
-    } else {
-        format!(
-            "scene: {} (kind {}, law {}{bars})\n",
-            params.source,
-            params.kind,
-            params.contact_law().name()
-        )
+    // A scene without spheres (a pulse, a cylinder) has no contact law to name.
+    let law = params.contact_law().map(|l| l.name());
+    let mut text = match law {
+        None => format!("scene: {} (kind {}{bars})\n", params.source, params.kind),
+        Some(law) => format!(
+            "scene: {} (kind {}, law {law}{bars})\n",
+            params.source, params.kind,
+        ),
     };
     for it in &out.summary {
         text.push_str(&format!(
@@ -171,7 +169,7 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
         serde_json::json!({
             "scene": params.source,
             "kind": params.kind,
-            "law": params.contact_law().name(),
+            "law": law,
             "fidelity": params.fidelity.name(),
             "bars": bar_knobs,
             "summary": summary,

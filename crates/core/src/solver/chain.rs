@@ -390,7 +390,7 @@ mod tests {
     //! (Johnson, Contact Mechanics §11.4) and the conservation of momentum and energy.
     use super::*;
     use crate::bar::{BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
-    use crate::contact::{LawKind, Region2Form, Unloading};
+    use crate::contact::{LawKind, LawSpec, Region2Form, Unloading};
     use crate::solver::body::MassSpec;
     use crate::solver::{hertz_impact_duration, record::Recorder};
 
@@ -434,9 +434,11 @@ mod tests {
             joints: vec![
                 Joint::Spheres {
                     props: p,
-                    law: LawKind::Hertz,
-                    region2: Region2Form::Smooth,
-                    unloading: Unloading::Static,
+                    law: LawSpec {
+                        kind: LawKind::Hertz,
+                        region2: Region2Form::Smooth,
+                        unloading: Unloading::Static,
+                    },
                     seating: crate::specimen::Seating::Touching,
                 };
                 n - 1
@@ -536,9 +538,11 @@ mod tests {
             ],
             joints: vec![Joint::Spheres {
                 props: pair.contact_properties(),
-                law: LawKind::Hertz,
-                region2: Region2Form::Smooth,
-                unloading: Unloading::Static,
+                law: LawSpec {
+                    kind: LawKind::Hertz,
+                    region2: Region2Form::Smooth,
+                    unloading: Unloading::Static,
+                },
                 seating,
             }],
             striker_velocity_m_s: 0.0,

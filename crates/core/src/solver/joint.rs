@@ -17,7 +17,7 @@
 //!   (its crossing of F = law(F) need not be unique where the rate changes sign).
 
 use super::body::Body;
-use crate::contact::{Contact, ContactEval, LawKind, Region2Form, Unloading};
+use crate::contact::{Contact, ContactEval, LawSpec};
 use crate::shaper::{PulseShaper, ShaperState};
 use crate::specimen::{ContactProperties, Seating};
 
@@ -33,12 +33,8 @@ pub enum Joint {
     Spheres {
         /// Effective contact properties of the pair.
         props: ContactProperties,
-        /// The contact law.
-        law: LawKind,
-        /// Form of region II.
-        region2: Region2Form,
-        /// Unloading rule.
-        unloading: Unloading,
+        /// The contact law with its own parameters.
+        law: LawSpec,
         /// How the pair sits before the test (a gap, or a static preload).
         seating: Seating,
     },
@@ -77,10 +73,8 @@ impl JointState {
             Joint::Spheres {
                 props,
                 law,
-                region2,
-                unloading,
                 seating,
-            } => (Some(law.build_options(props, region2, unloading)), seating),
+            } => (Some(law.build(props)), seating),
             _ => (None, Seating::Touching),
         };
         let (closure_offset_m, static_force_n) = match (seating, law.as_mut()) {

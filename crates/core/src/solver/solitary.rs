@@ -8,7 +8,7 @@ use super::body::{Body, BodySpec, MassSpec};
 use super::chain::ChainSetup;
 use super::joint::{Joint, JointState};
 use super::record::Recorder;
-use crate::contact::{LawKind, Region2Form, Unloading, hertz_energy};
+use crate::contact::{LawKind, LawSpec, Region2Form, Unloading, hertz_energy};
 use crate::material::Material;
 use crate::specimen::{ContactProperties, Sphere, SpherePair};
 
@@ -76,9 +76,11 @@ pub fn hertz_chain(
         joints: vec![
             Joint::Spheres {
                 props: identical_contact(material, diameter_m),
-                law: LawKind::Hertz,
-                region2: Region2Form::Smooth,
-                unloading: Unloading::Static,
+                law: LawSpec {
+                    kind: LawKind::Hertz,
+                    region2: Region2Form::Smooth,
+                    unloading: Unloading::Static,
+                },
                 seating: crate::specimen::Seating::Touching,
             };
             count.saturating_sub(1)

@@ -11,7 +11,7 @@
 //! force changes by more than 1e-13 of the largest. For two spheres this is exactly one
 //! solve of the pair stepper, in the same arithmetic, so a chain of two reproduces the
 //! `collision` scene bit for bit. Each contact keeps its own law and memory
-//! (`LawKind::build_options`) and commits it once a step.
+//! (`LawSpec::build`) and commits it once a step.
 //!
 //! A striker is a rigid mass with a flat face (rigid, or of a material) against sphere 1; a
 //! wall is a flat of infinite mass (rigid, or elastic with a material) after sphere N; their
@@ -25,7 +25,7 @@
 
 use super::{ContactSeries, PASSIVITY_TOLERANCE, contact_period, hertz_impact_duration};
 use super::{hertz_max_approach, solve_approach_speed};
-use crate::contact::{Contact, ContactEval, LawKind, Region2Form, Unloading, hertz_force};
+use crate::contact::{Contact, ContactEval, LawSpec, hertz_force};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::specimen::{ContactProperties, SphereChain, reduced_mass_kg};
@@ -56,11 +56,7 @@ pub struct FreeChainSetup {
     /// The spheres, sphere 1 first.
     pub chain: SphereChain,
     /// The contact law of every contact.
-    pub law: LawKind,
-    /// Form of region II of the loading law.
-    pub region2: Region2Form,
-    /// Unloading rule of every contact.
-    pub unloading: Unloading,
+    pub law: LawSpec,
     /// Initial velocity of sphere 1, m/s (the others rest); 0 with a striker.
     pub velocity1_m_s: f64,
     /// A striker hitting sphere 1 instead (None: sphere 1 moves).
@@ -246,11 +242,7 @@ struct Stepper {
 impl Stepper {
     fn new(setup: &FreeChainSetup) -> Stepper {
         let l = setup.layout();
-        let laws: Vec<Box<dyn Contact>> = l
-            .contacts
-            .iter()
-            .map(|&p| setup.law.build_options(p, setup.region2, setup.unloading))
-            .collect();
+        let laws: Vec<Box<dyn Contact>> = l.contacts.iter().map(|&p| setup.law.build(p)).collect();
         let mut position_m = vec![0.0];
         for d in &l.touch_distance_m {
             let last = *position_m.last().expect("one body at least");
@@ -536,6 +528,7 @@ mod tests {
     //! The chain against the two-sphere `collision` stepper (N = 2, identical arithmetic), and
     //! the conservation of momentum and energy of longer chains (module docs).
     use super::*;
+    use crate::contact::{LawKind, Region2Form};
     use crate::material::JohnsonCook;
     use crate::solver::{CollisionSetup, collision};
     use crate::specimen::{Sphere, SpherePair};
@@ -557,9 +550,7 @@ mod tests {
     fn setup(chain: SphereChain, law: LawKind, speed: f64, end_time_s: f64) -> FreeChainSetup {
         let mut s = FreeChainSetup {
             chain,
-            law,
-            region2: Region2Form::Smooth,
-            unloading: Unloading::default(),
+            law: LawSpec::of(law),
             velocity1_m_s: speed,
             striker: None,
             wall: None,

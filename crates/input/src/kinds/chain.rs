@@ -8,10 +8,12 @@ use crate::error::{Result, Validator};
 use crate::material::MaterialFile;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
+use shpb_core::contact::LawSpec;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::material::Material;
 use shpb_core::scene::SceneParams;
 use shpb_core::solver::{FreeChainSetup, StrikerMass, Wall};
+use shpb_core::specimen::{Seating, Specimen, SphereSpecimen};
 use std::path::Path;
 
 /// The registry entry.
@@ -182,9 +184,11 @@ fn parse(
     };
     let mut setup = FreeChainSetup {
         chain,
-        law: f.law,
-        region2: f.region2,
-        unloading: f.unloading,
+        law: LawSpec {
+            kind: f.law,
+            region2: f.region2,
+            unloading: f.unloading,
+        },
         velocity1_m_s,
         striker,
         wall,
@@ -226,8 +230,12 @@ fn parse(
         Some(t) => v.positive("end_time_s", t, 1.0, "s")?,
         None => default_end,
     };
-    let pair = setup.chain.pair(0);
-    Ok((pair, f.law, f.region2, SceneParams::Chain(Box::new(setup))))
+    let specimen = Specimen::Spheres(SphereSpecimen {
+        chain: setup.chain.clone(),
+        law: setup.law,
+        seating: Seating::Touching,
+    });
+    Ok((Some(specimen), SceneParams::Chain(Box::new(setup))))
 }
 
 #[cfg(test)]
@@ -243,7 +251,8 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (pair, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let (specimen, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let pair = specimen.unwrap().spheres().unwrap().first_pair();
         let SceneParams::Chain(s) = p else {
             panic!("not a chain: {p:?}")
         };
@@ -325,7 +334,7 @@ mod tests {
     fn a_striker_and_a_wall() {
         let v = Validator::new("c.toml");
         let text = "kind = \"chain\"\n[striker]\nmass_kg = 0.01\nvelocity_m_s = 2.0\nmaterial = \"ss302\"\n[wall]\nkind = \"rigid\"\n[specimen]\ncount = 3\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n";
-        let (_, _, _, p) = parse(text, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let (_, p) = parse(text, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
         let SceneParams::Chain(s) = p else {
             panic!("not a chain")
         };

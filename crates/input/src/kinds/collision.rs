@@ -117,7 +117,10 @@ fn parse(
         max_time_s: solver::COLLISION_TIME_LIMIT_CONTACT_TIMES * tc,
         output_every: check_every(v, f.output_every)?,
     };
-    Ok((pair, f.law, f.region2, SceneParams::Collision(setup)))
+    Ok((
+        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
+        SceneParams::Collision(setup),
+    ))
 }
 
 #[cfg(test)]
@@ -133,7 +136,8 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (pair, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let (specimen, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let pair = specimen.unwrap().spheres().unwrap().first_pair();
         let SceneParams::Collision(s) = p else {
             panic!("not a collision: {p:?}")
         };

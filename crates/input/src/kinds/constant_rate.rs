@@ -67,7 +67,10 @@ fn parse(
         max_displacement_m: check_max_displacement(v, f.max_displacement_m, &pair)?,
         points: check_points(v, f.points)?,
     };
-    Ok((pair, f.law, f.region2, p))
+    Ok((
+        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
+        p,
+    ))
 }
 
 #[cfg(test)]
@@ -83,7 +86,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (_, _, _, p) = super::super::parse_example(&KIND, Fidelity::Fast);
+        let (_, p) = super::super::parse_example(&KIND, Fidelity::Fast);
         assert_eq!(
             p,
             SceneParams::ConstantRate {

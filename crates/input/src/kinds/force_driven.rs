@@ -213,9 +213,7 @@ fn parse(
         output_every: check_every(v, f.output_every)?,
     };
     Ok((
-        pair,
-        f.law,
-        f.region2,
+        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
         SceneParams::ForceDriven {
             setup,
             measured_displacement_m,
@@ -289,7 +287,7 @@ mod tests {
         );
         // Declared: read as the original file.
         let declared = format!("{scene}force_sign = \"tension-positive\"\n");
-        let (_, _, _, p) = parse(&declared, "f.toml", &dir, Fidelity::Fast, &v).unwrap();
+        let (_, p) = parse(&declared, "f.toml", &dir, Fidelity::Fast, &v).unwrap();
         let SceneParams::ForceDriven {
             setup,
             measured_displacement_m,
@@ -314,7 +312,7 @@ mod tests {
     #[test]
     fn example_reads_the_whole_csv() {
         let v = Validator::new("example.toml");
-        let (_, _, _, p) = parse(
+        let (_, p) = parse(
             KIND.example,
             "example.toml",
             &repo(),

@@ -9,10 +9,10 @@
 
 use crate::error::{Result, Validator};
 use serde::Deserialize;
-use shpb_core::contact::{LawKind, Region2Form, Unloading};
+use shpb_core::contact::{LawKind, LawSpec, Region2Form, Unloading};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
-use shpb_core::specimen::SpherePair;
+use shpb_core::specimen::{Specimen, SpherePair, SphereSpecimen};
 use std::path::Path;
 
 mod chain;
@@ -42,8 +42,6 @@ macro_rules! sphere_scene_file {
             law: shpb_core::contact::LawKind,
             #[serde(default, with = "super::Region2Toml")]
             region2: shpb_core::contact::Region2Form,
-            /// Read again by `Params::from_toml` (common to every sphere scene).
-            #[allow(dead_code)]
             #[serde(default, with = "super::UnloadingToml")]
             unloading: shpb_core::contact::Unloading,
             $($(#[$fmeta])* $field: $ty,)*
@@ -52,9 +50,27 @@ macro_rules! sphere_scene_file {
 }
 pub(crate) use sphere_scene_file;
 
-/// What a kind's parser returns: the specimen, the contact law, the form of region II and the
-/// kind-specific parameters (the rest of [`shpb_core::scene::Params`] is common to all kinds).
-pub type Parsed = (SpherePair, LawKind, Region2Form, SceneParams);
+/// What a kind's parser returns: the specimen with its own model (None for a `pulse` scene) and
+/// the kind-specific parameters (the rest of [`shpb_core::scene::Params`] is common to all kinds).
+pub type Parsed = (Option<Specimen>, SceneParams);
+
+/// A pair of spheres touching at rest as a scene's specimen, with its contact law (the scene keys
+/// `law`, `region2`, `unloading`).
+pub(crate) fn pair_specimen(
+    pair: &SpherePair,
+    kind: LawKind,
+    region2: Region2Form,
+    unloading: Unloading,
+) -> Option<Specimen> {
+    Some(Specimen::Spheres(SphereSpecimen::pair(
+        pair,
+        LawSpec {
+            kind,
+            region2,
+            unloading,
+        },
+    )))
+}
 
 /// A kind's parser: `(text, file, base_dir, fidelity, v)` → validated parameters. `text` is the
 /// whole scene TOML, `file` its name for messages, `base_dir` the directory relative paths are

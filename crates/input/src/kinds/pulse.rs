@@ -4,17 +4,16 @@
 
 use super::{Key, LawKindToml, Parsed, Region2Toml, SceneKind, UnloadingToml};
 use crate::error::{Result, Validator};
-use crate::material::MaterialFile;
 use crate::setup::{ApparatusFile, ShaperOverride};
 use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
-use shpb_core::apparatus::{Apparatus, CYLINDER_MIN_CELLS, IncidentEnd, PulseOptions};
+use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb_core::bar::Dispersion;
-use shpb_core::contact::{LawKind, Region2Form, Unloading};
+use shpb_core::contact::{LawKind, LawSpec, Region2Form, Unloading};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
-use shpb_core::specimen::SpherePair;
+use shpb_core::specimen::{CYLINDER_MIN_CELLS, Specimen, SphereSpecimen};
 use std::path::Path;
 
 /// The registry entry.
@@ -180,19 +179,19 @@ pub(super) fn parse_bars(
 ) -> Result<Parsed> {
     let sv = v.table("specimen");
     let f: PulseFile = parse_as(text, file)?;
-    let mut cylinder = None;
     let specimen = match (&f.specimen, is_test) {
         (Some(spec), true) if spec.is_cylinder(&sv)? => {
-            cylinder = Some(spec.build_cylinder(base_dir, &sv)?);
-            None
+            Some(Specimen::Cylinder(spec.build_cylinder(base_dir, &sv)?))
         }
-        (Some(spec), true) => Some(shpb_core::apparatus::SpecimenSetup {
-            spheres: spec.spheres_only().build_chain(base_dir, &sv)?,
-            law: f.law,
-            region2: f.region2,
-            unloading: f.unloading,
+        (Some(spec), true) => Some(Specimen::Spheres(SphereSpecimen {
+            chain: spec.spheres_only().build_chain(base_dir, &sv)?,
+            law: LawSpec {
+                kind: f.law,
+                region2: f.region2,
+                unloading: f.unloading,
+            },
             seating: spec.build_seating(&sv)?,
-        }),
+        })),
         (None, true) => {
             return Err(v.error(
                 "specimen",
@@ -209,6 +208,7 @@ pub(super) fn parse_bars(
         }
         (None, false) => None,
     };
+    let cylinder = specimen.as_ref().and_then(Specimen::cylinder).copied();
     let set_up = base_dir.join(&f.bars);
     if crate::builtin::setup(&f.bars).is_none() && !crate::files::is_file(&set_up) {
         return Err(v.error(
@@ -401,8 +401,6 @@ pub(super) fn parse_bars(
         }
     };
     let options = PulseOptions {
-        specimen: specimen.clone(),
-        cylinder,
         striker_velocity_m_s: velocity,
         shaper,
         end,
@@ -419,24 +417,14 @@ pub(super) fn parse_bars(
     crate::resources::check_estimate(
         file,
         if is_test { "shpb" } else { "pulse" },
-        &shpb_core::estimate::bar_run(&apparatus, &options),
+        &shpb_core::estimate::bar_run(&apparatus, &options, specimen.as_ref()),
         &crate::resources::Limits::of_machine()?,
     )?;
-    for spec in &apparatus.pulse_chain(&options).bodies {
+    for spec in &apparatus.pulse_chain(&options, specimen.as_ref()).bodies {
         shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
     }
-    // A pulse scene has no spheres: its `pair` is a placeholder that nothing reads (a test's
-    // `pair` is its first contact).
-    let pair = match specimen {
-        Some(sp) => sp.spheres.pair(0),
-        None => {
-            SpherePair::paper(shpb_core::material::Material::builtin("ss440c").expect("built-in"))
-        }
-    };
     Ok((
-        pair,
-        f.law,
-        f.region2,
+        specimen,
         SceneParams::Pulse {
             apparatus: Box::new(apparatus),
             pressure_pa,
@@ -579,7 +567,7 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (_, _, _, p) = super::super::parse_example(&KIND, Fidelity::Standard);
+        let (specimen, p) = super::super::parse_example(&KIND, Fidelity::Standard);
         let SceneParams::Pulse {
             pressure_pa,
             options,
@@ -590,7 +578,7 @@ mod tests {
         };
         assert_eq!(pressure_pa, 10.0 * crate::units::PSI_PA);
         assert_eq!(options.end, IncidentEnd::Transmission);
-        assert_eq!(options.specimen, None);
+        assert_eq!(specimen, None);
         assert_eq!(options.snapshot_interval_s, None);
         assert_eq!(options.cell_size_m, 1e-3);
         assert_eq!(options.gauge_length_m, 2e-3);

@@ -67,7 +67,10 @@ fn parse(
         points: check_points(v, f.points)?,
         strain_rate_per_s: v.in_range("strain_rate_per_s", f.strain_rate_per_s, 0.0, 1e9, "1/s")?,
     };
-    Ok((pair, f.law, f.region2, p))
+    Ok((
+        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
+        p,
+    ))
 }
 
 #[cfg(test)]
@@ -84,9 +87,13 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (pair, law, region2, p) = super::super::parse_example(&KIND, Fidelity::Fast);
-        assert_eq!(pair.sphere1.radius_m, 3.175e-3);
-        assert_eq!((law, region2), (LawKind::default(), Region2Form::default()));
+        let (specimen, p) = super::super::parse_example(&KIND, Fidelity::Fast);
+        let spheres = specimen.unwrap().spheres().unwrap().clone();
+        assert_eq!(spheres.first_pair().sphere1.radius_m, 3.175e-3);
+        assert_eq!(
+            (spheres.law.kind, spheres.law.region2),
+            (LawKind::default(), Region2Form::default())
+        );
         assert_eq!(
             p,
             SceneParams::Quasistatic {

@@ -68,16 +68,15 @@ mod tests {
 
     #[test]
     fn example_values() {
-        let (pair, law, region2, p) = super::super::parse_example(&KIND, Fidelity::Fast);
+        let (specimen, p) = super::super::parse_example(&KIND, Fidelity::Fast);
         let SceneParams::Pulse { options, .. } = p else {
             panic!("not a bar scene: {p:?}")
         };
         assert_eq!(options.end, IncidentEnd::Specimen);
-        let specimen = options.specimen.expect("a specimen");
-        assert_eq!(
-            (specimen.spheres.pair(0), specimen.law, specimen.region2),
-            (pair, law, region2)
-        );
+        let specimen = specimen.expect("a specimen");
+        let spheres = specimen.spheres().expect("spheres");
+        assert_eq!(spheres.chain.len(), 2);
+        assert_eq!(spheres.law, shpb_core::contact::LawSpec::default());
         assert_eq!(options.cell_size_m, 4e-3);
         assert_eq!(
             options.snapshot_interval_s,
@@ -90,21 +89,24 @@ mod tests {
     /// (docs/physics.md §6.9), an explicit cell is kept when fine enough.
     #[test]
     fn a_cylinder_specimen_is_read_and_resolved() {
-        use shpb_core::apparatus::CYLINDER_MIN_CELLS;
         use shpb_core::material::Material;
+        use shpb_core::specimen::CYLINDER_MIN_CELLS;
         let v = Validator::new("c.toml");
         let head = "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n";
         let named = format!(
             "{head}[specimen]\nshape = \"cylinder\"\nmaterial = \"al2017\"\nlength_m = 6e-3\ndiameter_m = 12e-3\n"
         );
-        let (_, _, _, p) = parse(&named, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let (specimen, p) = parse(&named, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
         let SceneParams::Pulse {
             options, apparatus, ..
         } = p
         else {
             panic!("not a bar scene")
         };
-        let c = options.cylinder.expect("a cylinder");
+        let c = *specimen
+            .as_ref()
+            .and_then(|s| s.cylinder())
+            .expect("a cylinder");
         let al = <Material as crate::material::MaterialFile>::builtin("al2017").unwrap();
         assert_eq!(
             (
@@ -115,7 +117,6 @@ mod tests {
             (al.youngs_modulus_pa, al.poisson_ratio, al.density_kg_m3)
         );
         assert_eq!((c.length_m, c.diameter_m), (6e-3, 12e-3));
-        assert!(options.specimen.is_none());
         assert_eq!(options.end, IncidentEnd::Specimen);
         let c0 = apparatus.material.wave_speed_m_s();
         assert!(options.cell_size_m < Fidelity::Fast.bar_knobs().cell_size_m);
@@ -123,11 +124,11 @@ mod tests {
         let table = format!(
             "{head}cell_size_m = 5e-4\n[specimen]\nshape = \"cylinder\"\nlength_m = 5e-3\ndiameter_m = 5e-3\nmaterial = {{ density_kg_m3 = 7850.0, youngs_modulus_pa = 200e9, poisson_ratio = 0.3 }}\n"
         );
-        let (_, _, _, p) = parse(&table, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+        let (specimen, p) = parse(&table, "c.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
         let SceneParams::Pulse { options, .. } = p else {
             panic!("not a bar scene")
         };
-        let c = options.cylinder.unwrap();
+        let c = *specimen.as_ref().and_then(|s| s.cylinder()).unwrap();
         assert_eq!(c.material.youngs_modulus_pa, 200e9);
         assert_eq!(options.cell_size_m, 5e-4);
     }
@@ -142,11 +143,9 @@ mod tests {
             let text = format!(
                 "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\n[specimen]\npair = \"ss440c\"\n{extra}"
             );
-            let (_, _, _, p) = parse(&text, "s.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
-            let SceneParams::Pulse { options, .. } = p else {
-                panic!("not a bar scene")
-            };
-            options.specimen.unwrap().seating
+            let (specimen, p) = parse(&text, "s.toml", Path::new("."), Fidelity::Fast, &v).unwrap();
+            assert!(matches!(p, SceneParams::Pulse { .. }), "not a bar scene");
+            specimen.unwrap().spheres().unwrap().seating
         };
         assert_eq!(seating(""), Seating::Touching);
         assert_eq!(seating("gap_m = 0.0\n"), Seating::Touching);

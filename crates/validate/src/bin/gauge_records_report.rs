@@ -23,7 +23,7 @@ use shpb_core::reduce::{
     record_strains, reduce,
 };
 use shpb_core::scene::{Params, SceneParams};
-use shpb_core::specimen::Seating;
+use shpb_core::specimen::{Seating, Specimen};
 use shpb_input::csv::CsvTable;
 use shpb_input::gauges::reduce_record_file;
 use shpb_input::prelude::*;
@@ -153,14 +153,14 @@ struct Simulated {
 /// Runs the virtual test `validation/fig4-virtual-shpb/<scene>.toml` with its set-up changed by
 /// `variant`, and measures it.
 fn simulate(root: &Path, scene: &str, variant: &dyn Fn(&mut Apparatus)) -> Result<Simulated> {
-    simulate_with(root, scene, &|a, _| variant(a))
+    simulate_with(root, scene, &|a, _, _| variant(a))
 }
 
 /// [`simulate`] with the run's options open to the variant too.
 fn simulate_with(
     root: &Path,
     scene: &str,
-    variant: &dyn Fn(&mut Apparatus, &mut PulseOptions),
+    variant: &dyn Fn(&mut Apparatus, &mut PulseOptions, Option<&mut Specimen>),
 ) -> Result<Simulated> {
     let path = root.join(format!("validation/fig4-virtual-shpb/{scene}.toml"));
     let mut params = Params::from_file(&path)?;
@@ -168,7 +168,7 @@ fn simulate_with(
         apparatus, options, ..
     } = &mut params.params
     {
-        variant(apparatus, options);
+        variant(apparatus, options, params.specimen.as_mut());
     }
     let out = params.run()?;
     let bad = |problem: &str| Error::Input {
@@ -229,13 +229,13 @@ fn simulate_driven_with(
     seating: Option<Seating>,
 ) -> Result<Simulated> {
     let extra_s = drive.foot_s;
-    simulate_with(root, scene, &|a, o| {
+    simulate_with(root, scene, &|a, o, specimen| {
         geometry(a);
         o.end_time_s += extra_s;
         o.incident_drive = Some(drive.clone());
-        if let Some(specimen) = o.specimen.as_mut() {
+        if let Some(Specimen::Spheres(specimen)) = specimen {
             if let Some(law) = law {
-                specimen.law = law;
+                specimen.law.kind = law;
             }
             if let Some(seating) = seating {
                 specimen.seating = seating;

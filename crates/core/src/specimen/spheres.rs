@@ -1,8 +1,9 @@
-//! The specimen: two (possibly dissimilar) spheres and their effective contact properties
-//! (paper Sec. II: E*, r; docs/physics.md §1), a chain of N spheres ([`SphereChain`], §8), and
-//! how they sit before the test ([`Seating`]: touching, a gap or a preload; §6.11).
+//! Spheres as a specimen: two (possibly dissimilar) spheres and their effective contact properties
+//! (paper Sec. II: E*, r; docs/physics.md §1), a chain of N spheres ([`SphereChain`], §8), how
+//! they sit before the test ([`Seating`]: touching, a gap or a preload; §6.11), and the three as
+//! a scene's specimen with its contact law ([`SphereSpecimen`]).
 
-use crate::material::{JohnsonCook, Material};
+use crate::material::Material;
 
 /// One sphere of the specimen.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,23 +28,7 @@ impl Sphere {
     }
 }
 
-/// Effective properties of a pair as used by the contact law (paper Sec. II; authors' code for
-/// dissimilar spheres: the yield stress and rate hardening of the weaker sphere).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactProperties {
-    /// Effective modulus E* = [(1−ν1²)/E1 + (1−ν2²)/E2]⁻¹, Pa.
-    pub e_star_pa: f64,
-    /// Effective radius r = (1/r1 + 1/r2)⁻¹, m.
-    pub radius_m: f64,
-    /// r1 + r2, the length in the global strain rate of paper Eq. 3, m.
-    pub sum_of_radii_m: f64,
-    /// Quasi-static yield stress min(σy1, σy2), Pa.
-    pub yield_stress_pa: f64,
-    /// Rate hardening of the sphere with the smaller yield stress (paper Eq. 2).
-    pub rate: JohnsonCook,
-    /// Bar wave speed c0 = √(E/ρ) of the slower sphere, m/s (vibration loss, docs/physics.md §3).
-    pub wave_speed_m_s: f64,
-}
+pub use crate::contact::ContactProperties;
 
 /// Largest approach δ, as a fraction of the smaller sphere radius, over which the contact law
 /// was fitted: the paper's quasi-static FEM (Fig. 2) compressed 3.175 mm hemispheres to at most
@@ -214,4 +199,40 @@ pub enum Seating {
         /// The static force, N.
         force_n: f64,
     },
+}
+
+/// Spheres in a line as the specimen of a scene (docs/physics.md §8, §6.11): the chain (a pair is
+/// the chain of two), the contact law of every contact and how each contact sits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SphereSpecimen {
+    /// The spheres, sphere 1 first (on the incident bar in a bar test).
+    pub chain: SphereChain,
+    /// Contact law of every contact, with its own parameters.
+    pub law: crate::contact::LawSpec,
+    /// How every sphere–sphere contact sits before the test.
+    pub seating: Seating,
+}
+
+impl SphereSpecimen {
+    /// A pair touching at rest with the law `law`.
+    pub fn pair(pair: &SpherePair, law: crate::contact::LawSpec) -> SphereSpecimen {
+        SphereSpecimen {
+            chain: SphereChain::from_pair(pair),
+            law,
+            seating: Seating::Touching,
+        }
+    }
+
+    /// The first pair (spheres 1 and 2).
+    pub fn first_pair(&self) -> SpherePair {
+        self.chain.pair(0)
+    }
+
+    /// The two lengths whose sum divides the approach rate into the global strain rate
+    /// (paper Eq. 3): (r1, r2) of a pair; for a longer chain (r1, r2 + … + rN), so that the rate
+    /// is δ̇/Σ rᵢ over the whole specimen (docs/physics.md §8).
+    pub fn strain_rate_radii_m(&self) -> (f64, f64) {
+        let r = &self.chain.spheres;
+        (r[0].radius_m, r[1..].iter().map(|s| s.radius_m).sum())
+    }
 }
