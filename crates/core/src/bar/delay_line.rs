@@ -11,7 +11,8 @@ use super::{Interior, Nodes, node_momentum};
 use crate::transit::TransitDesign;
 use std::sync::Arc;
 
-/// The characteristic increments of a delay-line bar of N elements (docs/physics.md §6.2, "Delay lines").
+/// The characteristic increments of a delay-line bar of N elements (docs/physics.md §6.2,
+/// "Delay lines").
 #[derive(Debug, Clone)]
 struct Waves {
     /// Right-going increments: D_{e−n} in slot (e − n) mod N, m.

@@ -1,9 +1,7 @@
-//! The bars: 1D longitudinal waves `ρA ü = ∂/∂x(EA ∂u/∂x)` on a lumped-mass grid advanced by the
-//! explicit central-difference (leapfrog) scheme (docs/physics.md §6.2), under one of four bar
-//! theories, each a module behind the private [`Interior`] interface: the lumped chain
-//! ([`leapfrog`]), the Love rod ([`love`], §6.3), the exact delay line ([`delay_line`], §6.2) and
-//! the dispersive delay line ([`dispersive`], §6.2.1); the end nodes ([`ends`]) and the energy
-//! ledger ([`ledger`], §6.6) are shared. x runs from the left end; displacements, velocities and
+//! The bars (docs/physics.md §6): 1D longitudinal waves `ρA ü = ∂/∂x(EA ∂u/∂x)` on a lumped grid
+//! stepped by the leapfrog (§6.2) under one of four theories, each a module behind the private
+//! `Interior` trait: `leapfrog` (lumped chain), `love` (Love rod, §6.3), `delay_line` (§6.2) and
+//! `dispersive` (§6.2.1); `ends` and `ledger` (§6.6) are shared. x runs from the left end; u, v and
 //! forces are positive toward +x, strain, stress and element forces positive in tension.
 
 mod delay_line;
