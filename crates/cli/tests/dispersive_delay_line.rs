@@ -45,7 +45,7 @@ fn pulse_n(t_s: f64) -> f64 {
     -1e4 * (-((t_s - 40e-6) / 8e-6).powi(2)).exp()
 }
 
-/// The harness of the Love-rod scheme's test (`bar.rs`) measures each model's own phase velocity
+/// The harness of the Love-rod scheme's test (`bar/phase_velocity.rs`) measures each model's own phase velocity
 /// on a dispersive delay line at 1 mm cells, to its resolution of 1e-4, without attenuation.
 #[test]
 fn each_model_carries_its_phase_velocity() {

@@ -449,7 +449,7 @@ fn insert_only_delays(length_m: f64, tolerance: f64) {
     // A 6 mm insert is six whole 1 mm cells at Courant 1: the chain is then the d'Alembert
     // solution at the nodes and the delay 12 steps exactly, so only rounding remains (1e-9).
     // The 1/4" insert has ⌊L/Δx⌋ = 6 cells at Courant 0.945: its interfaces with the Courant-1
-    // bars are no longer exact (bar.rs) and its grid carries the steepest part of the contact's
+    // bars are no longer exact (physics §6.2) and its grid carries the steepest part of the contact's
     // response with a small phase error; measured 0.8 % (reflected) and 1.9 % (transmitted) of
     // the peak, bounded at 2.5 %.
     for (name, with, without, from) in [
@@ -520,7 +520,7 @@ fn an_insert_of_another_impedance_transmits_and_reflects_as_impedance_theory_say
     let reflected = plateau(&inc, t_inc + 2.0 * d_i / c0);
     let transmitted = plateau(&tra, t_inc + (d_i + ins.length_m + d_t) / c0);
     // Courant 1 in bars and insert (0.3 m is a whole number of 1 mm cells): the interfaces are
-    // exact (bar.rs); 0.5 % covers the plateau's ripple from the first-impact step.
+    // exact (physics §6.2); 0.5 % covers the plateau's ripple from the first-impact step.
     assert!(incident < 0.0);
     assert!(
         rel(reflected / incident, r_expected) < 5e-3,

@@ -1,6 +1,6 @@
 //! Regenerates `validation/love-rod/REPORT.md`: the phase velocity of the simulated Love rod
-//! (crates/core/src/bar.rs) against the Rayleigh–Love relation and the Bancroft first-mode fit
-//! (physics.md §6–§7). Run from the repository root with
+//! (crates/core/src/bar/love.rs, measured by bar/phase_velocity.rs) against the Rayleigh–Love
+//! relation and the Bancroft first-mode fit (physics.md §6–§7). Run from the repository root with
 //! `cargo run --release -p shpb-validate --bin love_rod_report`.
 
 #![warn(missing_docs)]
