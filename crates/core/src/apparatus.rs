@@ -395,7 +395,7 @@ impl Apparatus {
             for (k, right, m) in sphere_masses {
                 match &mut bodies[k] {
                     crate::solver::BodySpec::Mass(body) => body.mass_kg += m,
-                    crate::solver::BodySpec::Bar(_) => end_masses.push((k, right, m)),
+                    _ => end_masses.push((k, right, m)),
                 }
             }
             joints.extend(tail_joints);

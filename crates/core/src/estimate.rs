@@ -173,6 +173,7 @@ pub fn bar_run(
                 bars += 1.0;
             }
             BodySpec::Mass(_) => nodes += 1.0,
+            BodySpec::Cylinder(c) => nodes += c.cells_at(dt) as f64 + 1.0,
         }
     }
     // Recorders at every `record_every`-th step: gauges and time (allocated once), the energy

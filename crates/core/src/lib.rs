@@ -18,6 +18,7 @@ pub mod estimate;
 pub mod fidelity;
 #[cfg(test)]
 mod fixtures;
+pub mod flow;
 pub mod gauge;
 pub mod material;
 pub mod numeric;

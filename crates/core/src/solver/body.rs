@@ -4,6 +4,7 @@
 //! data to the joints: current displacement, last half-step velocity, the velocity the coming
 //! step would give the end without the joint's force, and the end's mobility ∂v/∂F.
 
+use super::cylinder::{CylinderSpec, PlasticCylinder};
 use crate::bar::{Bar, BarSpec};
 use crate::error::{Error, Result};
 
@@ -14,6 +15,8 @@ pub enum BodySpec {
     Bar(BarSpec),
     /// A rigid mass, e.g. a sphere of a chain between two contacts.
     Mass(MassSpec),
+    /// An elastoplastic cylindrical specimen (docs/physics.md §6.12).
+    Cylinder(CylinderSpec),
 }
 
 impl From<BarSpec> for BodySpec {
@@ -73,6 +76,8 @@ pub enum Body {
     Bar(Box<Bar>),
     /// A rigid mass.
     Mass(PointMass),
+    /// An elastoplastic cylinder (boxed, as a bar).
+    Cylinder(Box<PlasticCylinder>),
 }
 
 impl Body {
@@ -81,6 +86,7 @@ impl Body {
         Ok(match spec {
             BodySpec::Bar(s) => Body::Bar(Box::new(Bar::new(s, dt_s)?)),
             BodySpec::Mass(m) => Body::Mass(PointMass::new(m, dt_s)?),
+            BodySpec::Cylinder(c) => Body::Cylinder(Box::new(PlasticCylinder::new(c, dt_s)?)),
         })
     }
 
@@ -89,6 +95,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.name(),
             Body::Mass(m) => &m.name,
+            Body::Cylinder(c) => c.name(),
         }
     }
 
@@ -96,7 +103,15 @@ impl Body {
     pub fn as_bar(&self) -> Option<&Bar> {
         match self {
             Body::Bar(b) => Some(b),
-            Body::Mass(_) => None,
+            _ => None,
+        }
+    }
+
+    /// The elastoplastic cylinder, if the body is one.
+    pub fn as_cylinder(&self) -> Option<&PlasticCylinder> {
+        match self {
+            Body::Cylinder(c) => Some(c),
+            _ => None,
         }
     }
 
@@ -105,6 +120,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.displacement_m(if right { b.node_count() - 1 } else { 0 }),
             Body::Mass(m) => m.displacement_m,
+            Body::Cylinder(c) => c.displacement_m(if right { c.node_count() - 1 } else { 0 }),
         }
     }
 
@@ -113,6 +129,9 @@ impl Body {
         match self {
             Body::Bar(b) => b.half_step_velocity_m_s(if right { b.node_count() - 1 } else { 0 }),
             Body::Mass(m) => m.velocity_m_s,
+            Body::Cylinder(c) => {
+                c.half_step_velocity_m_s(if right { c.node_count() - 1 } else { 0 })
+            }
         }
     }
 
@@ -123,6 +142,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.free_end_velocity_m_s(right),
             Body::Mass(m) => m.velocity_m_s + m.dt_s * other_end_force_n / m.mass_kg,
+            Body::Cylinder(c) => c.free_end_velocity_m_s(right, other_end_force_n),
         }
     }
 
@@ -131,12 +151,18 @@ impl Body {
         match self {
             Body::Bar(b) => b.end_mobility_s_per_kg(right, right),
             Body::Mass(m) => m.dt_s / m.mass_kg,
+            Body::Cylinder(c) => c.end_mobility_s_per_kg(right),
         }
     }
 
-    /// Whether the force at one end moves the other end within the same step (a rigid mass).
+    /// Whether the force at one end moves the other end within the same step (a rigid mass, a
+    /// cylinder with radial inertia).
     pub fn is_rigid(&self) -> bool {
-        matches!(self, Body::Mass(_))
+        match self {
+            Body::Mass(_) => true,
+            Body::Cylinder(c) => c.couples_ends(),
+            Body::Bar(_) => false,
+        }
     }
 
     /// Advances one step with forces (N, toward +x) at the left and right ends.
@@ -148,6 +174,7 @@ impl Body {
                 m.displacement_m += m.dt_s * m.velocity_m_s;
                 m.step_index += 1;
             }
+            Body::Cylinder(c) => c.step(left_force_n, right_force_n),
         }
     }
 
@@ -156,6 +183,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.set_initial_velocity(v_m_s),
             Body::Mass(m) => m.velocity_m_s = v_m_s,
+            Body::Cylinder(c) => c.set_initial_velocity(v_m_s),
         }
     }
 
@@ -164,6 +192,7 @@ impl Body {
         match self {
             Body::Bar(b) => (0..b.node_count()).map(|i| b.node_mass_kg(i)).sum(),
             Body::Mass(m) => m.mass_kg,
+            Body::Cylinder(c) => (0..c.node_count()).map(|i| c.node_mass_kg(i)).sum(),
         }
     }
 
@@ -172,16 +201,38 @@ impl Body {
         match self {
             Body::Bar(b) => b.momentum_kg_m_s(),
             Body::Mass(m) => m.mass_kg * m.velocity_m_s,
+            Body::Cylinder(c) => c.momentum_kg_m_s(),
         }
     }
 
     /// Kinetic plus strain energy at the half level n − 1/2 (the scheme's conserved energy), J: a
-    /// bar's from its energy ledger ([`Bar::energy_j`], O(1)), a mass's from its velocity.
+    /// bar's from its energy ledger ([`Bar::energy_j`], O(1)), a mass's from its velocity, a
+    /// cylinder's kinetic plus elastic energy from its ledger ([`PlasticCylinder::energy_j`]).
     pub fn energy_j(&self) -> f64 {
         match self {
             Body::Bar(b) => b.energy_j(),
             Body::Mass(m) => 0.5 * m.mass_kg * m.velocity_m_s * m.velocity_m_s,
+            Body::Cylinder(c) => c.energy_j(),
         }
+    }
+
+    /// Plastic work done in the body so far (a cylinder's; 0 otherwise), J.
+    pub fn plastic_work_j(&self) -> f64 {
+        self.as_cylinder()
+            .map_or(0.0, PlasticCylinder::plastic_work_j)
+    }
+
+    /// Friction work at the body's faces so far (a cylinder's; 0 otherwise), J.
+    pub fn friction_work_j(&self) -> f64 {
+        self.as_cylinder()
+            .map_or(0.0, PlasticCylinder::friction_work_j)
+    }
+
+    /// Kinetic energy given to the body by its changing radial-inertia mass (a cylinder's;
+    /// 0 otherwise), J.
+    pub fn inertia_exchange_j(&self) -> f64 {
+        self.as_cylinder()
+            .map_or(0.0, PlasticCylinder::inertia_exchange_j)
     }
 
     /// The energy that has passed through the body: a bar's ledger turnover
@@ -190,6 +241,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.energy_turnover_j(),
             Body::Mass(_) => self.energy_j(),
+            Body::Cylinder(c) => c.energy_turnover_j(),
         }
     }
 
@@ -198,6 +250,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.recomputed_energy_j(),
             Body::Mass(_) => self.energy_j(),
+            Body::Cylinder(c) => c.recomputed_energy_j(),
         }
     }
 
@@ -205,7 +258,7 @@ impl Body {
     pub fn absorbed_energy_j(&self) -> f64 {
         match self {
             Body::Bar(b) => b.absorbed_energy_j(),
-            Body::Mass(_) => 0.0,
+            Body::Mass(_) | Body::Cylinder(_) => 0.0,
         }
     }
 
@@ -215,6 +268,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.check_step(),
             Body::Mass(_) => self.check_finite(),
+            Body::Cylinder(c) => c.check_step(),
         }
     }
 
@@ -225,6 +279,7 @@ impl Body {
         match self {
             Body::Bar(b) => b.check_energy_ledger(scale_j),
             Body::Mass(_) => Ok(()),
+            Body::Cylinder(c) => c.check_energy_ledger(scale_j),
         }
     }
 
@@ -248,6 +303,7 @@ impl Body {
                 }
                 Ok(())
             }
+            Body::Cylinder(c) => c.check_finite(),
         }
     }
 }

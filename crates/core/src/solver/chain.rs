@@ -104,10 +104,10 @@ impl Chain {
                     let node = if right { bar.node_count() - 1 } else { 0 };
                     bar.add_node_mass(node, mass_kg);
                 }
-                Body::Mass(_) => {
+                Body::Mass(_) | Body::Cylinder(_) => {
                     return Err(Error::invalid(
                         "end_masses",
-                        format!("body {k} is a rigid mass"),
+                        format!("body {k} is not a bar"),
                         "masses are added to bar ends",
                     ));
                 }
@@ -274,6 +274,15 @@ pub struct ChainResult {
     pub shaper_energy_j: Vec<f64>,
     /// Work taken by the sphere contacts so far (dissipated plus elastic energy held), J.
     pub contact_energy_j: Vec<f64>,
+    /// Plastic work done in elastoplastic specimens so far, J (docs/physics.md §6.12).
+    pub plastic_work_j: Vec<f64>,
+    /// Friction work at the specimens' faces so far, J (§6.12).
+    pub friction_work_j: Vec<f64>,
+    /// Kinetic energy given to the specimens by their changing radial-inertia mass so far, J
+    /// (§6.12): striker + drive + this = bodies + absorbed + shaper + contact + plastic + friction.
+    pub inertia_exchange_j: Vec<f64>,
+    /// The elastoplastic cylinder's series, if the chain has one (§6.12).
+    pub specimen: Option<super::cylinder::SpecimenSeries>,
     /// The first sphere contact's history (approach, force, σy*, strain rate), if the chain has one.
     pub contact: Option<crate::solver::ContactSeries>,
     /// Stress fields of the bars over time, if requested.
@@ -313,6 +322,16 @@ pub fn simulate_chain_with(
         .iter()
         .position(|j| j.law.is_some())
         .map(|k| ContactRecorder::new(k, setup.record_every, setup.dt_s, cap));
+    let mut specimen = chain
+        .bodies
+        .iter()
+        .position(|b| matches!(b, Body::Cylinder(_)))
+        .map(|k| super::cylinder::SpecimenRecorder {
+            body: k,
+            every: setup.record_every,
+            dt_s: setup.dt_s,
+            series: Default::default(),
+        });
     let mut snapshots = setup
         .snapshot_every
         .map(|k| SnapshotRecorder::new(&chain.bodies, k, setup.snapshot_spacing_m));
@@ -330,6 +349,9 @@ pub fn simulate_chain_with(
             recorders.push(d);
         }
         if let Some(c) = contact.as_mut() {
+            recorders.push(c);
+        }
+        if let Some(c) = specimen.as_mut() {
             recorders.push(c);
         }
         if let Some(s) = snapshots.as_mut() {
@@ -350,6 +372,10 @@ pub fn simulate_chain_with(
         absorbed_energy_j: energy.absorbed_energy_j,
         shaper_energy_j: energy.shaper_energy_j,
         contact_energy_j: energy.contact_energy_j,
+        plastic_work_j: energy.plastic_work_j,
+        friction_work_j: energy.friction_work_j,
+        inertia_exchange_j: energy.inertia_exchange_j,
+        specimen: specimen.map(|s| s.series),
         contact: contact.map(|c| c.series),
         snapshots: snapshots.map(|s| s.snapshots).unwrap_or_default(),
         striker_energy_j,

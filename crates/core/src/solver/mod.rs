@@ -34,6 +34,7 @@
 
 pub mod body;
 pub mod chain;
+pub mod cylinder;
 pub mod joint;
 pub mod record;
 pub mod solitary;
@@ -41,6 +42,9 @@ pub mod spheres;
 
 pub use body::{Body, BodySpec, MassSpec};
 pub use chain::{Chain, ChainResult, ChainSetup, simulate_chain, simulate_chain_with};
+pub use cylinder::{
+    CylinderSpec, Friction, FrictionModel, PlasticCylinder, SpecimenRecorder, SpecimenSeries,
+};
 pub use joint::Joint;
 pub use record::{BarSnapshots, GaugeProbe, Recorder};
 pub use spheres::{FreeChainResult, FreeChainSetup, StrikerMass, Wall, free_chain};

@@ -128,6 +128,12 @@ pub struct EnergyRecorder {
     pub shaper_energy_j: Vec<f64>,
     /// Work taken by sphere contacts so far (dissipated plus elastic energy held), J.
     pub contact_energy_j: Vec<f64>,
+    /// Plastic work in elastoplastic specimens so far, J (docs/physics.md §6.12).
+    pub plastic_work_j: Vec<f64>,
+    /// Friction work at the specimens' faces so far, J (§6.12).
+    pub friction_work_j: Vec<f64>,
+    /// Kinetic energy given to the specimens by their changing radial-inertia mass, J (§6.12).
+    pub inertia_exchange_j: Vec<f64>,
 }
 
 impl Recorder for EnergyRecorder {
@@ -148,6 +154,12 @@ impl Recorder for EnergyRecorder {
         };
         self.shaper_energy_j.push(work(false));
         self.contact_energy_j.push(work(true));
+        self.plastic_work_j
+            .push(bodies.iter().map(Body::plastic_work_j).sum());
+        self.friction_work_j
+            .push(bodies.iter().map(Body::friction_work_j).sum());
+        self.inertia_exchange_j
+            .push(bodies.iter().map(Body::inertia_exchange_j).sum());
     }
 }
 
