@@ -34,11 +34,12 @@ fn cylinder_of(params: &Params) -> CylinderSpecimen {
         matches!(params.params, SceneParams::Pulse { .. }),
         "not a bar scene"
     );
-    *params
+    params
         .specimen
         .as_ref()
         .and_then(|s| s.cylinder())
         .expect("a cylinder specimen")
+        .clone()
 }
 
 fn summary(out: &shpb::run::RunOutput, key: &str) -> f64 {

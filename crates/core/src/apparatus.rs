@@ -687,16 +687,11 @@ fn join_specimen(
                 (back, false, sp.chain.spheres[n - 1].mass_kg),
             ]
         }
-        // A cylinder is a bar segment of its own between two butt joints, as an insert
-        // (docs/physics.md §6.9).
+        // A cylinder is a body of its own between two butt joints, as an insert; elastic without
+        // friction or radial inertia it is a bar segment step for step (docs/physics.md §6.9,
+        // §6.12).
         Specimen::Cylinder(c) => {
-            bodies.push(BodySpec::Bar(BarSpec {
-                name: "specimen".to_string(),
-                segments: vec![c.segment()],
-                left_end: EndCondition::Free,
-                right_end: EndCondition::Free,
-                dispersion: Dispersion::None,
-            }));
+            bodies.push(BodySpec::Cylinder(c.clone()));
             joints.push(Joint::Butt);
             joints.push(Joint::Butt);
             Vec::new()

@@ -1,10 +1,9 @@
 //! Flow-stress models of an elastoplastic specimen (docs/physics.md §6.12): J2 plasticity in
 //! uniaxial stress reduces to |σ| ≤ σ_f(ε̄p, ε̇p, T). Johnson–Cook (G. R. Johnson, W. H. Cook,
 //! Proc. 7th Int. Symp. Ballistics, The Hague (1983) 541–547), a tabulated true-stress curve, or
-//! none (an elastic specimen). SI units; every constructor validates its numbers.
+//! none (an elastic specimen); and the barrelling factor end friction puts on it. SI units; every
+//! constructor validates its numbers.
 
-#[cfg(test)]
-use crate::error::Error;
 use crate::error::{Named, Result};
 
 /// Thermal softening of Johnson–Cook, (1 − T*ᵐ) with T* = (T − T_room)/(T_melt − T_room) clamped to
@@ -255,9 +254,55 @@ impl FlowModel {
     }
 }
 
+/// How end friction raises the mean axial pressure needed to make a cylinder flow (§6.12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionModel {
+    /// Avitzur's upper bound for a cylinder flowing without bulging, with the constant friction
+    /// factor m = min(√3 μ, 1): p̄/σ_f = 1 + m d/(3√3 h) (B. Avitzur, *Metal Forming: Processes
+    /// and Analysis*, McGraw-Hill (1968), forging of a solid disc; = Siebel's 1 + μd/(3h) below
+    /// sticking).
+    Avitzur,
+    /// The slab (Schroeder–Webster) solution with Coulomb sliding over the whole face:
+    /// p̄/σ_f = 2(eᵇ − b − 1)/b², b = μ d/h (W. Schroeder, D. A. Webster, *J. Appl. Mech.* 16,
+    /// 289 (1949)); its small-μ limit is Siebel's 1 + μd/(3h).
+    Slab,
+}
+
+/// Coulomb friction at both faces of the specimen (§6.12).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Friction {
+    /// Coulomb coefficient μ (0 to 10).
+    pub coefficient: f64,
+    /// The barrelling factor applied to the flow stress.
+    pub model: FrictionModel,
+}
+
+impl Friction {
+    /// The factor p̄/σ_f ≥ 1 of [`FrictionModel`] for a cylinder of diameter `diameter_m` and
+    /// height `height_m` (§6.12).
+    pub fn factor(&self, diameter_m: f64, height_m: f64) -> f64 {
+        let aspect = diameter_m / height_m;
+        match self.model {
+            FrictionModel::Avitzur => {
+                let m = (3f64.sqrt() * self.coefficient).min(1.0);
+                1.0 + m * aspect / (3.0 * 3f64.sqrt())
+            }
+            FrictionModel::Slab => {
+                let b = self.coefficient * aspect;
+                if b < 1e-3 {
+                    1.0 + b / 3.0 + b * b / 12.0 + b * b * b / 60.0
+                } else {
+                    2.0 * (b.exp_m1() - b) / (b * b)
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::Error;
 
     fn copper() -> JohnsonCook {
         JohnsonCook {

@@ -9,6 +9,7 @@
 
 pub mod builtin;
 pub mod csv;
+pub mod cylinder;
 pub mod distribution;
 pub mod error;
 pub mod files;

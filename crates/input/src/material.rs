@@ -22,6 +22,125 @@ struct MaterialToml {
     jc_c: f64,
     #[serde(default = "default_reference_rate")]
     jc_reference_rate_per_s: f64,
+    /// The flow stress of a cylinder of this material (docs/physics.md §6.12); spheres ignore it.
+    #[allow(dead_code)]
+    johnson_cook: Option<toml::Value>,
+}
+
+/// A `[johnson_cook]` table (a material file's, or a cylinder's `[specimen.johnson_cook]`):
+/// σ_f = (A + B ε̄pⁿ)(1 + C ln max(ε̇p/ε̇0, 1))(1 − T*ᵐ), docs/physics.md §6.12; the thermal term
+/// when `m`, `melt_temperature_k` and `specific_heat_j_kg_k` are given.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JohnsonCookToml {
+    a_pa: f64,
+    b_pa: f64,
+    n: f64,
+    #[serde(default)]
+    c: f64,
+    #[serde(default = "default_jc_flow_rate")]
+    reference_rate_per_s: f64,
+    m: Option<f64>,
+    #[serde(default = "default_room_temperature")]
+    room_temperature_k: f64,
+    melt_temperature_k: Option<f64>,
+    specific_heat_j_kg_k: Option<f64>,
+    /// Where the constants come from (kept in the file; not used by the model).
+    #[allow(dead_code)]
+    source: Option<String>,
+}
+
+fn default_jc_flow_rate() -> f64 {
+    1.0
+}
+
+fn default_room_temperature() -> f64 {
+    293.0
+}
+
+/// Taylor–Quinney factor β, the fraction of plastic work turned into heat, unless a scene sets
+/// `taylor_quinney` (docs/physics.md §6.12; Taylor & Quinney, Proc. R. Soc. A 143, 307 (1934)).
+pub const DEFAULT_TAYLOR_QUINNEY: f64 = 0.9;
+
+/// Reads a `[johnson_cook]` table `value` (under `key` of `v`) into the core's law, with the
+/// Taylor–Quinney factor `taylor_quinney` for its heating.
+pub fn johnson_cook_from_value(
+    value: &toml::Value,
+    taylor_quinney: f64,
+    v: &Validator,
+    key: &str,
+) -> Result<shpb_core::flow::JohnsonCook> {
+    let raw: JohnsonCookToml = value.clone().try_into().map_err(|e: toml::de::Error| {
+        v.error(
+            key,
+            e.message().to_string(),
+            "a table { a_pa, b_pa, n, c, reference_rate_per_s, m, room_temperature_k, melt_temperature_k, specific_heat_j_kg_k }",
+        )
+    })?;
+    let tv = v.table(key);
+    let thermal = match (raw.m, raw.melt_temperature_k, raw.specific_heat_j_kg_k) {
+        (None, None, None) => None,
+        (Some(m), Some(melt), Some(cp)) => Some(shpb_core::flow::ThermalSoftening {
+            m,
+            room_temperature_k: raw.room_temperature_k,
+            melt_temperature_k: melt,
+            specific_heat_j_kg_k: cp,
+            taylor_quinney,
+        }),
+        _ => {
+            return Err(tv.error(
+                "m",
+                "thermal softening needs m, melt_temperature_k and specific_heat_j_kg_k together",
+                "all three, or none (no thermal softening)",
+            ));
+        }
+    };
+    shpb_core::flow::JohnsonCook::new(
+        key,
+        shpb_core::flow::JohnsonCook {
+            a_pa: raw.a_pa,
+            b_pa: raw.b_pa,
+            n: raw.n,
+            c: raw.c,
+            reference_rate_per_s: raw.reference_rate_per_s,
+            thermal,
+        },
+    )
+    .map_err(tv.core_named())
+}
+
+/// The `[johnson_cook]` table of a material reference (a built-in name or a `.toml` file, as
+/// [`MaterialFile::resolve`] reads it), if it has one.
+pub fn material_johnson_cook_table(
+    reference: &str,
+    base_dir: &Path,
+    v: &Validator,
+    key: &str,
+) -> Result<Option<toml::Value>> {
+    let (text, file) = if reference.ends_with(".toml") {
+        let path = base_dir.join(reference);
+        let text = crate::files::read_to_string(&path).map_err(|e| {
+            v.error(
+                key,
+                format!("cannot read {}: {e}", path.display()),
+                "a readable material .toml file, relative to the scene file's directory",
+            )
+        })?;
+        (text, path.display().to_string())
+    } else {
+        match BUILTIN_MATERIALS.iter().find(|(n, _)| *n == reference) {
+            Some((n, text)) => {
+                let file = format!("specimens/{n}.toml");
+                (crate::files::builtin(&file, text).to_string(), file)
+            }
+            None => return Ok(None),
+        }
+    };
+    let raw: MaterialToml = toml::from_str(&text).map_err(|e| Error::Parse {
+        file,
+        message: e.to_string(),
+    })?;
+    Ok(raw.johnson_cook)
 }
 
 fn default_reference_rate() -> f64 {
@@ -33,6 +152,23 @@ pub const BUILTIN_MATERIALS: &[(&str, &str)] = &[
     ("ss440c", include_str!("../../../specimens/ss440c.toml")),
     ("ss302", include_str!("../../../specimens/ss302.toml")),
     ("al2017", include_str!("../../../specimens/al2017.toml")),
+    (
+        "ofhc-copper",
+        include_str!("../../../specimens/ofhc-copper.toml"),
+    ),
+    (
+        "al6061-t6",
+        include_str!("../../../specimens/al6061-t6.toml"),
+    ),
+    (
+        "al7075-t6",
+        include_str!("../../../specimens/al7075-t6.toml"),
+    ),
+    ("ti6al4v", include_str!("../../../specimens/ti6al4v.toml")),
+    (
+        "steel4340",
+        include_str!("../../../specimens/steel4340.toml"),
+    ),
 ];
 
 /// Reading and resolving materials: built-in names or `.toml` files.

@@ -63,6 +63,36 @@ pub struct SpecimenSpec {
     pub gap_m: Option<f64>,
     /// `shpb` scenes: each contact pressed by this static force before the test, N (0 to 10 kN).
     pub preload_n: Option<f64>,
+    /// A cylinder's flow model (docs/physics.md §6.12): `elastic`, `johnson-cook` or `table`
+    /// (default: johnson-cook when the material has a `[johnson_cook]` table or the specimen
+    /// gives one, else elastic).
+    pub model: Option<String>,
+    /// A cylinder's Johnson–Cook constants (replaces the material file's `[johnson_cook]`).
+    pub johnson_cook: Option<toml::Value>,
+    /// A cylinder's tabulated flow curve: true stress against equivalent plastic strain.
+    pub flow_curve: Option<FlowCurveSpec>,
+    /// A cylinder's Taylor–Quinney factor (fraction of plastic work turned into heat, 0 to 1).
+    pub taylor_quinney: Option<f64>,
+    /// A cylinder's initial temperature, K.
+    pub initial_temperature_k: Option<f64>,
+    /// A cylinder's radial inertia (Davies–Hunter), default false.
+    pub radial_inertia: Option<bool>,
+    /// Coulomb friction coefficient at a cylinder's faces (0 to 10, default 0).
+    pub friction_coefficient: Option<f64>,
+    /// The barrelling factor of that friction: `avitzur` (default) or `slab`.
+    pub friction_model: Option<String>,
+    /// Compressive true strain a flowing cylinder's grid is built to carry (0 to 2).
+    pub design_true_strain: Option<f64>,
+}
+
+/// A tabulated flow curve (`[specimen.flow_curve]`): true stress at equivalent plastic strains.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlowCurveSpec {
+    /// Equivalent plastic strains, strictly increasing from 0.
+    pub plastic_strain: Vec<f64>,
+    /// True flow stress at each, Pa.
+    pub stress_pa: Vec<f64>,
 }
 
 /// Largest seating gap a scene may give, m: beyond it the spheres are not seated but loose.
@@ -223,12 +253,28 @@ impl SpecimenSpec {
                 "shape = \"spheres\" (or no shape) in this scene kind",
             ));
         }
-        if self.length_m.is_some() {
-            return Err(v.error(
-                "length_m",
-                "`length_m` belongs to a cylinder",
-                "shape = \"cylinder\" (kind = \"shpb\") for a cylindrical specimen",
-            ));
+        for (key, given) in [
+            ("length_m", self.length_m.is_some()),
+            ("model", self.model.is_some()),
+            ("johnson_cook", self.johnson_cook.is_some()),
+            ("flow_curve", self.flow_curve.is_some()),
+            ("taylor_quinney", self.taylor_quinney.is_some()),
+            (
+                "initial_temperature_k",
+                self.initial_temperature_k.is_some(),
+            ),
+            ("radial_inertia", self.radial_inertia.is_some()),
+            ("friction_coefficient", self.friction_coefficient.is_some()),
+            ("friction_model", self.friction_model.is_some()),
+            ("design_true_strain", self.design_true_strain.is_some()),
+        ] {
+            if given {
+                return Err(v.error(
+                    key,
+                    format!("`{key}` belongs to a cylinder"),
+                    "shape = \"cylinder\" (kind = \"shpb\") for a cylindrical specimen",
+                ));
+            }
         }
         Ok(())
     }
@@ -246,7 +292,8 @@ impl SpecimenSpec {
         }
     }
 
-    /// Validates a cylindrical specimen (`shape = "cylinder"`, docs/physics.md §6.9).
+    /// Validates a cylindrical specimen (`shape = "cylinder"`, docs/physics.md §6.9, §6.12): its
+    /// geometry and material here, its flow in [`crate::cylinder::build`].
     pub fn build_cylinder(
         &self,
         base_dir: &Path,
@@ -278,29 +325,7 @@ impl SpecimenSpec {
             };
             return Err(v.error(key, "missing", CYLINDER_FORM));
         };
-        let material = match material {
-            toml::Value::String(name) => {
-                let m = Material::resolve(name, base_dir, v, "material")?;
-                shpb_core::bar::BarMaterial {
-                    density_kg_m3: m.density_kg_m3,
-                    youngs_modulus_pa: m.youngs_modulus_pa,
-                    poisson_ratio: m.poisson_ratio,
-                }
-            }
-            table @ toml::Value::Table(_) => crate::setup::bar_material_value(table, v)?,
-            other => {
-                return Err(v.error(
-                    "material",
-                    format!("a value of type {} is not a material", other.type_str()),
-                    CYLINDER_FORM,
-                ));
-            }
-        };
-        Ok(shpb_core::specimen::CylinderSpecimen {
-            material,
-            length_m: v.positive("length_m", length, 0.1, "m")?,
-            diameter_m: v.positive("diameter_m", diameter, 0.1, "m")?,
-        })
+        crate::cylinder::build(self, material, length, diameter, base_dir, v)
     }
 
     /// Whether the table gives a chain (`count`, `material`, `diameter_m` or `sphere`) rather

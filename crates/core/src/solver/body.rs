@@ -4,9 +4,10 @@
 //! data to the joints: current displacement, last half-step velocity, the velocity the coming
 //! step would give the end without the joint's force, and the end's mobility ∂v/∂F.
 
-use super::cylinder::{CylinderSpec, PlasticCylinder};
+use super::cylinder::PlasticCylinder;
 use crate::bar::{Bar, BarSpec};
 use crate::error::{Error, Result};
+use crate::specimen::CylinderSpecimen;
 
 /// What a chain is built from, left to right.
 #[derive(Debug, Clone, PartialEq)]
@@ -16,7 +17,7 @@ pub enum BodySpec {
     /// A rigid mass, e.g. a sphere of a chain between two contacts.
     Mass(MassSpec),
     /// An elastoplastic cylindrical specimen (docs/physics.md §6.12).
-    Cylinder(CylinderSpec),
+    Cylinder(CylinderSpecimen),
 }
 
 impl From<BarSpec> for BodySpec {

@@ -8,147 +8,11 @@
 use super::body::Body;
 use super::joint::JointState;
 use super::record::Recorder;
-use crate::bar::{
-    BarMaterial, BarSpec, Dispersion, ENERGY_LEDGER_TOLERANCE, EndCondition, Segment,
-};
+use crate::bar::ENERGY_LEDGER_TOLERANCE;
 use crate::error::{Error, Named, Result};
 use crate::flow::FlowModel;
+use crate::specimen::CylinderSpecimen;
 use std::f64::consts::PI;
-
-/// How end friction raises the mean axial pressure needed to make a cylinder flow (§6.12).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrictionModel {
-    /// Avitzur's upper bound for a cylinder flowing without bulging, with the constant friction
-    /// factor m = min(√3 μ, 1): p̄/σ_f = 1 + m d/(3√3 h) (B. Avitzur, *Metal Forming: Processes
-    /// and Analysis*, McGraw-Hill (1968), forging of a solid disc; = Siebel's 1 + μd/(3h) below
-    /// sticking).
-    Avitzur,
-    /// The slab (Schroeder–Webster) solution with Coulomb sliding over the whole face:
-    /// p̄/σ_f = 2(eᵇ − b − 1)/b², b = μ d/h (W. Schroeder, D. A. Webster, *J. Appl. Mech.* 16,
-    /// 289 (1949)); its small-μ limit is Siebel's 1 + μd/(3h).
-    Slab,
-}
-
-/// Coulomb friction at both faces of the specimen (§6.12).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Friction {
-    /// Coulomb coefficient μ (0 to 10).
-    pub coefficient: f64,
-    /// The barrelling factor applied to the flow stress.
-    pub model: FrictionModel,
-}
-
-impl Friction {
-    /// The factor p̄/σ_f ≥ 1 of [`FrictionModel`] for a cylinder of diameter `diameter_m` and
-    /// height `height_m` (§6.12).
-    pub fn factor(&self, diameter_m: f64, height_m: f64) -> f64 {
-        let aspect = diameter_m / height_m;
-        match self.model {
-            FrictionModel::Avitzur => {
-                let m = (3f64.sqrt() * self.coefficient).min(1.0);
-                1.0 + m * aspect / (3.0 * 3f64.sqrt())
-            }
-            FrictionModel::Slab => {
-                let b = self.coefficient * aspect;
-                if b < 1e-3 {
-                    1.0 + b / 3.0 + b * b / 12.0 + b * b * b / 60.0
-                } else {
-                    2.0 * (b.exp_m1() - b) / (b * b)
-                }
-            }
-        }
-    }
-}
-
-/// An elastoplastic cylinder between two bodies of the chain (docs/physics.md §6.12).
-#[derive(Debug, Clone, PartialEq)]
-pub struct CylinderSpec {
-    /// Name (errors name `specimen <name>`).
-    pub name: String,
-    /// Elastic material: E, ν (radial inertia while elastic), ρ.
-    pub material: BarMaterial,
-    /// Initial diameter d₀, m.
-    pub diameter_m: f64,
-    /// Initial length L₀ along the bar axis, m.
-    pub length_m: f64,
-    /// The flow stress ([`FlowModel::Elastic`]: today's elastic cylinder).
-    pub flow: FlowModel,
-    /// Radial inertia (Davies & Hunter 1963): the lateral kinetic energy ½ρν_eff²J(u̇')².
-    pub radial_inertia: bool,
-    /// End friction (None: frictionless faces).
-    pub friction: Option<Friction>,
-    /// Initial temperature, K (the flow model's room temperature for Johnson–Cook).
-    pub initial_temperature_k: f64,
-    /// Compressive true strain the grid is built to carry stably: the cells are those of a
-    /// segment of length L₀ e^{−ε_d} (0: exactly a bar segment's, [`CylinderSpec::cells_at`]).
-    pub design_true_strain: f64,
-}
-
-impl CylinderSpec {
-    /// The validator whose errors name this specimen.
-    fn validator(&self) -> Named {
-        Named::new(format!("specimen {}", self.name))
-    }
-
-    /// Checks every number (Error::Invalid naming the key).
-    pub fn validate(&self) -> Result<()> {
-        let v = self.validator();
-        v.positive("length_m", self.length_m, 10.0, "m")?;
-        v.positive("diameter_m", self.diameter_m, 10.0, "m")?;
-        let m = v.table("material");
-        m.positive("density_kg_m3", self.material.density_kg_m3, 1e5, "kg/m³")?;
-        m.positive(
-            "youngs_modulus_pa",
-            self.material.youngs_modulus_pa,
-            1e13,
-            "Pa",
-        )?;
-        m.in_range(
-            "poisson_ratio",
-            self.material.poisson_ratio,
-            -0.99,
-            0.4999,
-            "",
-        )?;
-        self.flow.validate(&format!("specimen {}", self.name))?;
-        if let Some(f) = &self.friction {
-            v.table("friction")
-                .in_range("coefficient", f.coefficient, 0.0, 10.0, "")?;
-        }
-        v.positive(
-            "initial_temperature_k",
-            self.initial_temperature_k,
-            1e4,
-            "K",
-        )?;
-        v.in_range("design_true_strain", self.design_true_strain, 0.0, 2.0, "")?;
-        Ok(())
-    }
-
-    /// The specimen as one uniform bar segment (its initial geometry).
-    pub fn segment(&self) -> Segment {
-        Segment {
-            length_m: self.length_m,
-            diameter_m: self.diameter_m,
-            material: self.material,
-        }
-    }
-
-    /// Cells at time step `dt_s`: ⌊L₀ e^{−ε_d}/(c Δt)⌋ ≥ 1, exactly a bar segment's
-    /// ([`BarSpec::cells_for_time_step`]) for ε_d = 0.
-    pub fn cells_at(&self, dt_s: f64) -> usize {
-        let mut s = self.segment();
-        s.length_m *= (-self.design_true_strain).exp();
-        BarSpec {
-            name: self.name.clone(),
-            segments: vec![s],
-            left_end: EndCondition::Free,
-            right_end: EndCondition::Free,
-            dispersion: Dispersion::None,
-        }
-        .cells_for_time_step(dt_s)[0]
-    }
-}
 
 /// One sample of the specimen at a time level (compression positive, as docs/physics.md §7.8).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -223,7 +87,7 @@ impl Tridiagonal {
 /// The specimen in its time-stepping state (docs/physics.md §6.12).
 #[derive(Debug, Clone)]
 pub struct PlasticCylinder {
-    spec: CylinderSpec,
+    spec: CylinderSpecimen,
     dt_s: f64,
     step_index: usize,
     /// Initial cell Δx₀, m.
@@ -279,11 +143,11 @@ pub struct PlasticCylinder {
 const STABILITY_BOUND: f64 = 4.0 * (1.0 + 1e-9);
 
 impl PlasticCylinder {
-    /// Builds the specimen on time step `dt_s` (cells [`CylinderSpec::cells_at`]); refuses a
+    /// Builds the specimen on time step `dt_s` (cells [`CylinderSpecimen::cells_at`]); refuses a
     /// step above the stability limit of one cell (Error::Invalid naming `time_step_s`).
-    pub fn new(spec: &CylinderSpec, dt_s: f64) -> Result<PlasticCylinder> {
+    pub fn new(spec: &CylinderSpecimen, dt_s: f64) -> Result<PlasticCylinder> {
         spec.validate()?;
-        let val = spec.validator();
+        let val = Named::new(CylinderSpecimen::NAME);
         val.positive("time_step_s", dt_s, 1.0, "s")?;
         let n = spec.cells_at(dt_s);
         let seg = spec.segment();
@@ -362,11 +226,11 @@ impl PlasticCylinder {
 
     /// The specimen's name.
     pub fn name(&self) -> &str {
-        &self.spec.name
+        CylinderSpecimen::NAME
     }
 
     /// Its specification.
-    pub fn spec(&self) -> &CylinderSpec {
+    pub fn spec(&self) -> &CylinderSpecimen {
         &self.spec
     }
 
@@ -408,6 +272,37 @@ impl PlasticCylinder {
     /// True stress F/A_p of element e at the current level (tension positive), Pa.
     pub fn element_stress_pa(&self, e: usize) -> f64 {
         self.force[e] * self.lp[e] / (self.area0_m2 * self.dx0_m)
+    }
+
+    /// Initial length L₀, m (the x–t snapshots' axis).
+    pub fn initial_length_m(&self) -> f64 {
+        self.dx0_m * self.element_count() as f64
+    }
+
+    /// Elastic strain (l − l_p)/l_p = (Δu − s)/l_p of element e (tension positive): with no
+    /// plastic slack exactly a bar element's Δu/Δx₀.
+    fn elastic_strain(&self, e: usize) -> f64 {
+        (self.u[e + 1] - self.u[e] - self.slack[e]) / self.lp[e]
+    }
+
+    /// True stress E ε_e at x along the initial length (tension positive), Pa: linear between
+    /// element centres, constant from the outermost centres to the ends, as
+    /// [`crate::bar::Bar::stress_at`] reads a bar.
+    pub fn stress_at(&self, x_m: f64) -> f64 {
+        let n = self.element_count();
+        let e_mod = self.spec.material.youngs_modulus_pa;
+        if n == 1 {
+            return e_mod * self.elastic_strain(0);
+        }
+        let xi = (x_m / self.dx0_m - 0.5).clamp(0.0, (n - 1) as f64);
+        let j = (xi as usize).min(n - 2);
+        let t = xi - j as f64;
+        let strain = if t == 0.0 {
+            self.elastic_strain(j)
+        } else {
+            (1.0 - t) * self.elastic_strain(j) + t * self.elastic_strain(j + 1)
+        };
+        e_mod * strain
     }
 
     /// The sample taken by the last step (the level of its end forces).
@@ -766,7 +661,8 @@ impl PlasticCylinder {
                         format!(
                             "specimen {}: compressed to a true strain {strain:.3}, node {i} is past the \
                              grid's stability limit (design_true_strain = {} sets the cells for it)",
-                            self.spec.name, self.spec.design_true_strain
+                            CylinderSpecimen::NAME,
+                            self.spec.design_true_strain
                         ),
                         bound,
                     ));
@@ -867,7 +763,8 @@ impl PlasticCylinder {
             time_s: self.time_s(),
             quantity: format!(
                 "specimen {}: energy ledger {:e} J minus its recomputation {full:e} J (allowed: {ENERGY_LEDGER_TOLERANCE:e} of {scale:e} J)",
-                self.spec.name, self.ledger_j
+                CylinderSpecimen::NAME,
+                self.ledger_j
             ),
             value: difference,
         })
@@ -884,7 +781,10 @@ impl PlasticCylinder {
                 return Err(Error::Unstable {
                     step: self.step_index,
                     time_s: self.time_s(),
-                    quantity: format!("specimen {}: {what} of node or element {i}", self.spec.name),
+                    quantity: format!(
+                        "specimen {}: {what} of node or element {i}",
+                        CylinderSpecimen::NAME
+                    ),
                     value,
                 });
             }

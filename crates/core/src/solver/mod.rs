@@ -42,9 +42,7 @@ pub mod spheres;
 
 pub use body::{Body, BodySpec, MassSpec};
 pub use chain::{Chain, ChainResult, ChainSetup, simulate_chain, simulate_chain_with};
-pub use cylinder::{
-    CylinderSpec, Friction, FrictionModel, PlasticCylinder, SpecimenRecorder, SpecimenSeries,
-};
+pub use cylinder::{PlasticCylinder, SpecimenRecorder, SpecimenSeries};
 pub use joint::Joint;
 pub use record::{BarSnapshots, GaugeProbe, Recorder};
 pub use spheres::{FreeChainResult, FreeChainSetup, StrikerMass, Wall, free_chain};

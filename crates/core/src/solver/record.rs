@@ -371,12 +371,18 @@ impl SnapshotRecorder {
     pub fn new(bodies: &[Body], every: usize, spacing_m: f64) -> SnapshotRecorder {
         let snapshots = bodies
             .iter()
-            .filter_map(Body::as_bar)
-            .map(|b| {
-                let len = b.node_position_m(b.node_count() - 1);
+            .filter_map(|b| {
+                match b {
+                    Body::Bar(bar) => Some(bar.node_position_m(bar.node_count() - 1)),
+                    Body::Cylinder(c) => Some(c.initial_length_m()),
+                    Body::Mass(_) => None,
+                }
+                .map(|len| (b.name(), len))
+            })
+            .map(|(name, len)| {
                 let n = ((len / spacing_m).round() as usize).max(1);
                 BarSnapshots {
-                    name: b.name().to_string(),
+                    name: name.to_string(),
                     x_m: (0..=n).map(|k| len * k as f64 / n as f64).collect(),
                     time_s: Vec::new(),
                     stress_pa: Vec::new(),
@@ -395,10 +401,13 @@ impl SnapshotRecorder {
     pub fn finish(&mut self, bodies: &[Body]) {
         for (b, s) in bodies
             .iter()
-            .filter_map(Body::as_bar)
+            .filter(|b| !matches!(b, Body::Mass(_)))
             .zip(self.snapshots.iter_mut())
         {
-            if let Some(rows) = b.stress_history(&s.x_m, &self.steps) {
+            if let Some(rows) = b
+                .as_bar()
+                .and_then(|b| b.stress_history(&s.x_m, &self.steps))
+            {
                 s.stress_pa = rows;
             }
         }
@@ -413,13 +422,20 @@ impl Recorder for SnapshotRecorder {
         self.steps.push(step);
         for (b, s) in bodies
             .iter()
-            .filter_map(Body::as_bar)
+            .filter(|b| !matches!(b, Body::Mass(_)))
             .zip(self.snapshots.iter_mut())
         {
             s.time_s.push(time_s);
-            if b.transit_model().is_none() {
-                s.stress_pa
-                    .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+            match b {
+                Body::Bar(b) if b.transit_model().is_none() => {
+                    s.stress_pa
+                        .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
+                }
+                Body::Cylinder(c) => {
+                    s.stress_pa
+                        .push(s.x_m.iter().map(|&x| c.stress_at(x)).collect());
+                }
+                _ => {}
             }
         }
     }

@@ -7,7 +7,9 @@
 pub mod cylinder;
 pub mod spheres;
 
-pub use cylinder::{CYLINDER_MIN_CELLS, CylinderSpecimen};
+pub use cylinder::{
+    ASPECT_RATIO_RANGE, CYLINDER_MIN_CELLS, CylinderSpecimen, DEFAULT_DESIGN_TRUE_STRAIN,
+};
 pub use spheres::{
     ContactProperties, MODEL_APPROACH_LIMIT_OF_RADIUS, Seating, Sphere, SphereChain, SpherePair,
     SphereSpecimen, reduced_mass_kg,

@@ -208,7 +208,7 @@ pub(super) fn parse_bars(
         }
         (None, false) => None,
     };
-    let cylinder = specimen.as_ref().and_then(Specimen::cylinder).copied();
+    let cylinder = specimen.as_ref().and_then(Specimen::cylinder).cloned();
     let set_up = base_dir.join(&f.bars);
     if crate::builtin::setup(&f.bars).is_none() && !crate::files::is_file(&set_up) {
         return Err(v.error(
@@ -337,7 +337,9 @@ pub(super) fn parse_bars(
     let c0 = apparatus.material.wave_speed_m_s();
     // A cylinder gets at least CYLINDER_MIN_CELLS cells (docs/physics.md §6.9): the default
     // cell is refined to it, an explicit one that cannot is refused.
-    let cylinder_cell = cylinder.map(|c| c.largest_bar_cell_m(c0, CYLINDER_MIN_CELLS));
+    let cylinder_cell = cylinder
+        .as_ref()
+        .map(|c| c.largest_bar_cell_m(c0, CYLINDER_MIN_CELLS));
     let default_cell = cylinder_cell.map_or(knobs.cell_size_m, |c| c.min(knobs.cell_size_m));
     // Dispersion on the travelling waves needs bars of whole cells (docs/physics.md §6.2.1):
     // the preset's cell is refined to the largest that divides every bar (10/3 mm for the

@@ -103,10 +103,11 @@ mod tests {
         else {
             panic!("not a bar scene")
         };
-        let c = *specimen
+        let c = specimen
             .as_ref()
             .and_then(|s| s.cylinder())
-            .expect("a cylinder");
+            .expect("a cylinder")
+            .clone();
         let al = <Material as crate::material::MaterialFile>::builtin("al2017").unwrap();
         assert_eq!(
             (
@@ -128,7 +129,11 @@ mod tests {
         let SceneParams::Pulse { options, .. } = p else {
             panic!("not a bar scene")
         };
-        let c = *specimen.as_ref().and_then(|s| s.cylinder()).unwrap();
+        let c = specimen
+            .as_ref()
+            .and_then(|s| s.cylinder())
+            .unwrap()
+            .clone();
         assert_eq!(c.material.youngs_modulus_pa, 200e9);
         assert_eq!(options.cell_size_m, 5e-4);
     }

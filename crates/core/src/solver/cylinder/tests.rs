@@ -1,10 +1,12 @@
 //! The elastoplastic cylinder against its constitutive law, today's elastic cylinder, the energy
 //! ledger, Davies–Hunter's inertia and the friction factors (docs/physics.md §6.12).
 use super::*;
-use crate::flow::{FlowTable, JohnsonCook, ThermalSoftening};
+use crate::bar::{BarMaterial, BarSpec, Dispersion, EndCondition, Segment};
+use crate::flow::{FlowTable, Friction, FrictionModel, JohnsonCook, ThermalSoftening};
 use crate::solver::body::BodySpec;
 use crate::solver::chain::{ChainSetup, simulate_chain};
 use crate::solver::{GaugeProbe, Joint};
+use crate::specimen::CylinderSpecimen;
 
 const ALUMINIUM: BarMaterial = BarMaterial {
     density_kg_m3: 2700.0,
@@ -35,9 +37,8 @@ fn copper_jc(thermal: bool) -> JohnsonCook {
     }
 }
 
-fn cylinder(material: BarMaterial, d: f64, l: f64, flow: FlowModel) -> CylinderSpec {
-    CylinderSpec {
-        name: "specimen".into(),
+fn cylinder(material: BarMaterial, d: f64, l: f64, flow: FlowModel) -> CylinderSpecimen {
+    CylinderSpecimen {
         material,
         diameter_m: d,
         length_m: l,
