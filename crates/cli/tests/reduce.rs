@@ -1271,7 +1271,7 @@ fn plot_writes_a_png_and_refuses_to_clobber() {
     let again = common::shpb(dir, &["reduce", &rec, "--plot", "r.png"]);
     assert_eq!(again.status.code(), Some(2), "{}", common::stderr(&again));
     assert!(
-        common::stderr(&again).contains("--plot"),
+        common::stderr(&again).contains("r.png: output file exists"),
         "{}",
         common::stderr(&again)
     );

@@ -265,7 +265,7 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
         apparatus,
         hdf5_input,
         cylinder,
-        ..
+        specimen,
     } = reduced;
     let bridges: Vec<String> = ["incident", "transmission"]
         .iter()
@@ -330,6 +330,13 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
             stated.as_ref().map_or(f64::NAN, |s| s.transmission_gauge_m),
         ));
     }
+    if let (Some((r1, r2)), Some(rate)) = (specimen.radii_m(), &r.strain_rate_per_s) {
+        text.push_str(&format!(
+            "spheres, r1 + r2 = {:.3} mm: peak strain rate δ̇/(r1 + r2) {:.0} 1/s\n",
+            (r1 + r2) * 1e3,
+            rate.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        ));
+    }
     if let Some(c) = cylinder {
         text.push_str(&format!(
             "cylinder {:.3} mm × {:.3} mm (1-wave, compression positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
@@ -390,6 +397,12 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
         "equilibrium_ratio_at_peak": finite(r.equilibrium_ratio_at_peak),
         "warnings": r.warnings,
     });
+    if let (Some((r1, r2)), Some(rate)) = (reduced.specimen.radii_m(), &r.strain_rate_per_s) {
+        json["spheres"] = serde_json::json!({
+            "radii_sum_m": finite(r1 + r2),
+            "peak_strain_rate_per_s": finite(rate.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+        });
+    }
     if let Some(c) = &reduced.cylinder {
         json["cylinder"] = serde_json::json!({
             "length_m": finite(c.geometry.length_m),
