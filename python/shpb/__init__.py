@@ -309,6 +309,7 @@ def reduce(
     specimen_diameter_m: Optional[float] = None,
     layout: Optional[PathLike] = None,
     balance_bound_s: float = 60e-6,
+    specimen: Optional[PathLike] = None,
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -324,7 +325,10 @@ def reduce(
     (docs/physics.md §7.8), and ``peak_stress``, ``strain_at_peak_stress``,
     ``mean_strain_rate`` in the summary. ``layout``: a record layout file (``--layout``) for a
     lab's own text export. ``balance_bound_s``: the bound of ``align="balance"``'s search on
-    each window shift, s (``--balance-bound``)."""
+    each window shift, s (``--balance-bound``). ``specimen``: a specimen file (``--specimen``),
+    a ``[specimen]`` table as in a scene: spheres of any diameter (the strain rate over their
+    radii, δ̇/Σrᵢ) or ``shape = "cylinder"`` (its 1/2/3-wave curves); not with
+    ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -339,6 +343,7 @@ def reduce(
             specimen_diameter_m,
             None if layout is None else os.fspath(layout),
             float(balance_bound_s),
+            None if specimen is None else os.fspath(specimen),
         )
     )
 

@@ -328,6 +328,26 @@ def test_sweep_in_parallel_equals_serial():
 # --- errors: the exception of the exit code, with the command line's message ---------------
 
 
+def test_reduce_specimen_keyword_equals_the_flag(cli, tmp_path):
+    # specimen= is `shpb reduce --specimen`: the same datasets; 12.7 mm spheres halve the rate
+    # of the default 6.35 mm ones exactly; a bad file names its key, as the flag's message.
+    big = tmp_path / "big.toml"
+    big.write_text('[specimen]\ncount = 2\nmaterial = "ss440c"\ndiameter_m = 12.7e-3\n')
+    cli("reduce", RECORD, "--bars", "authors", "-o", tmp_path / "big.h5", "--specimen", big)
+    r = shpb.reduce(RECORD, bars="authors", specimen=big)
+    for k, (data, units) in h5_datasets(tmp_path / "big.h5").items():
+        assert same(r[k], data), k
+    small = shpb.reduce(RECORD, bars="authors")
+    assert np.array_equal(r["reduction/strain_rate"], small["reduction/strain_rate"] / 2)
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[specimen]\nshape = "cube"\n')
+    code, message = cli_message(cli, "reduce", RECORD, "--specimen", bad)
+    with pytest.raises(shpb.InputError) as e:
+        shpb.reduce(RECORD, specimen=bad)
+    assert "`specimen.shape`" in str(e.value) and "`specimen.shape`" in message
+    assert code == 2
+
+
 def cli_message(cli, *args):
     p = cli(*args, check=False)
     assert p.returncode != 0

@@ -445,6 +445,17 @@ pub enum Command {
         /// Diameter of a cylindrical specimen, m (with --specimen-length).
         #[arg(long, value_name = "D")]
         specimen_diameter: Option<f64>,
+        /// The specimen: a TOML file with a `[specimen]` table as in a scene (spheres of any
+        /// diameter, a chain, or shape = "cylinder"): spheres give the strain rate δ̇/Σrᵢ over
+        /// their radii, a cylinder its 1/2/3-wave curves [default: a run file's own specimen,
+        /// else two 6.35 mm spheres]. Not with --specimen-length/--specimen-diameter.
+        #[arg(long, value_name = "FILE.toml")]
+        specimen: Option<PathBuf>,
+        /// Figure of the reduction (one record): waves at the faces, forces, equilibrium, and
+        /// force–approach with the strain rate (spheres) or stress–strain and strain rate (a
+        /// cylinder).
+        #[arg(long, value_name = "FILE.png")]
+        plot: Option<PathBuf>,
         /// How the reflected and transmitted windows are placed: from the gauge distances, the
         /// record's pulse feet, or a bounded force-balance search (docs/physics.md §7.6).
         #[arg(long, value_enum, default_value = "geometric")]
@@ -698,6 +709,8 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             layout,
             specimen_length,
             specimen_diameter,
+            specimen,
+            plot,
             force,
         } => {
             let window = shpb_core::reduce::WindowOverride {
@@ -714,6 +727,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                     csv: csv.as_deref(),
                     summary: summary.as_deref(),
                     report: report.as_deref(),
+                    plot: plot.as_deref(),
                     force,
                 },
                 &shpb_study::api::RecordOptions {
@@ -736,6 +750,10 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                         specimen_diameter,
                         ("--specimen-length", "--specimen-diameter"),
                     )?,
+                    specimen: specimen
+                        .as_deref()
+                        .map(shpb_input::specimen_file::SpecimenFile::read)
+                        .transpose()?,
                 },
             )
         }

@@ -35,6 +35,7 @@ fn reduce_command(
             csv,
             summary: None,
             report: None,
+            plot: None,
             force,
         },
         &shpb::api::RecordOptions {
@@ -1062,4 +1063,254 @@ fn bad_inputs_name_file_and_key() {
     uneven.time_s[100] += 0.5e-7;
     let err = reduce(&uneven, &s, &ReductionOptions::default()).unwrap_err();
     assert!(err.to_string().contains("time_s"), "{err}");
+}
+
+// ---- `shpb reduce --specimen FILE.toml` and `--plot FILE.png` (the command line) ----
+
+mod common;
+
+/// The real record these tests reduce (a copy of the 2013-05-22 sample 1; credit in
+/// crates/cli/tests/data/README.md).
+fn fixture_record() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/2013-05-22_sample1_ss440c.csv")
+}
+
+/// Writes `text` to `dir/name` and returns its path as a string.
+fn write_file(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+/// The columns of a reduction CSV of `shpb reduce --csv`, by name (values parsed exactly: the
+/// writer prints the shortest representation that reads back to the same double).
+fn csv_columns(path: &Path) -> std::collections::BTreeMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let names: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+    for line in lines {
+        for (k, v) in line.split(',').enumerate() {
+            cols[k].push(v.parse().unwrap());
+        }
+    }
+    names.into_iter().zip(cols).collect()
+}
+
+/// `shpb reduce` in `dir`, which must succeed.
+fn reduce_ok(dir: &Path, args: &[&str]) -> std::process::Output {
+    let mut all = vec!["reduce"];
+    all.extend_from_slice(args);
+    let out = common::shpb(dir, &all);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    out
+}
+
+/// The acceptance: a record read as 12.7 mm spheres has exactly half the strain rate
+/// δ̇/(r1 + r2) of the same record read as 6.35 mm ones. Exactly, bit for bit: the radii come
+/// from the diameters by halving, 12.7e-3 and 6.35e-3 m parse to doubles in the exact ratio 2
+/// (the nearest double of 2x is twice the nearest double of x), so r1 + r2 doubles exactly,
+/// and δ̇/(2s) is the correctly rounded δ̇/s halved, which is exact. Every other series is
+/// the same record's, untouched by the specimen.
+#[test]
+fn spheres_of_twice_the_diameter_halve_the_strain_rate_exactly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let rec = fixture_record().display().to_string();
+    let big = write_file(
+        dir,
+        "big.toml",
+        "[specimen]\ncount = 2\nmaterial = \"ss440c\"\ndiameter_m = 12.7e-3\n",
+    );
+    let pair = write_file(dir, "pair.toml", "[specimen]\npair = \"ss440c\"\n");
+    reduce_ok(dir, &[&rec, "--csv", "default.csv"]);
+    reduce_ok(dir, &[&rec, "--specimen", &big, "--csv", "big.csv"]);
+    reduce_ok(dir, &[&rec, "--specimen", &pair, "--csv", "pair.csv"]);
+    let default = csv_columns(&dir.join("default.csv"));
+    let big = csv_columns(&dir.join("big.csv"));
+    // The paper's pair, named, is the default.
+    assert_eq!(csv_columns(&dir.join("pair.csv")), default);
+    let (rate_small, rate_big) = (&default["strain_rate_per_s"], &big["strain_rate_per_s"]);
+    assert!(rate_small.iter().any(|r| r.abs() > 100.0));
+    for (s, b) in rate_small.iter().zip(rate_big) {
+        assert_eq!(b.to_bits(), (s / 2.0).to_bits(), "{s} {b}");
+    }
+    for (name, col) in &default {
+        if name != "strain_rate_per_s" {
+            assert_eq!(&big[name], col, "{name}");
+        }
+    }
+}
+
+/// A bad specimen file is an input error (exit 2) naming the file and the key; a missing one
+/// names `--specimen`; the file with the cylinder flags is refused, naming both.
+#[test]
+fn a_bad_specimen_file_is_refused_naming_file_and_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let rec = fixture_record().display().to_string();
+    let run = |args: &[&str]| {
+        let mut all = vec!["reduce", rec.as_str()];
+        all.extend_from_slice(args);
+        let out = common::shpb(dir, &all);
+        assert_eq!(out.status.code(), Some(2), "{}", common::stderr(&out));
+        common::stderr(&out)
+    };
+    let bad = write_file(
+        dir,
+        "bad.toml",
+        "[specimen]\ncount = 2\nmaterial = \"ss440c\"\ndiameter_m = -12.7e-3\n",
+    );
+    let msg = run(&["--specimen", &bad]);
+    assert!(
+        msg.contains("bad.toml")
+            && msg.contains("`specimen.diameter_m`")
+            && msg.contains("allowed"),
+        "{msg}"
+    );
+    let shape = write_file(dir, "shape.toml", "[specimen]\nshape = \"cube\"\n");
+    let msg = run(&["--specimen", &shape]);
+    assert!(
+        msg.contains("shape.toml") && msg.contains("`specimen.shape`") && msg.contains("cylinder"),
+        "{msg}"
+    );
+    let unknown = write_file(
+        dir,
+        "unknown.toml",
+        "[specimen]\npair = \"ss440c\"\nradius = 1\n",
+    );
+    let msg = run(&["--specimen", &unknown]);
+    assert!(
+        msg.contains("unknown.toml") && msg.contains("radius"),
+        "{msg}"
+    );
+    let msg = run(&["--specimen", "nowhere.toml"]);
+    assert!(
+        msg.contains("`--specimen`") && msg.contains("nowhere.toml"),
+        "{msg}"
+    );
+    let cyl = write_file(
+        dir,
+        "cyl.toml",
+        "[specimen]\nshape = \"cylinder\"\nlength_m = 6e-3\ndiameter_m = 12e-3\nmaterial = \"al2017\"\n",
+    );
+    let msg = run(&[
+        "--specimen",
+        &cyl,
+        "--specimen-length",
+        "6e-3",
+        "--specimen-diameter",
+        "12e-3",
+    ]);
+    assert!(
+        msg.contains("`--specimen`") && msg.contains("--specimen-length"),
+        "{msg}"
+    );
+}
+
+/// A cylinder specimen file reduces the record exactly as the cylinder flags do: the same CSV,
+/// byte for byte, with the 1/2/3-wave columns and no sphere strain rate.
+#[test]
+fn a_cylinder_specimen_file_gives_the_cylinder_flags_result() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let rec = fixture_record().display().to_string();
+    let cyl = write_file(
+        dir,
+        "cyl.toml",
+        "[specimen]\nshape = \"cylinder\"\nlength_m = 6e-3\ndiameter_m = 12e-3\nmaterial = \"al2017\"\n",
+    );
+    let by_file = reduce_ok(dir, &[&rec, "--specimen", &cyl, "--csv", "file.csv"]);
+    let by_flags = reduce_ok(
+        dir,
+        &[
+            &rec,
+            "--specimen-length",
+            "6e-3",
+            "--specimen-diameter",
+            "12e-3",
+            "--csv",
+            "flags.csv",
+        ],
+    );
+    let a = std::fs::read(dir.join("file.csv")).unwrap();
+    assert_eq!(a, std::fs::read(dir.join("flags.csv")).unwrap());
+    let cols = csv_columns(&dir.join("file.csv"));
+    assert!(cols.contains_key("three_wave_stress_Pa") && !cols.contains_key("strain_rate_per_s"));
+    let line = |out: &std::process::Output| {
+        common::stdout(out)
+            .lines()
+            .find(|l| l.starts_with("cylinder "))
+            .map(str::to_string)
+    };
+    assert!(line(&by_file).is_some());
+    assert_eq!(line(&by_file), line(&by_flags));
+}
+
+/// `--plot` writes a PNG (atomically), refuses to clobber it without `--force`, never
+/// overwrites an input, and takes one record.
+#[test]
+fn plot_writes_a_png_and_refuses_to_clobber() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let rec = fixture_record().display().to_string();
+    let out = reduce_ok(dir, &[&rec, "--plot", "r.png"]);
+    assert!(
+        common::stderr(&out).contains("wrote r.png"),
+        "{}",
+        common::stderr(&out)
+    );
+    let png = std::fs::read(dir.join("r.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 10_000);
+    std::fs::write(dir.join("r.png"), b"kept").unwrap();
+    let again = common::shpb(dir, &["reduce", &rec, "--plot", "r.png"]);
+    assert_eq!(again.status.code(), Some(2), "{}", common::stderr(&again));
+    assert!(
+        common::stderr(&again).contains("r.png: output file exists"),
+        "{}",
+        common::stderr(&again)
+    );
+    assert_eq!(std::fs::read(dir.join("r.png")).unwrap(), b"kept");
+    reduce_ok(dir, &[&rec, "--plot", "r.png", "--force"]);
+    assert!(
+        std::fs::read(dir.join("r.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
+    // A cylinder's figure (stress–strain, strain rate) and a sphere file's.
+    let cyl = write_file(
+        dir,
+        "cyl.toml",
+        "[specimen]\nshape = \"cylinder\"\nlength_m = 6e-3\ndiameter_m = 12e-3\nmaterial = \"al2017\"\n",
+    );
+    reduce_ok(dir, &[&rec, "--specimen", &cyl, "--plot", "cyl.png"]);
+    assert!(
+        std::fs::read(dir.join("cyl.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
+    // Never an input, even with --force; and one record only.
+    let copy = dir.join("rec.png");
+    std::fs::copy(fixture_record(), &copy).unwrap();
+    let copy = copy.display().to_string();
+    let clobber = common::shpb(dir, &["reduce", &copy, "--plot", &copy, "--force"]);
+    assert_eq!(
+        clobber.status.code(),
+        Some(2),
+        "{}",
+        common::stderr(&clobber)
+    );
+    let two = common::shpb(dir, &["reduce", &rec, &rec, "--plot", "two.png"]);
+    assert_eq!(two.status.code(), Some(2));
+    assert!(
+        common::stderr(&two).contains("--plot"),
+        "{}",
+        common::stderr(&two)
+    );
+    assert!(!dir.join("two.png").exists());
 }

@@ -23,7 +23,8 @@ pub mod gauge;
 pub mod material;
 pub mod numeric;
 pub mod reduce;
-pub mod reduce_cylinder;
+/// The cylinder analysis under its former name (now the specimen stage of the reduction).
+pub use reduce::specimen as reduce_cylinder;
 pub mod run;
 pub mod scene;
 pub mod shaper;

@@ -22,6 +22,7 @@ pub mod resources;
 pub mod scene;
 pub mod setup;
 pub mod specimen;
+pub mod specimen_file;
 mod toml_file;
 pub mod units;
 

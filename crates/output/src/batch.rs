@@ -4,6 +4,7 @@
 use crate::atomic::write_text_atomically;
 use crate::plot::{Axes, Curve, panels_figure};
 use shpb_core::reduce::{BarProperties, Reduction, WaveMetrics, wave_metrics};
+use shpb_core::reduce_cylinder::CylinderReduction;
 use shpb_input::Result;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -321,15 +322,17 @@ pub fn write_report(
     write_text_atomically(path, force, &report_markdown(command, records))
 }
 
-/// The figure of one reduction: the three waves at the faces, the 1-, 2- and 3-wave forces, the
-/// equilibrium ratio (shown up to 1), and force against sphere approach.
-pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) -> Result<()> {
-    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
-    let waves_title = format!("{title}: waves at the faces");
-    let panels = vec![
+/// The three panels every reduction figure starts with: waves at the faces, the 1/2/3-wave
+/// forces, the equilibrium ratio (`ratio`, capped at 1).
+fn face_panels<'a>(
+    waves_title: &'a str,
+    r: &'a Reduction,
+    ratio: &'a [f64],
+) -> Vec<(Axes<'a>, Vec<Curve<'a>>)> {
+    vec![
         (
             Axes {
-                title: &waves_title,
+                title: waves_title,
                 x_label: "time at the faces (µs)",
                 y_label: "bar strain (µε), tension positive",
                 x_scale: 1e6,
@@ -363,22 +366,103 @@ pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) ->
                 x_scale: 1e6,
                 y_scale: 1.0,
             },
-            vec![curve("equilibrium ratio", &r.time_s, &ratio)],
+            vec![curve("equilibrium ratio", &r.time_s, ratio)],
         ),
-        (
-            Axes {
-                title: "force against sphere approach",
-                x_label: "sphere approach δ (µm)",
-                y_label: "force (kN)",
-                x_scale: 1e6,
-                y_scale: 1e-3,
-            },
-            vec![
-                curve("back", &r.displacement_m, &r.force_back_n),
-                curve("front", &r.displacement_m, &r.force_front_n),
-            ],
-        ),
-    ];
+    ]
+}
+
+/// The force–approach panel of spheres.
+fn force_approach_panel(r: &Reduction) -> (Axes<'_>, Vec<Curve<'_>>) {
+    (
+        Axes {
+            title: "force against sphere approach",
+            x_label: "sphere approach δ (µm)",
+            y_label: "force (kN)",
+            x_scale: 1e6,
+            y_scale: 1e-3,
+        },
+        vec![
+            curve("back", &r.displacement_m, &r.force_back_n),
+            curve("front", &r.displacement_m, &r.force_front_n),
+        ],
+    )
+}
+
+/// The figure of one reduction: the three waves at the faces, the 1-, 2- and 3-wave forces, the
+/// equilibrium ratio (shown up to 1), and force against sphere approach.
+pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) -> Result<()> {
+    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
+    let waves_title = format!("{title}: waves at the faces");
+    let mut panels = face_panels(&waves_title, r, &ratio);
+    panels.push(force_approach_panel(r));
+    panels_figure(path, force, 2, &panels)
+}
+
+/// The figure of `shpb reduce --plot` (atomic; an existing file is kept unless `force`): the
+/// panels of [`reduction_figure`], then what the specimen makes of the waves (docs/physics.md
+/// §7.3, §7.8). Spheres: force against approach and, when their radii are known, the global
+/// strain rate δ̇/Σrᵢ; a cylinder: its 1/2/3-wave engineering stress against strain and strain
+/// rate against time, compression positive.
+pub fn record_figure(
+    path: &Path,
+    force: bool,
+    title: &str,
+    r: &Reduction,
+    cylinder: Option<&CylinderReduction>,
+) -> Result<()> {
+    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
+    let waves_title = format!("{title}: waves at the faces");
+    let mut panels = face_panels(&waves_title, r, &ratio);
+    match cylinder {
+        Some(c) => {
+            let analyses = [
+                ("1-wave", &c.one_wave),
+                ("2-wave", &c.two_wave),
+                ("3-wave", &c.three_wave),
+            ];
+            panels.push((
+                Axes {
+                    title: "cylinder: engineering stress against strain",
+                    x_label: "engineering strain (%), compression positive",
+                    y_label: "engineering stress (MPa), compression positive",
+                    x_scale: 1e2,
+                    y_scale: 1e-6,
+                },
+                analyses
+                    .iter()
+                    .map(|(name, a)| curve(name, &a.strain, &a.stress_pa))
+                    .collect(),
+            ));
+            panels.push((
+                Axes {
+                    title: "cylinder: engineering strain rate",
+                    x_label: "time at the faces (µs)",
+                    y_label: "strain rate (1/s), compression positive",
+                    x_scale: 1e6,
+                    y_scale: 1.0,
+                },
+                analyses
+                    .iter()
+                    .map(|(name, a)| curve(name, &r.time_s, &a.strain_rate_per_s))
+                    .collect(),
+            ));
+        }
+        None => {
+            panels.push(force_approach_panel(r));
+            if let Some(rate) = &r.strain_rate_per_s {
+                panels.push((
+                    Axes {
+                        title: "global strain rate δ̇/Σrᵢ",
+                        x_label: "time at the faces (µs)",
+                        y_label: "strain rate (1/s)",
+                        x_scale: 1e6,
+                        y_scale: 1.0,
+                    },
+                    vec![curve("strain rate", &r.time_s, rate)],
+                ));
+            }
+        }
+    }
     panels_figure(path, force, 2, &panels)
 }
 

@@ -504,9 +504,10 @@ fn curve<'py>(
 /// `align` is `geometric`, `foot` or `balance` (`--align`), `smooth` the moving-average width in
 /// s (`--smooth`), `layout` a record layout file (`--layout`), `balance_bound_s` the bound of the
 /// balance search (`--balance-bound`); with a cylinder's length and diameter (m, both or
-/// neither) also its 1/2/3-wave curves (docs/physics.md §7.6–7.9).
+/// neither) also its 1/2/3-wave curves; `specimen` a specimen file (`--specimen`: spheres of any
+/// diameter, a chain, or a cylinder) (docs/physics.md §7.3, §7.6–7.9).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S, specimen = None))]
 #[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
@@ -520,6 +521,7 @@ fn reduce(
     specimen_diameter_m: Option<f64>,
     layout: Option<PathBuf>,
     balance_bound_s: f64,
+    specimen: Option<PathBuf>,
 ) -> PyResult<RunData> {
     let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
         return Err(input_error(
@@ -560,6 +562,10 @@ fn reduce(
             layout: layout
                 .as_deref()
                 .map(shpb_input::layout::RecordLayout::from_file)
+                .transpose()?,
+            specimen: specimen
+                .as_deref()
+                .map(shpb_input::specimen_file::SpecimenFile::read)
                 .transpose()?,
         };
         let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;

@@ -7,7 +7,8 @@ use shpb_core::apparatus::Apparatus;
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::reduce::{
-    PAPER_SPHERE_RADII_M, Reduction, ReductionInput, ReductionOptions, ReductionSetup,
+    PAPER_SPHERE_RADII_M, ReducedSpecimen, Reduction, ReductionInput, ReductionOptions,
+    ReductionSetup,
 };
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
@@ -245,6 +246,9 @@ pub struct Reduced {
     /// A cylindrical specimen's 1/2/3-wave stress and strain, when its geometry was given
     /// (docs/physics.md §7.8).
     pub cylinder: Option<shpb_core::reduce_cylinder::CylinderReduction>,
+    /// The specimen the record was reduced for (`--specimen`, the cylinder flags, a run file's
+    /// own, else the paper's two 6.35 mm spheres).
+    pub specimen: ReducedSpecimen,
 }
 
 /// The cylinder of `shpb reduce --specimen-length L --specimen-diameter D` (both or neither;
@@ -312,10 +316,6 @@ pub fn reduce_record(
     )
 }
 
-/// Largest bound of the balance search (`--balance-bound`), s: 200 µs, most of the authors'
-/// 232 µs window; a shift beyond would leave little of the pulses to compare.
-const MAX_BALANCE_BOUND_S: f64 = 200e-6;
-
 /// The choices of `shpb reduce` beyond the record and set-up (its flags; docs/physics.md §7).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordOptions {
@@ -339,6 +339,9 @@ pub struct RecordOptions {
     pub cylinder: Option<shpb_core::reduce_cylinder::CylinderGeometry>,
     /// How to read a text record that is not the authors' CSV (`--layout`).
     pub layout: Option<shpb_input::layout::RecordLayout>,
+    /// The specimen of a specimen file (`--specimen FILE.toml`: spheres of any diameter, a chain,
+    /// or a cylinder; for a run file it overrides the run's own). Not with `cylinder`.
+    pub specimen: Option<shpb_input::specimen_file::SpecimenFile>,
 }
 
 impl RecordOptions {
@@ -380,6 +383,9 @@ impl RecordOptions {
                 g.length_m, g.diameter_m
             ));
         }
+        if let Some(s) = &self.specimen {
+            c.push_str(&format!(" --specimen {}", s.source));
+        }
         c
     }
 }
@@ -395,7 +401,36 @@ impl Default for RecordOptions {
             window: None,
             cylinder: None,
             layout: None,
+            specimen: None,
         }
+    }
+}
+
+/// The `shpb reduce` flag of each quantity of [`ReductionOptions`] (the core's name otherwise).
+fn reduce_flag(quantity: &str) -> &str {
+    match quantity {
+        "smoothing_window_s" => "--smooth",
+        "balance_bound_s" => "--balance-bound",
+        "tyas_pope" => "--tyas-pope",
+        "window.incident_start_s" => "--incident-start",
+        "window.reflected_delay_s" => "--reflected-delay",
+        "window.transmitted_delay_s" => "--transmitted-delay",
+        "window.duration_s" => "--duration",
+        other => other,
+    }
+}
+
+/// A core error of [`ReductionOptions::validate`] as an input error naming the flag at fault
+/// (as [`shpb_input::Validator::core`] names a file's key).
+fn flag_err(e: shpb_core::Error) -> Error {
+    match e {
+        shpb_core::Error::Invalid {
+            quantity,
+            problem,
+            allowed,
+            ..
+        } => input_err(reduce_flag(&quantity), problem, allowed),
+        other => other.into(),
     }
 }
 
@@ -405,48 +440,26 @@ pub fn reduce_record_with(
     bars_flag: Option<&Path>,
     choices: &RecordOptions,
 ) -> Result<Reduced> {
-    if !(choices.smoothing_s.is_finite() && choices.smoothing_s >= 0.0) {
+    // The options are checked once, by the core; its errors are reported as the flags.
+    let mut options = ReductionOptions {
+        dispersion: choices.dispersion,
+        tyas_pope: choices.tyas_pope,
+        alignment: choices.alignment,
+        smoothing_window_s: choices.smoothing_s,
+        balance_bound_s: choices.balance_bound_s,
+        window: choices.window,
+        ..ReductionOptions::default()
+    };
+    options.validate().map_err(flag_err)?;
+    if let (Some(file), Some(_)) = (&choices.specimen, choices.cylinder) {
         return Err(input_err(
-            "--smooth",
-            format!("{} s is out of range", choices.smoothing_s),
-            "0 (off) or a positive width in seconds, e.g. 2e-6",
+            "--specimen",
+            format!(
+                "{} gives the specimen, and so do --specimen-length/--specimen-diameter",
+                file.source
+            ),
+            "either --specimen FILE.toml (spheres or shape = \"cylinder\") or --specimen-length L --specimen-diameter D, not both",
         ));
-    }
-    if !(choices.balance_bound_s.is_finite()
-        && choices.balance_bound_s > 0.0
-        && choices.balance_bound_s <= MAX_BALANCE_BOUND_S)
-    {
-        return Err(input_err(
-            "--balance-bound",
-            format!("{} s is out of range", choices.balance_bound_s),
-            "a positive bound in seconds up to 2e-4 (200 µs), e.g. 6e-5",
-        ));
-    }
-    if let Some(w) = choices.window {
-        for (flag, v) in [
-            ("--reflected-delay", w.reflected_delay_s),
-            ("--transmitted-delay", w.transmitted_delay_s),
-            ("--duration", w.duration_s),
-        ] {
-            if let Some(v) = v
-                && !(v.is_finite() && v > 0.0)
-            {
-                return Err(input_err(
-                    flag,
-                    format!("{v} s is out of range"),
-                    "a positive number of seconds",
-                ));
-            }
-        }
-        if let Some(v) = w.incident_start_s
-            && !v.is_finite()
-        {
-            return Err(input_err(
-                "--incident-start",
-                format!("{v} s"),
-                "a finite time on the record clock, s",
-            ));
-        }
     }
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
@@ -496,19 +509,15 @@ pub fn reduce_record_with(
         }
         None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M, None),
     };
-    // A cylinder run file is reduced as its own specimen unless the geometry is given.
-    let cylinder = choices.cylinder.or(run_cylinder);
-    let options = ReductionOptions {
-        dispersion: choices.dispersion,
-        tyas_pope: choices.tyas_pope,
-        // A cylinder's rate is its own (reduce_cylinder); the spheres' δ̇/(r1 + r2) is not.
-        specimen_radii_m: cylinder.is_none().then_some(radii),
-        alignment: choices.alignment,
-        smoothing_window_s: choices.smoothing_s,
-        balance_bound_s: choices.balance_bound_s,
-        window: choices.window,
-        ..ReductionOptions::default()
+    // The specimen: a specimen file's, the cylinder flags', else the run file's own (a cylinder
+    // or its spheres), else the paper's spheres. A cylinder's rate is its own (its 1/2/3-wave
+    // analysis); the spheres' is δ̇/Σrᵢ.
+    let specimen = match (&choices.specimen, choices.cylinder, run_cylinder) {
+        (Some(file), _, _) => file.specimen,
+        (None, Some(g), _) | (None, None, Some(g)) => ReducedSpecimen::Cylinder(g),
+        (None, None, None) => ReducedSpecimen::Spheres { radii_m: radii },
     };
+    options.specimen_radii_m = specimen.radii_m();
     let reduction = if hdf5_input {
         // A run file with its own set-up is read as the lab reads a record: its digitised
         // voltages through the set-up's bridges, exactly as the run reduced them; otherwise (a
@@ -565,19 +574,13 @@ pub fn reduce_record_with(
     } else {
         shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
     };
-    let cylinder = match cylinder {
-        Some(g) => Some(shpb_core::reduce_cylinder::reduce_cylinder(
-            &reduction,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &g,
-        )?),
-        None => None,
-    };
+    let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
     Ok(Reduced {
         reduction,
         apparatus,
         hdf5_input,
         cylinder,
+        specimen,
     })
 }
 

@@ -4,7 +4,9 @@ use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, war
 use shpb_core::reduce::{DispersionCorrection, Reduction, ReductionSetup};
 use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, check_output_path};
-use shpb_output::batch::{BatchRecord, reduction_figure, write_report, write_summary};
+use shpb_output::batch::{
+    BatchRecord, record_figure, reduction_figure, write_report, write_summary,
+};
 use shpb_output::reduction::{write_reduction_csv_with, write_reduction_hdf5_with};
 use shpb_study::api::{RecordOptions, Reduced, reduce_record_with};
 use std::path::{Path, PathBuf};
@@ -19,6 +21,8 @@ pub struct Outputs<'a> {
     pub summary: Option<&'a Path>,
     /// `--report`: Markdown report, with one figure per record beside it.
     pub report: Option<&'a Path>,
+    /// `--plot`: the figure of the reduction (one record only).
+    pub plot: Option<&'a Path>,
     /// Overwrite existing files.
     pub force: bool,
 }
@@ -55,6 +59,7 @@ fn command_line(records: &[PathBuf], bars: &str, o: &Outputs, choices: &RecordOp
         ("--csv", o.csv),
         ("--summary", o.summary),
         ("--report", o.report),
+        ("--plot", o.plot),
     ] {
         if let Some(p) = p {
             c.push_str(&format!(" {flag} {}", p.display()));
@@ -67,8 +72,8 @@ fn command_line(records: &[PathBuf], bars: &str, o: &Outputs, choices: &RecordOp
     c
 }
 
-/// `shpb reduce RECORD... [--bars SET-UP] [-o OUT.h5] [--csv OUT.csv] [--summary S.csv]
-/// [--report R.md] [--align geometric|foot|balance] [--smooth SECONDS] [window overrides]
+/// `shpb reduce RECORD... [--bars SET-UP] [--specimen S.toml] [-o OUT.h5] [--csv OUT.csv]
+/// [--plot OUT.png] [--summary S.csv] [--report R.md] [--align geometric|foot|balance] [--smooth SECONDS] [window overrides]
 /// [--force]`: reduces raw records (the authors' CSV) or HDF5 files of `shpb run` (recognised by
 /// their signature) with the set-up's bars and gauges, writes `/reduction/*` (HDF5) and/or CSV
 /// for one record, a summary and a report for any number, and prints a summary of each. A
@@ -82,21 +87,26 @@ pub fn reduce_command(
 ) -> Result<()> {
     let bars = bars_flag.unwrap_or(Path::new(DEFAULT_BARS));
     require_bars(bars)?;
-    if records.len() > 1 && (o.output.is_some() || o.csv.is_some()) {
+    if records.len() > 1 && (o.output.is_some() || o.csv.is_some() || o.plot.is_some()) {
         let flag = if o.output.is_some() {
             "--output"
-        } else {
+        } else if o.csv.is_some() {
             "--csv"
+        } else {
+            "--plot"
         };
         return Err(Error::Input {
             file: "command line".into(),
             key: flag.into(),
             problem: format!("{} records were given, but {flag} holds one reduction", records.len()),
-            allowed: "one record with -o/--csv, or several with --summary FILE.csv and/or --report FILE.md".into(),
+            allowed: "one record with -o/--csv/--plot, or several with --summary FILE.csv and/or --report FILE.md".into(),
         });
     }
     let mut inputs: Vec<PathBuf> = records.to_vec();
     inputs.push(bars.to_path_buf());
+    if let Some(s) = &choices.specimen {
+        inputs.push(PathBuf::from(&s.source));
+    }
     let figures: Vec<PathBuf> = match o.report {
         Some(rep) => (0..records.len())
             .map(|k| figure_path(rep, records, k))
@@ -108,6 +118,7 @@ pub fn reduce_command(
         (o.csv, "--csv", &["csv"][..]),
         (o.summary, "--summary", &["csv"][..]),
         (o.report, "--report", &["md"][..]),
+        (o.plot, "--plot", &["png"][..]),
     ];
     for (p, flag, extensions) in outputs {
         if let Some(p) = p {
@@ -119,7 +130,7 @@ pub fn reduce_command(
         check_output_path(f, o.force, "--report (figure)", &["png"])?;
         check_not_input(f, "--report (figure)", &inputs)?;
     }
-    let data_on_stdout = stdout_once(&[o.output, o.csv, o.summary, o.report])?;
+    let data_on_stdout = stdout_once(&[o.output, o.csv, o.summary, o.report, o.plot])?;
 
     let mut reduced: Vec<Result<Reduced>> = records
         .iter()
@@ -146,6 +157,16 @@ pub fn reduce_command(
         if let Some(c) = o.csv {
             write_reduction_csv_with(c, o.force, &r.reduction, r.cylinder.as_ref())?;
             wrote(c);
+        }
+        if let Some(p) = o.plot {
+            record_figure(
+                p,
+                o.force,
+                &stem(&records[0]),
+                &r.reduction,
+                r.cylinder.as_ref(),
+            )?;
+            wrote(p);
         }
     }
     let mut batch = Vec::new();
@@ -244,6 +265,7 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
         apparatus,
         hdf5_input,
         cylinder,
+        specimen,
     } = reduced;
     let bridges: Vec<String> = ["incident", "transmission"]
         .iter()
@@ -308,6 +330,13 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
             stated.as_ref().map_or(f64::NAN, |s| s.transmission_gauge_m),
         ));
     }
+    if let (Some((r1, r2)), Some(rate)) = (specimen.radii_m(), &r.strain_rate_per_s) {
+        text.push_str(&format!(
+            "spheres, r1 + r2 = {:.3} mm: peak strain rate δ̇/(r1 + r2) {:.0} 1/s\n",
+            (r1 + r2) * 1e3,
+            rate.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        ));
+    }
     if let Some(c) = cylinder {
         text.push_str(&format!(
             "cylinder {:.3} mm × {:.3} mm (1-wave, compression positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
@@ -368,6 +397,12 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
         "equilibrium_ratio_at_peak": finite(r.equilibrium_ratio_at_peak),
         "warnings": r.warnings,
     });
+    if let (Some((r1, r2)), Some(rate)) = (reduced.specimen.radii_m(), &r.strain_rate_per_s) {
+        json["spheres"] = serde_json::json!({
+            "radii_sum_m": finite(r1 + r2),
+            "peak_strain_rate_per_s": finite(rate.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+        });
+    }
     if let Some(c) = &reduced.cylinder {
         json["cylinder"] = serde_json::json!({
             "length_m": finite(c.geometry.length_m),

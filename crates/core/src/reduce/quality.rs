@@ -146,6 +146,84 @@ pub fn wave_metrics(
     })
 }
 
+/// The fourth stage's checks (docs/physics.md §7.7): equilibrium over the loading, the incident
+/// pulse's length against the reflected delay, each channel's signal against its noise;
+/// `warnings` gets an overlap and a weak channel.
+pub(crate) fn assess(
+    options: &super::ReductionOptions,
+    strains: &super::baseline::Conditioned,
+    placed: &super::windows::Placed,
+    waves: &super::waves::FaceWaves,
+    warnings: &mut Vec<String>,
+) -> Quality {
+    let dt = strains.dt;
+    let f = &waves.faces;
+    let samples = placed.windows.samples;
+    let reflected_delay_s = placed.windows.reflected_delay_s;
+    let ((ka, kb), equilibrium_mean, equilibrium_max, verdict) =
+        equilibrium_over_loading(&f.force_3wave_n, &f.equilibrium_ratio);
+    let manual_start = options.window.is_some_and(|w| w.incident_start_s.is_some());
+    let incident_duration_s = match strains.incident_foot {
+        Some((k_foot, k_peak)) if !manual_start => incident_duration_s(
+            &strains.incident,
+            dt,
+            k_foot,
+            k_peak,
+            options.start_fraction * strains.incident_peak,
+        ),
+        _ => f64::NAN,
+    };
+    let pulse_overlap_s = (incident_duration_s - reflected_delay_s).max(0.0);
+    if pulse_overlap_s > 0.0 {
+        warnings.push(format!(
+            "the incident pulse lasts {:.1} µs at its gauge but the reflected one arrives {:.1} µs \
+             after its foot: they overlap there, and the windows ({:.1} µs) miss the last {:.1} µs \
+             of the incident pulse",
+            incident_duration_s * 1e6,
+            reflected_delay_s * 1e6,
+            (samples - 1) as f64 * dt * 1e6,
+            (incident_duration_s - (samples - 1) as f64 * dt).max(0.0) * 1e6
+        ));
+    }
+    let noise_strain = (
+        baseline_rms(&strains.incident, strains.baseline_samples),
+        strains.transmission_noise,
+    );
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    let snr = |peak: f64, noise: f64| {
+        if noise > 0.0 {
+            peak / noise
+        } else {
+            f64::INFINITY
+        }
+    };
+    let signal_to_noise = (
+        snr(largest(&waves.incident), noise_strain.0),
+        snr(largest(&waves.transmitted), noise_strain.1),
+    );
+    for (name, s) in [
+        ("incident", signal_to_noise.0),
+        ("transmission", signal_to_noise.1),
+    ] {
+        if s < MINIMUM_SIGNAL_TO_NOISE {
+            warnings.push(format!(
+                "the {name} channel's pulse is only {s:.1} times its baseline noise (RMS): feet \
+                 and peaks are uncertain (smooth with --smooth, or check the gauge)"
+            ));
+        }
+    }
+    Quality {
+        loading_span_s: (ka as f64 * dt, kb as f64 * dt),
+        equilibrium_mean,
+        equilibrium_max,
+        verdict,
+        incident_duration_s,
+        pulse_overlap_s,
+        noise_strain,
+        signal_to_noise,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

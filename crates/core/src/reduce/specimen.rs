@@ -1,30 +1,78 @@
-//! Stress, strain and strain rate of a cylindrical specimen from a bar reduction
-//! (docs/physics.md §7.8): the 1-, 2- and 3-wave analyses of the Kolsky bar (G. T. Gray III,
-//! "Classic Split-Hopkinson Pressure Bar Testing", ASM Handbook Vol. 8, ASM International
-//! (2000), pp. 462–476; W. Chen & B. Song, *Split Hopkinson (Kolsky) Bar*, Springer (2011),
-//! §1.3), and the true stress and strain at constant volume.
-//!
-//! # Signs
-//!
-//! Bar strains εI, εR, εT at the specimen faces are positive in tension ([`crate::reduce`]).
-//! Every specimen quantity here is **positive in compression**: stress, engineering strain (the
-//! shortening over L_s), its rate, true stress and true strain. The textbook 1-wave rate
-//! ε̇ = −2 c0 εR/L_s (tension-positive specimen strain) is therefore reported as +2 c0 εR/L_s.
-//!
-//! With A_b, E_b, c0 of the bars and A_s = π d_s²/4, L_s of the specimen:
-//!
-//! * 1-wave: σ₁ = −E_b A_b εT/A_s (transmitted wave, back face), ε̇₁ = 2 c0 εR/L_s;
-//! * 2-wave: σ₂ = −E_b A_b (εI + εR)/A_s (incident + reflected, front face), ε̇₂ = ε̇₁;
-//! * 3-wave: σ₃ = (σ₁ + σ₂)/2, ε̇₃ = δ̇/L_s = −c0 (εI − εR − εT)/L_s;
-//! * ε = ∫ ε̇ dt (trapezoidal rule from the window start, ε(0) = 0);
-//! * true (constant volume, compression positive): σ_true = σ (1 − ε), ε_true = −ln(1 − ε).
-//!
-//! The 1- and 2-wave strain assumes equilibrium (εI + εR = εT); the 3-wave strain is the exact
-//! shortening of the specimen δ/L_s (the faces' displacement difference of [`Reduction`]).
+//! The last stage of the reduction: what the specimen makes of the waves (docs/physics.md §7.3,
+//! §7.8). Spheres: the global strain rate δ̇/Σrᵢ over their radii (paper Eq. 3); a cylinder:
+//! the 1-, 2- and 3-wave engineering stress, strain and strain rate, the true stress and strain
+//! at constant volume (Gray 2000; Chen & Song 2011, §1.3), compression positive, and the
+//! loading modulus.
 
+use super::{Reduction, ReductionSetup};
 use crate::error::{Error, Result};
 use crate::numeric::{argmax, cumulative_trapezoid, least_squares};
-use crate::reduce::{Reduction, ReductionSetup};
+
+/// Radii of the paper's specimen, two 6.35 mm spheres, m (what `shpb reduce` assumes for the
+/// strain rate of a record without `--specimen`; the authors' `analysis.m` divides by
+/// 0.0254/4 m = r1 + r2 too).
+pub const PAPER_SPHERE_RADII_M: (f64, f64) = (3.175e-3, 3.175e-3);
+
+/// The specimen a reduction reads the waves for (docs/physics.md §7.3, §7.8).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ReducedSpecimen {
+    /// Spheres: the strain rate is δ̇/(r1 + r2); for a chain of N spheres (r1, r2 + … + rN), so
+    /// that it is δ̇/Σrᵢ over the whole chain (`scene::specimen_radii_m`, docs/physics.md §8).
+    Spheres {
+        /// The two lengths whose sum divides δ̇, m.
+        radii_m: (f64, f64),
+    },
+    /// A cylinder: its 1/2/3-wave stress, strain and strain rate (docs/physics.md §7.8).
+    Cylinder(CylinderGeometry),
+}
+
+impl Default for ReducedSpecimen {
+    /// The paper's two 6.35 mm spheres ([`PAPER_SPHERE_RADII_M`]).
+    fn default() -> Self {
+        ReducedSpecimen::Spheres {
+            radii_m: PAPER_SPHERE_RADII_M,
+        }
+    }
+}
+
+impl ReducedSpecimen {
+    /// The sphere radii of the strain rate δ̇/(r1 + r2), None for a cylinder (whose rate is its
+    /// own, [`reduce_cylinder`]).
+    pub fn radii_m(&self) -> Option<(f64, f64)> {
+        match self {
+            ReducedSpecimen::Spheres { radii_m } => Some(*radii_m),
+            ReducedSpecimen::Cylinder(_) => None,
+        }
+    }
+
+    /// The cylinder's geometry, None for spheres.
+    pub fn cylinder(&self) -> Option<CylinderGeometry> {
+        match self {
+            ReducedSpecimen::Spheres { .. } => None,
+            ReducedSpecimen::Cylinder(g) => Some(*g),
+        }
+    }
+
+    /// A cylinder's 1/2/3-wave analysis of reduction `r` ([`reduce_cylinder`]); None for
+    /// spheres, whose strain rate the reduction itself carries.
+    pub fn reduce(
+        &self,
+        r: &Reduction,
+        setup: &ReductionSetup,
+    ) -> Result<Option<CylinderReduction>> {
+        self.cylinder()
+            .map(|g| reduce_cylinder(r, setup, &g))
+            .transpose()
+    }
+}
+
+/// Global strain rate of spheres δ̇/(r1 + r2), 1/s (paper Eq. 3; docs/physics.md §7.3).
+pub(crate) fn sphere_strain_rate(approach_velocity_m_s: &[f64], (r1, r2): (f64, f64)) -> Vec<f64> {
+    approach_velocity_m_s
+        .iter()
+        .map(|v| v / (r1 + r2))
+        .collect()
+}
 
 /// The geometry of a cylindrical specimen as the reduction needs it (docs/physics.md §7.8).
 #[derive(Debug, Clone, Copy, PartialEq)]

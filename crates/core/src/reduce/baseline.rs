@@ -1,0 +1,245 @@
+//! The first stage of the reduction (docs/physics.md §7.3, "Windows" 1–3): the records checked,
+//! smoothed, their baselines removed, each channel's polarity judged, and the incident foot
+//! found; and a raw record's voltages read as bar strains.
+
+use super::{ReductionInput, ReductionOptions, channel, input_err, quality};
+use crate::apparatus::Apparatus;
+use crate::error::Result;
+use crate::gauge::RawRecord;
+use crate::numeric::moving_average;
+
+/// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
+pub(crate) fn check_input(input: &ReductionInput, file: &str) -> Result<f64> {
+    let n = input.time_s.len();
+    if input.incident_strain.len() != n || input.transmission_strain.len() != n {
+        return Err(input_err(
+            file,
+            "incident_strain/transmission_strain",
+            format!(
+                "{} times but {} incident and {} transmission samples",
+                n,
+                input.incident_strain.len(),
+                input.transmission_strain.len()
+            ),
+            "one strain sample per time on both channels",
+        ));
+    }
+    if n < 16 {
+        return Err(input_err(
+            file,
+            "time_s",
+            format!("{n} samples"),
+            "at least 16 samples",
+        ));
+    }
+    for (key, v) in [
+        ("time_s", &input.time_s),
+        ("incident_strain", &input.incident_strain),
+        ("transmission_strain", &input.transmission_strain),
+    ] {
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            return Err(input_err(
+                file,
+                key,
+                format!("sample {k} is {}", v[k]),
+                "finite numbers",
+            ));
+        }
+    }
+    let t = &input.time_s;
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    if dt.is_nan() || dt <= 0.0 {
+        return Err(input_err(
+            file,
+            "time_s",
+            "times do not increase",
+            "a uniform increasing time axis",
+        ));
+    }
+    if let Some(k) = t
+        .windows(2)
+        .position(|w| ((w[1] - w[0]) - dt).abs() > 0.01 * dt)
+    {
+        return Err(input_err(
+            file,
+            "time_s",
+            format!(
+                "step {:e} s between samples {k} and {} differs from the mean step {dt:e} s by more than 1 %",
+                t[k + 1] - t[k],
+                k + 1
+            ),
+            "a uniform time axis (steps within 1 % of their mean)",
+        ));
+    }
+    Ok(dt)
+}
+
+/// Subtracts the mean of the first `n` samples (none if `n` is 0).
+pub(crate) fn debias(v: &[f64], n: usize) -> Vec<f64> {
+    crate::gauge::remove_baseline(v, n)
+}
+
+/// Index of the foot of the first pulse of `y` (positive pulse) and its peak index, by the rule
+/// of docs/physics.md §7.3, "Windows" 3 (`gauge::pulse_foot`); None if `y` has no positive value.
+fn pulse_foot(y: &[f64], fraction: f64) -> Option<(usize, usize)> {
+    crate::gauge::pulse_foot(y, fraction).map(|f| (f.index, f.peak_index))
+}
+
+/// How many times the RMS of its baseline a channel's largest |ε| must be for its polarity to be
+/// judged (docs/physics.md §7.3, "Polarity").
+const POLARITY_SIGNAL_TO_NOISE: f64 = 10.0;
+
+/// The first sample of `eps` (baseline removed) whose |ε| reaches half the largest |ε|, as
+/// (index, value), when that largest |ε| stands out of the noise of the first `baseline`
+/// samples (docs/physics.md §7.3, "Polarity"); None for a channel without a clear pulse.
+fn first_pulse(eps: &[f64], baseline: usize) -> Option<(usize, f64)> {
+    let largest = eps.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    let noise = quality::baseline_rms(eps, baseline);
+    if !(largest > 0.0 && largest > POLARITY_SIGNAL_TO_NOISE * noise) {
+        return None;
+    }
+    eps.iter()
+        .position(|e| e.abs() >= 0.5 * largest)
+        .map(|k| (k, eps[k]))
+}
+
+/// Refuses a channel whose first pulse is tensile: its polarity is inverted (docs/physics.md §7.3,
+/// "Polarity"). `channel` is `incident` or `transmission`.
+fn check_polarity(
+    eps: &[f64],
+    baseline: usize,
+    time_s: &[f64],
+    channel: &str,
+    file: &str,
+) -> Result<()> {
+    match first_pulse(eps, baseline) {
+        Some((k, e)) if e > 0.0 => Err(input_err(
+            file,
+            &format!("{channel}_strain"),
+            format!(
+                "the first pulse on the {channel} gauge is tensile (strain +{} at {}), but the \
+                 {} pulse, compressive, comes first there: the channel's polarity is inverted (a \
+                 compressive pulse recorded as tension)",
+                crate::error::format_si(e, ""),
+                crate::error::format_si(time_s[k], "s"),
+                if channel == "incident" {
+                    "incident"
+                } else {
+                    "transmitted"
+                }
+            ),
+            format!(
+                "a record whose first {channel} pulse is compressive (strain < 0): flip the sign \
+                 of `polarity` of the {channel} channel in the gauge set-up (bars/gauges-*.toml) \
+                 that reads this record, or correct the record"
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Bar strains of a raw record (the authors' CSV) read through the set-up's `incident` and
+/// `transmission` channels (bridge, gain, polarity), after removing each channel's voltage
+/// baseline (the mean of its first `baseline_samples` samples, as the authors do).
+pub fn record_strains(
+    record: &RawRecord,
+    apparatus: &Apparatus,
+    baseline_samples: usize,
+) -> Result<ReductionInput> {
+    let n = baseline_samples.min(record.time_s.len() / 2);
+    let inc = channel(apparatus, "incident")?;
+    let tra = channel(apparatus, "transmission")?;
+    Ok(ReductionInput {
+        time_s: record.time_s.clone(),
+        incident_strain: inc.strains_from_voltages(&debias(&record.incident_v, n)),
+        transmission_strain: tra.strains_from_voltages(&debias(&record.transmission_v, n)),
+    })
+}
+
+/// The two strain records after the first stage: smoothed, baselines removed, polarity checked
+/// (docs/physics.md §7.3, "Windows" 1–3).
+pub(crate) struct Conditioned {
+    /// Sample step, s.
+    pub dt: f64,
+    /// Incident-gauge strain, smoothed and debiased.
+    pub incident: Vec<f64>,
+    /// Transmission-gauge strain, smoothed and debiased.
+    pub transmission: Vec<f64>,
+    /// Baseline samples actually averaged (cut short before an early pulse).
+    pub baseline_samples: usize,
+    /// The incident pulse's (foot, peak) sample indices, if it has one.
+    pub incident_foot: Option<(usize, usize)>,
+    /// Largest compressive incident strain of the first pulse (0 without one).
+    pub incident_peak: f64,
+    /// RMS of the transmission channel's baseline.
+    pub transmission_noise: f64,
+}
+
+/// Checks, smooths and debiases the two records, judges their polarity and finds the incident
+/// foot; the baseline is re-taken before the pulse if the pulse starts within it.
+pub(crate) fn condition(
+    input: &ReductionInput,
+    options: &ReductionOptions,
+    file: &str,
+) -> Result<Conditioned> {
+    let dt = check_input(input, file)?;
+    let n = input.time_s.len();
+
+    // 0. Optional smoothing (a centred moving average over an odd number of samples).
+    let half = (options.smoothing_window_s / dt / 2.0).round() as usize;
+    let incident_strain = moving_average(&input.incident_strain, half);
+    let transmission_strain = moving_average(&input.transmission_strain, half);
+
+    // 1–3. Baseline, polarity, then the incident foot; the baseline must end before the pulse.
+    let mut nb = options.baseline_samples.min(n / 2);
+    let mut eps_i = debias(&incident_strain, nb);
+    check_polarity(&eps_i, nb, &input.time_s, "incident", file)?;
+    check_polarity(
+        &debias(&transmission_strain, nb),
+        nb,
+        &input.time_s,
+        "transmission",
+        file,
+    )?;
+    let foot = |e: &[f64]| {
+        let y: Vec<f64> = e.iter().map(|v| -v).collect();
+        pulse_foot(&y, options.start_fraction)
+    };
+    let mut detected = foot(&eps_i);
+    if let Some((k_foot, _)) = detected
+        && k_foot < nb
+    {
+        nb = k_foot;
+        eps_i = debias(&incident_strain, nb);
+        detected = foot(&eps_i);
+    }
+    let eps_t = debias(&transmission_strain, nb);
+    let incident_peak = detected.map(|(_, k)| -eps_i[k]).unwrap_or(0.0);
+    let transmission_noise = quality::baseline_rms(&eps_t, nb);
+    Ok(Conditioned {
+        dt,
+        incident: eps_i,
+        transmission: eps_t,
+        baseline_samples: nb,
+        incident_foot: detected,
+        incident_peak,
+        transmission_noise,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polarity_is_not_judged_on_noise() {
+        // A channel that is all noise has no first pulse to judge.
+        let noise: Vec<f64> = (0..2000)
+            .map(|k| 1e-7 * ((k * 7919 % 101) as f64 - 50.0))
+            .collect();
+        assert_eq!(first_pulse(&noise, 900), None);
+        let mut pulse = noise.clone();
+        pulse[1500] = 1e-3;
+        assert_eq!(first_pulse(&pulse, 900), Some((1500, 1e-3)));
+    }
+}
