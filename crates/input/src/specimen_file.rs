@@ -7,8 +7,9 @@
 use crate::error::{Error, Result, Validator};
 use crate::specimen::SpecimenSpec;
 use serde::Deserialize;
+use shpb_core::contact::LawSpec;
 use shpb_core::reduce::ReducedSpecimen;
-use shpb_core::reduce_cylinder::CylinderGeometry;
+use shpb_core::specimen::{Seating, Specimen, SphereSpecimen};
 use std::path::Path;
 
 /// What a specimen file may hold, for messages.
@@ -33,7 +34,7 @@ pub struct SpecimenFile {
 impl SpecimenFile {
     /// Reads `path`: its `[specimen]` table validated as a scene's (paths inside it relative to
     /// the file's directory). Spheres give the radii of the strain rate δ̇/Σrᵢ (a pair: r1 + r2;
-    /// a chain: every sphere's radius, as `shpb_core::scene::specimen_radii_m`); a cylinder its
+    /// a chain: every sphere's radius, as `SphereSpecimen::strain_rate_radii_m`); a cylinder its
     /// length and diameter. A seating (`gap_m`, `preload_n`) is accepted and does not change a
     /// reduction. Errors name the file and the key (exit code 2).
     pub fn read(path: &Path) -> Result<SpecimenFile> {
@@ -55,17 +56,15 @@ impl SpecimenFile {
         let base = path.parent().unwrap_or(Path::new("."));
         let v = v.table("specimen");
         let specimen = if spec.is_cylinder(&v)? {
-            let c = spec.build_cylinder(base, &v)?;
-            ReducedSpecimen::Cylinder(CylinderGeometry {
-                length_m: c.length_m,
-                diameter_m: c.diameter_m,
-            })
+            Specimen::Cylinder(spec.build_cylinder(base, &v)?)
         } else {
-            let chain = spec.spheres_only().build_chain(base, &v)?;
-            ReducedSpecimen::Spheres {
-                radii_m: shpb_core::scene::specimen_radii_m(&chain),
-            }
+            Specimen::Spheres(SphereSpecimen {
+                chain: spec.spheres_only().build_chain(base, &v)?,
+                law: LawSpec::default(),
+                seating: Seating::Touching,
+            })
         };
+        let specimen = ReducedSpecimen::of(&specimen);
         Ok(SpecimenFile {
             source: file,
             specimen,
@@ -76,6 +75,7 @@ impl SpecimenFile {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use shpb_core::reduce_cylinder::CylinderGeometry;
 
     fn read(text: &str) -> Result<SpecimenFile> {
         use std::sync::atomic::{AtomicUsize, Ordering};

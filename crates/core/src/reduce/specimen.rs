@@ -17,7 +17,7 @@ pub const PAPER_SPHERE_RADII_M: (f64, f64) = (3.175e-3, 3.175e-3);
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ReducedSpecimen {
     /// Spheres: the strain rate is δ̇/(r1 + r2); for a chain of N spheres (r1, r2 + … + rN), so
-    /// that it is δ̇/Σrᵢ over the whole chain (`scene::specimen_radii_m`, docs/physics.md §8).
+    /// that it is δ̇/Σrᵢ over the whole chain (`SphereSpecimen::strain_rate_radii_m`, docs/physics.md §8).
     Spheres {
         /// The two lengths whose sum divides δ̇, m.
         radii_m: (f64, f64),
@@ -36,6 +36,20 @@ impl Default for ReducedSpecimen {
 }
 
 impl ReducedSpecimen {
+    /// What a reduction reads for a scene's specimen: spheres their radii
+    /// ([`crate::specimen::SphereSpecimen::strain_rate_radii_m`]), a cylinder its geometry.
+    pub fn of(specimen: &crate::specimen::Specimen) -> ReducedSpecimen {
+        match specimen {
+            crate::specimen::Specimen::Spheres(s) => ReducedSpecimen::Spheres {
+                radii_m: s.strain_rate_radii_m(),
+            },
+            crate::specimen::Specimen::Cylinder(c) => ReducedSpecimen::Cylinder(CylinderGeometry {
+                length_m: c.length_m,
+                diameter_m: c.diameter_m,
+            }),
+        }
+    }
+
     /// The sphere radii of the strain rate δ̇/(r1 + r2), None for a cylinder (whose rate is its
     /// own, [`reduce_cylinder`]).
     pub fn radii_m(&self) -> Option<(f64, f64)> {
