@@ -322,7 +322,7 @@ diameter_m = 6.35e-3
         &[
             "`specimen.sphere1.material`",
             "unknown material `unobtainium`",
-            "allowed: ss440c, ss302, al2017 or a path to a material .toml file",
+            "allowed: ss440c, ss302, al2017, ofhc-copper, al6061-t6, al7075-t6, ti6al4v, steel4340 or a path to a material .toml file",
         ],
     );
 }

@@ -976,6 +976,8 @@ fn reduce_command_reads_a_shpb_run_hdf5_file() {
         warnings: Vec::new(),
         chain: None,
         drive: None,
+        specimen: None,
+        cylinder_reduction: None,
     };
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run.h5");

@@ -49,6 +49,11 @@ pub struct RunOutput {
     /// `/drive/{time,force}`: the force a recorded incident wave applied at the incident bar's
     /// impact end (`[incident_record]` scenes, docs/physics.md §6.10).
     pub drive: Option<DriveSeries>,
+    /// A cylinder's own true stress, strain and strain rate, its plastic and friction work
+    /// (docs/physics.md §6.12), beside the lab's reduction of it.
+    pub specimen: Option<crate::solver::SpecimenSeries>,
+    /// The lab's 1/2/3-wave reduction of a cylinder (docs/physics.md §7.8).
+    pub cylinder_reduction: Option<crate::reduce_cylinder::CylinderReduction>,
 }
 
 /// The prescribed force on the incident bar's impact end, one value per time step (the force of
@@ -89,6 +94,8 @@ impl RunOutput {
             warnings: Vec::new(),
             chain: None,
             drive: None,
+            specimen: None,
+            cylinder_reduction: None,
         }
     }
 }

@@ -106,6 +106,13 @@ impl Params {
 
     /// Warnings about the scene that do not stop it (e.g. a pair whose law has no region II).
     pub fn warnings(&self) -> Vec<String> {
+        if let Some(c) = self.specimen.as_ref().and_then(Specimen::cylinder) {
+            return c
+                .warnings()
+                .into_iter()
+                .map(|w| format!("{}: {w}", self.source))
+                .collect();
+        }
         let Some((pair, _)) = self.sphere_pair() else {
             return vec![];
         };
@@ -555,8 +562,23 @@ fn run_pulse(
     let absorbed = resample(&r.time_s, &r.absorbed_energy_j, &t);
     let shaper = resample(&r.time_s, &r.shaper_energy_j, &t);
     let contact_work = resample(&r.time_s, &r.contact_energy_j, &t);
+    // A cylinder's dissipation (docs/physics.md §6.12): plastic and friction work, less the
+    // kinetic energy its changing radial inertia exchanged (zero without it).
+    let dissipation = cylinder.map(|_| {
+        (
+            resample(&r.time_s, &r.plastic_work_j, &t),
+            resample(&r.time_s, &r.friction_work_j, &t),
+            resample(&r.time_s, &r.inertia_exchange_j, &t),
+        )
+    });
     let total: Vec<f64> = (0..t.len())
-        .map(|i| bars[i] + absorbed[i] + shaper[i] + contact_work[i])
+        .map(|i| {
+            let held = bars[i] + absorbed[i] + shaper[i] + contact_work[i];
+            match &dissipation {
+                Some((p, f, x)) => held + p[i] + f[i] - x[i],
+                None => held,
+            }
+        })
         .collect();
     if let Some(c) = &r.contact {
         let k = c.peak_index();
@@ -599,10 +621,19 @@ fn run_pulse(
     if r.contact.is_some() {
         energy.push(("contact".into(), contact_work));
     }
+    if let Some((plastic, friction, exchange)) = dissipation {
+        energy.push(("plastic".into(), plastic));
+        energy.push(("friction".into(), friction));
+        energy.push(("inertia_exchange".into(), exchange));
+    }
     energy.push(("total".into(), total));
-    let mut warnings = Vec::new();
+    let mut warnings = clipping_warnings(apparatus, cylinder, &gauges);
     // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.8).
     let radii = spheres_specimen.map(|sp| sp.strain_rate_radii_m());
+    let mut cylinder_reduction = None;
+    if let (Some(c), Some(series)) = (cylinder, &r.specimen) {
+        summary.extend(specimen_summary(c, series));
+    }
     let reduction = match (radii, cylinder) {
         (Some(_), _) | (None, Some(_)) => {
             match reduce_simulated_records(apparatus, options, radii, &t, &gauges) {
@@ -611,7 +642,13 @@ fn run_pulse(
                     if let Some(c) = cylinder {
                         summary.push(item("specimen_cells", c.cells_at(chain.dt_s) as f64, "1"));
                         match reduced_cylinder_summary(apparatus, c, &red) {
-                            Ok(items) => summary.extend(items),
+                            Ok((items, cyl)) => {
+                                summary.extend(items);
+                                if let Some(series) = &r.specimen {
+                                    summary.extend(true_and_reduced_summary(series, &cyl));
+                                }
+                                cylinder_reduction = Some(cyl);
+                            }
                             Err(e) => warnings.push(format!("cylinder reduction failed: {e}")),
                         }
                     }
@@ -636,6 +673,8 @@ fn run_pulse(
         reduction,
         warnings,
         chain: spheres_rec.map(|rec| rec.into_series()),
+        specimen: r.specimen,
+        cylinder_reduction,
         drive: driven.then(|| crate::run::DriveSeries {
             time_s: (0..chain.drive_force_n.len())
                 .map(|k| k as f64 * chain.dt_s)
@@ -786,7 +825,7 @@ fn reduced_cylinder_summary(
     apparatus: &Apparatus,
     c: &crate::specimen::CylinderSpecimen,
     red: &crate::reduce::Reduction,
-) -> Result<Vec<SummaryItem>> {
+) -> Result<(Vec<SummaryItem>, crate::reduce_cylinder::CylinderReduction)> {
     use crate::reduce_cylinder::{CylinderGeometry, loading_modulus, reduce_cylinder};
     let g = CylinderGeometry {
         length_m: c.length_m,
@@ -811,7 +850,144 @@ fn reduced_cylinder_summary(
     ) {
         v.push(item("reduced_loading_modulus", fit.modulus_pa, "Pa"));
     }
-    Ok(v)
+    Ok((v, cyl))
+}
+
+/// A warning for every gauge record that reaches its digitiser's full scale: the reduction cannot
+/// resolve what lies beyond it. On the transmission bar of a cylinder test it is said as the
+/// specimen stress the full scale stands for, E_b A_b ε_full / A_s (docs/physics.md §7.1, §7.8).
+fn clipping_warnings(
+    apparatus: &Apparatus,
+    cylinder: Option<&crate::specimen::CylinderSpecimen>,
+    gauges: &[crate::run::GaugeTrace],
+) -> Vec<String> {
+    let mut w = Vec::new();
+    for g in gauges {
+        let Some(ch) = apparatus.gauges.channel(&g.name) else {
+            continue;
+        };
+        let full = ch.digitiser.range_v - ch.digitiser.quantisation_step_v();
+        if !g.voltage_v.iter().any(|v| v.abs() >= full) {
+            continue;
+        }
+        let strain = ch.strains_from_voltages(&[full])[0].abs();
+        let mut msg = format!(
+            "the {} record reaches its digitiser's full scale (±{} V, strain {:.3e}): the \
+             reduction cannot resolve the wave beyond it",
+            g.name, ch.digitiser.range_v, strain
+        );
+        if let (Some(c), "transmission") = (cylinder, g.name.as_str()) {
+            let bar = &apparatus.transmission;
+            let stress =
+                apparatus.material.youngs_modulus_pa * strain * bar.area_m2() / c.area_m2();
+            msg.push_str(&format!(
+                "; the specimen's stress passes {}, the most the transmission record can show",
+                format_si(stress, "Pa")
+            ));
+        }
+        w.push(msg);
+    }
+    w
+}
+
+/// Lowest true strain from which a cylinder's reduced flow stress is compared with its true one
+/// ([`true_and_reduced_summary`]): below it the specimen rings up and yields (docs/physics.md
+/// §6.12).
+pub const FLOW_COMPARISON_FROM_STRAIN: f64 = 0.02;
+
+/// Summary items of a simulated cylinder (docs/physics.md §6.12): its peak true stress, largest
+/// true strain, peak true strain rate, plastic and friction work, and the largest stress its end
+/// friction and radial inertia add.
+fn specimen_summary(
+    c: &crate::specimen::CylinderSpecimen,
+    s: &crate::solver::SpecimenSeries,
+) -> Vec<SummaryItem> {
+    let max = |v: &[f64]| v.iter().copied().fold(0.0f64, f64::max);
+    let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let last = |v: &[f64]| v.last().copied().unwrap_or(0.0);
+    let mut v = vec![
+        item("true_peak_stress", max(&s.face_stress_pa), "Pa"),
+        item("true_max_strain", max(&s.true_strain), "1"),
+        item(
+            "true_peak_strain_rate",
+            max(&s.true_strain_rate_per_s),
+            "1/s",
+        ),
+    ];
+    if !matches!(c.flow, crate::flow::FlowModel::Elastic) {
+        v.push(item("plastic_work", last(&s.plastic_work_j), "J"));
+        v.push(item("max_plastic_strain", max(&s.plastic_strain), "1"));
+        v.push(item("max_temperature", max(&s.temperature_k), "K"));
+    }
+    if c.friction.is_some() {
+        v.push(item("friction_work", last(&s.friction_work_j), "J"));
+        v.push(item(
+            "friction_peak_stress",
+            max_abs(&s.friction_stress_pa),
+            "Pa",
+        ));
+    }
+    if c.radial_inertia {
+        v.push(item(
+            "inertia_peak_stress",
+            max_abs(&s.inertia_stress_pa),
+            "Pa",
+        ));
+    }
+    v
+}
+
+/// How far the lab's 1-wave reduction of a simulated cylinder lies from its true flow stress
+/// (docs/physics.md §6.12): the largest |σ_reduced/σ_true − 1| over its loading from the true
+/// strain [`FLOW_COMPARISON_FROM_STRAIN`] to the end of loading (the peak stress), σ_true the
+/// specimen's face stress at the same true strain on its own loading branch. Empty when the
+/// specimen never reaches that strain while loading.
+fn true_and_reduced_summary(
+    s: &crate::solver::SpecimenSeries,
+    cyl: &crate::reduce_cylinder::CylinderReduction,
+) -> Vec<SummaryItem> {
+    match reduced_flow_error(s, &cyl.one_wave) {
+        Some(e) => vec![item("reduced_true_stress_max_relative_error", e, "1")],
+        None => vec![],
+    }
+}
+
+/// The largest |σ_reduced/σ_true − 1| of [`true_and_reduced_summary`] for one analysis.
+pub fn reduced_flow_error(
+    s: &crate::solver::SpecimenSeries,
+    a: &crate::reduce_cylinder::WaveAnalysis,
+) -> Option<f64> {
+    // The loading branches, each up to its peak stress (the end of loading), where the strain
+    // increases.
+    let peak = crate::numeric::argmax(&s.face_stress_pa);
+    let mut strain = Vec::new();
+    let mut stress = Vec::new();
+    for k in 0..=peak {
+        if strain.last().is_none_or(|&e| s.true_strain[k] > e) {
+            strain.push(s.true_strain[k]);
+            stress.push(s.face_stress_pa[k]);
+        }
+    }
+    let end = *strain.last()?;
+    if end <= FLOW_COMPARISON_FROM_STRAIN {
+        return None;
+    }
+    let reduced_peak = crate::numeric::argmax(&a.true_stress_pa);
+    let window: Vec<usize> = (0..=reduced_peak)
+        .filter(|&k| (FLOW_COMPARISON_FROM_STRAIN..=end).contains(&a.true_strain[k]))
+        .collect();
+    if window.is_empty() {
+        return None;
+    }
+    let at: Vec<f64> = window.iter().map(|&k| a.true_strain[k]).collect();
+    let truth = resample(&strain, &stress, &at);
+    Some(
+        window
+            .iter()
+            .zip(&truth)
+            .map(|(&k, t)| (a.true_stress_pa[k] / t - 1.0).abs())
+            .fold(0.0, f64::max),
+    )
 }
 
 /// Summary items of the reduction of a simulated test (`reduced_*`).

@@ -21,16 +21,36 @@ const ROOM_TEMPERATURE_K: f64 = 293.0;
 /// The flow models a cylinder may name with `model`.
 const MODELS: &str = "elastic, johnson-cook, table";
 
-/// Validates a cylinder of `material` (a name, a file or a table), `length` and `diameter` with
-/// the flow keys of `spec`; `v` reports keys under `[specimen]`.
-pub(crate) fn build(
-    spec: &SpecimenSpec,
-    material: &toml::Value,
-    length: f64,
-    diameter: f64,
-    base_dir: &Path,
-    v: &Validator,
-) -> Result<CylinderSpecimen> {
+/// Validates a cylindrical specimen (`shape = "cylinder"`, docs/physics.md §6.9, §6.12): its
+/// geometry, material (a name, a file or a table) and flow keys; `v` reports keys under
+/// `[specimen]`.
+pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<CylinderSpecimen> {
+    spec.refuse_seating_keys(v)?;
+    for (key, given) in [
+        ("pair", spec.pair.is_some()),
+        ("sphere1", spec.sphere1.is_some()),
+        ("sphere2", spec.sphere2.is_some()),
+        ("count", spec.count.is_some()),
+        ("sphere", spec.sphere.is_some()),
+    ] {
+        if given {
+            return Err(v.error(
+                key,
+                format!("`{key}` describes spheres, not a cylinder"),
+                CYLINDER_FORM,
+            ));
+        }
+    }
+    let (Some(length), Some(diameter), Some(material)) =
+        (spec.length_m, spec.diameter_m, &spec.material)
+    else {
+        let key = match (spec.length_m, spec.diameter_m) {
+            (None, _) => "length_m",
+            (_, None) => "diameter_m",
+            _ => "material",
+        };
+        return Err(v.error(key, "missing", CYLINDER_FORM));
+    };
     let (elastic, material_jc) = match material {
         toml::Value::String(name) => {
             let m = Material::resolve(name, base_dir, v, "material")?;

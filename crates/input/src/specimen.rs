@@ -214,7 +214,7 @@ impl SpecimenSpec {
 
     /// Refuses the seating keys where no bars hold the specimen (every scene kind but `shpb`,
     /// and a cylinder, which sits on butt joints).
-    fn refuse_seating_keys(&self, v: &Validator) -> Result<()> {
+    pub(crate) fn refuse_seating_keys(&self, v: &Validator) -> Result<()> {
         for (key, given) in [
             ("gap_m", self.gap_m.is_some()),
             ("preload_n", self.preload_n.is_some()),
@@ -290,42 +290,6 @@ impl SpecimenSpec {
                 "a built-in material name or a material .toml file",
             )),
         }
-    }
-
-    /// Validates a cylindrical specimen (`shape = "cylinder"`, docs/physics.md §6.9, §6.12): its
-    /// geometry and material here, its flow in [`crate::cylinder::build`].
-    pub fn build_cylinder(
-        &self,
-        base_dir: &Path,
-        v: &Validator,
-    ) -> Result<shpb_core::specimen::CylinderSpecimen> {
-        self.refuse_seating_keys(v)?;
-        for (key, given) in [
-            ("pair", self.pair.is_some()),
-            ("sphere1", self.sphere1.is_some()),
-            ("sphere2", self.sphere2.is_some()),
-            ("count", self.count.is_some()),
-            ("sphere", self.sphere.is_some()),
-        ] {
-            if given {
-                return Err(v.error(
-                    key,
-                    format!("`{key}` describes spheres, not a cylinder"),
-                    CYLINDER_FORM,
-                ));
-            }
-        }
-        let (Some(length), Some(diameter), Some(material)) =
-            (self.length_m, self.diameter_m, &self.material)
-        else {
-            let key = match (self.length_m, self.diameter_m) {
-                (None, _) => "length_m",
-                (_, None) => "diameter_m",
-                _ => "material",
-            };
-            return Err(v.error(key, "missing", CYLINDER_FORM));
-        };
-        crate::cylinder::build(self, material, length, diameter, base_dir, v)
     }
 
     /// Whether the table gives a chain (`count`, `material`, `diameter_m` or `sphere`) rather

@@ -56,7 +56,7 @@ impl SpecimenFile {
         let base = path.parent().unwrap_or(Path::new("."));
         let v = v.table("specimen");
         let specimen = if spec.is_cylinder(&v)? {
-            Specimen::Cylinder(spec.build_cylinder(base, &v)?)
+            Specimen::Cylinder(crate::cylinder::build(&spec, base, &v)?)
         } else {
             Specimen::Spheres(SphereSpecimen {
                 chain: spec.spheres_only().build_chain(base, &v)?,

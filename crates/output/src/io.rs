@@ -197,10 +197,28 @@ pub fn write_hdf5(
                 )?;
             }
         }
+        if let Some(sp) = &out.specimen {
+            let g = f.create_group("specimen").map_err(h5err(path))?;
+            for (name, data, units) in specimen_columns(sp) {
+                write_dataset(&g, name, data, units, path)?;
+            }
+            origin(&g, "time", TIME_ORIGIN, 0.0)?;
+            string_attr(
+                &g,
+                "description",
+                "the cylinder's own state (compression positive): true stress (face forces over the \
+                 current area), true strain −ln(h/L0) and its rate, as the model has them, beside \
+                 /reduction/cylinder, what the lab's reduction reads; docs/physics.md §6.12",
+                path,
+            )?;
+        }
         if let Some(r) = &out.reduction {
             let g = f.create_group("reduction").map_err(h5err(path))?;
             for (name, data, units, _) in crate::reduction::reduction_columns(r) {
                 write_dataset(&g, name, data, units, path)?;
+            }
+            if let Some(c) = &out.cylinder_reduction {
+                crate::reduction::write_cylinder_group(&g, c, path)?;
             }
             origin(
                 &g,
@@ -247,6 +265,25 @@ pub fn write_hdf5(
         }
         f.close().map_err(h5err(path))
     })
+}
+
+/// The `/specimen/*` series of a simulated cylinder (name, data, units; docs/physics.md §6.12).
+pub fn specimen_columns(
+    s: &shpb_core::solver::SpecimenSeries,
+) -> [(&'static str, &[f64], &'static str); 11] {
+    [
+        ("time", &s.time_s, "s"),
+        ("true_stress", &s.face_stress_pa, "Pa"),
+        ("element_stress", &s.element_stress_pa, "Pa"),
+        ("true_strain", &s.true_strain, "1"),
+        ("true_strain_rate", &s.true_strain_rate_per_s, "1/s"),
+        ("plastic_strain", &s.plastic_strain, "1"),
+        ("temperature", &s.temperature_k, "K"),
+        ("friction_stress", &s.friction_stress_pa, "Pa"),
+        ("inertia_stress", &s.inertia_stress_pa, "Pa"),
+        ("plastic_work", &s.plastic_work_j, "J"),
+        ("friction_work", &s.friction_work_j, "J"),
+    ]
 }
 
 /// Writes a run as CSV with one header line (units in the column names): the contact series,

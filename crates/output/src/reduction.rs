@@ -207,6 +207,35 @@ pub fn analysis_columns(
     ]
 }
 
+/// Writes `cylinder/` under the reduction group `g`: the geometry as attributes and
+/// `<analysis>/<series>` of [`cylinder_analyses`] (compression positive, docs/physics.md §7.8).
+pub fn write_cylinder_group(g: &hdf5::Group, c: &CylinderReduction, path: &Path) -> Result<()> {
+    let cg = g.create_group("cylinder").map_err(h5err(path))?;
+    for (key, value) in [
+        ("length_m", c.geometry.length_m),
+        ("diameter_m", c.geometry.diameter_m),
+    ] {
+        cg.new_attr::<f64>()
+            .shape(())
+            .create(key)
+            .and_then(|a| a.write_scalar(&value))
+            .map_err(h5err(path))?;
+    }
+    string_attr(
+        &cg,
+        "sign",
+        "compression positive (stress, strain, strain rate); docs/physics.md §7.8",
+        path,
+    )?;
+    for (group, a) in cylinder_analyses(c) {
+        let ag = cg.create_group(group).map_err(h5err(path))?;
+        for (name, data, units, _) in analysis_columns(a) {
+            write_dataset(&ag, name, data, units, path)?;
+        }
+    }
+    Ok(())
+}
+
 /// Scalar results of a cylinder's reduction, as `/summary` attributes: (key, value, unit).
 pub fn cylinder_summary_items(c: &CylinderReduction) -> Vec<(&'static str, f64, &'static str)> {
     vec![
@@ -239,29 +268,7 @@ pub fn write_reduction_hdf5_with(
         }
         let mut items = summary_items(r);
         if let Some(c) = cylinder {
-            let cg = g.create_group("cylinder").map_err(h5err(path))?;
-            for (key, value) in [
-                ("length_m", c.geometry.length_m),
-                ("diameter_m", c.geometry.diameter_m),
-            ] {
-                cg.new_attr::<f64>()
-                    .shape(())
-                    .create(key)
-                    .and_then(|a| a.write_scalar(&value))
-                    .map_err(h5err(path))?;
-            }
-            string_attr(
-                &cg,
-                "sign",
-                "compression positive (stress, strain, strain rate); docs/physics.md §7.8",
-                path,
-            )?;
-            for (group, a) in cylinder_analyses(c) {
-                let ag = cg.create_group(group).map_err(h5err(path))?;
-                for (name, data, units, _) in analysis_columns(a) {
-                    write_dataset(&ag, name, data, units, path)?;
-                }
-            }
+            write_cylinder_group(&g, c, path)?;
             items.extend(cylinder_summary_items(c));
         }
         let s = f.create_group("summary").map_err(h5err(path))?;

@@ -81,8 +81,16 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
             units: Cow::Borrowed("Pa"),
         });
     }
+    if let Some(sp) = &out.specimen {
+        for (name, data, units) in crate::io::specimen_columns(sp) {
+            v.push(one_d(format!("specimen/{name}"), data, units));
+        }
+    }
     if let Some(r) = &out.reduction {
         v.extend(reduction_datasets(r));
+    }
+    if let Some(c) = &out.cylinder_reduction {
+        v.extend(cylinder_datasets(c));
     }
     for (name, data) in &out.energy {
         v.push(one_d(format!("energy/{name}"), data, "J"));
@@ -225,6 +233,18 @@ mod tests {
                 time_s: vec![0.0, 1e-7, 2e-7],
                 force_n: vec![0.0, 3.0, 0.0],
             }),
+            specimen: Some({
+                let mut s = shpb_core::solver::SpecimenSeries::default();
+                let sample = shpb_core::solver::cylinder::SpecimenSample {
+                    face_stress_pa: 1e8,
+                    true_strain: 0.1,
+                    ..Default::default()
+                };
+                s.push(0.0, &sample);
+                s.push(1e-6, &sample);
+                s
+            }),
+            cylinder_reduction: None,
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.h5");

@@ -95,6 +95,8 @@ pub fn strain(
         warnings: Vec::new(),
         chain: None,
         drive: None,
+        specimen: None,
+        cylinder_reduction: None,
     };
     let text = format!(
         "record = \"{}\"\nbars = \"{}\"\nbaseline_samples = {n}\n",
