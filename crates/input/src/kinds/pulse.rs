@@ -180,9 +180,9 @@ pub(super) fn parse_bars(
     let sv = v.table("specimen");
     let f: PulseFile = parse_as(text, file)?;
     let specimen = match (&f.specimen, is_test) {
-        (Some(spec), true) if spec.is_cylinder(&sv)? => {
-            Some(Specimen::Cylinder(crate::cylinder::build(spec, base_dir, &sv)?))
-        }
+        (Some(spec), true) if spec.is_cylinder(&sv)? => Some(Specimen::Cylinder(
+            crate::cylinder::build(spec, base_dir, &sv)?,
+        )),
         (Some(spec), true) => Some(Specimen::Spheres(SphereSpecimen {
             chain: spec.spheres_only().build_chain(base_dir, &sv)?,
             law: LawSpec {
