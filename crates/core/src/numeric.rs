@@ -356,6 +356,57 @@ pub fn spectral_filter(
     buf.iter().take(n).map(|z| z.re / m as f64).collect()
 }
 
+/// A factorised symmetric tridiagonal matrix (Thomas algorithm): the Love rod's mass operator
+/// (docs/physics.md §6.3) and a cylinder's radial-inertia mass (§6.12).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Tridiagonal {
+    /// Off-diagonal A_{i,i+1}.
+    off: Vec<f64>,
+    /// Modified upper coefficients c'_i = A_{i,i+1}/den_i.
+    cprime: Vec<f64>,
+    /// 1/den_i of the forward sweep.
+    inv_den: Vec<f64>,
+}
+
+impl Tridiagonal {
+    /// Factorises the matrix with diagonal `diag` and off-diagonal `off` (diagonally dominant here).
+    pub(crate) fn factor(diag: &[f64], off: Vec<f64>) -> Tridiagonal {
+        let n = diag.len();
+        let mut cprime = vec![0.0; n.saturating_sub(1)];
+        let mut inv_den = vec![0.0; n];
+        let mut prev_c = 0.0;
+        for i in 0..n {
+            let den = if i == 0 {
+                diag[0]
+            } else {
+                diag[i] - off[i - 1] * prev_c
+            };
+            inv_den[i] = 1.0 / den;
+            if i + 1 < n {
+                prev_c = off[i] * inv_den[i];
+                cprime[i] = prev_c;
+            }
+        }
+        Tridiagonal {
+            off,
+            cprime,
+            inv_den,
+        }
+    }
+
+    /// Solves A x = b in place (b in, x out).
+    pub(crate) fn solve(&self, x: &mut [f64]) {
+        let n = x.len();
+        x[0] *= self.inv_den[0];
+        for i in 1..n {
+            x[i] = (x[i] - self.off[i - 1] * x[i - 1]) * self.inv_den[i];
+        }
+        for i in (0..n - 1).rev() {
+            x[i] -= self.cprime[i] * x[i + 1];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -117,24 +117,8 @@ pub fn material_johnson_cook_table(
     v: &Validator,
     key: &str,
 ) -> Result<Option<toml::Value>> {
-    let (text, file) = if reference.ends_with(".toml") {
-        let path = base_dir.join(reference);
-        let text = crate::files::read_to_string(&path).map_err(|e| {
-            v.error(
-                key,
-                format!("cannot read {}: {e}", path.display()),
-                "a readable material .toml file, relative to the scene file's directory",
-            )
-        })?;
-        (text, path.display().to_string())
-    } else {
-        match BUILTIN_MATERIALS.iter().find(|(n, _)| *n == reference) {
-            Some((n, text)) => {
-                let file = format!("specimens/{n}.toml");
-                (crate::files::builtin(&file, text).to_string(), file)
-            }
-            None => return Ok(None),
-        }
+    let Some((text, file)) = material_source(reference, base_dir, v, key)? else {
+        return Ok(None);
     };
     let raw: MaterialToml = toml::from_str(&text).map_err(|e| Error::Parse {
         file,
@@ -227,25 +211,43 @@ impl MaterialFile for Material {
 
     /// Resolves a material reference: a path to a `.toml` file (relative to `base_dir`) or a built-in name.
     fn resolve(reference: &str, base_dir: &Path, v: &Validator, key: &str) -> Result<Material> {
-        if reference.ends_with(".toml") {
-            let path = base_dir.join(reference);
-            let text = crate::files::read_to_string(&path).map_err(|e| {
-                v.error(
-                    key,
-                    format!("cannot read {}: {e}", path.display()),
-                    "a readable material .toml file, relative to the scene file's directory",
-                )
-            })?;
-            return Material::from_toml(&text, &path.display().to_string());
-        }
-        Material::builtin(reference).ok_or_else(|| {
-            v.error(
+        match material_source(reference, base_dir, v, key)? {
+            Some((text, file)) => Material::from_toml(&text, &file),
+            None => Err(v.error(
                 key,
                 format!("unknown material `{reference}`"),
                 format!("{} or a path to a material .toml file", builtin_names()),
-            )
-        })
+            )),
+        }
     }
+}
+
+/// The text and name of a material reference: a `.toml` file relative to `base_dir` (read through
+/// `files`, so a run records it), or a built-in material; None for neither.
+fn material_source(
+    reference: &str,
+    base_dir: &Path,
+    v: &Validator,
+    key: &str,
+) -> Result<Option<(String, String)>> {
+    if reference.ends_with(".toml") {
+        let path = base_dir.join(reference);
+        let text = crate::files::read_to_string(&path).map_err(|e| {
+            v.error(
+                key,
+                format!("cannot read {}: {e}", path.display()),
+                "a readable material .toml file, relative to the scene file's directory",
+            )
+        })?;
+        return Ok(Some((text, path.display().to_string())));
+    }
+    Ok(BUILTIN_MATERIALS
+        .iter()
+        .find(|(n, _)| *n == reference)
+        .map(|(n, text)| {
+            let file = format!("specimens/{n}.toml");
+            (crate::files::builtin(&file, text).to_string(), file)
+        }))
 }
 
 /// The built-in material names joined for error messages.

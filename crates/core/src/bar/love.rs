@@ -5,56 +5,7 @@
 
 use super::leapfrog::{advance_nodes, lumped_kinetic, node_strain_energy, tensions};
 use super::{Interior, Nodes};
-
-/// A factorised symmetric tridiagonal matrix (Thomas algorithm).
-#[derive(Debug, Clone)]
-struct Tridiagonal {
-    /// Off-diagonal A_{i,i+1}.
-    off: Vec<f64>,
-    /// Modified upper coefficients c'_i = A_{i,i+1}/den_i.
-    cprime: Vec<f64>,
-    /// 1/den_i of the forward sweep.
-    inv_den: Vec<f64>,
-}
-
-impl Tridiagonal {
-    /// Factorises the matrix with diagonal `diag` and off-diagonal `off` (diagonally dominant here).
-    fn factor(diag: &[f64], off: Vec<f64>) -> Tridiagonal {
-        let n = diag.len();
-        let mut cprime = vec![0.0; n.saturating_sub(1)];
-        let mut inv_den = vec![0.0; n];
-        let mut prev_c = 0.0;
-        for i in 0..n {
-            let den = if i == 0 {
-                diag[0]
-            } else {
-                diag[i] - off[i - 1] * prev_c
-            };
-            inv_den[i] = 1.0 / den;
-            if i + 1 < n {
-                prev_c = off[i] * inv_den[i];
-                cprime[i] = prev_c;
-            }
-        }
-        Tridiagonal {
-            off,
-            cprime,
-            inv_den,
-        }
-    }
-
-    /// Solves A x = b in place (b in, x out).
-    fn solve(&self, x: &mut [f64]) {
-        let n = x.len();
-        x[0] *= self.inv_den[0];
-        for i in 1..n {
-            x[i] = (x[i] - self.off[i - 1] * x[i - 1]) * self.inv_den[i];
-        }
-        for i in (0..n - 1).rev() {
-            x[i] -= self.cprime[i] * x[i + 1];
-        }
-    }
-}
+use crate::numeric::Tridiagonal;
 
 /// The Love rod on every node: factorised M + β-terms + ΔtD/2 and the responses to unit end forces.
 #[derive(Debug, Clone)]

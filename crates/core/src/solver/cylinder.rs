@@ -11,6 +11,7 @@ use super::record::Recorder;
 use crate::bar::ENERGY_LEDGER_TOLERANCE;
 use crate::error::{Error, Named, Result};
 use crate::flow::FlowModel;
+use crate::numeric::Tridiagonal;
 use crate::specimen::CylinderSpecimen;
 use std::f64::consts::PI;
 
@@ -37,51 +38,6 @@ pub struct SpecimenSample {
     pub plastic_work_j: f64,
     /// Friction work so far, J.
     pub friction_work_j: f64,
-}
-
-/// A factorised symmetric tridiagonal matrix (Thomas algorithm), for the radial-inertia mass.
-#[derive(Debug, Clone, Default)]
-struct Tridiagonal {
-    off: Vec<f64>,
-    cprime: Vec<f64>,
-    inv_den: Vec<f64>,
-}
-
-impl Tridiagonal {
-    fn factor(diag: &[f64], off: &[f64]) -> Tridiagonal {
-        let n = diag.len();
-        let mut cprime = vec![0.0; n.saturating_sub(1)];
-        let mut inv_den = vec![0.0; n];
-        let mut prev_c = 0.0;
-        for i in 0..n {
-            let den = if i == 0 {
-                diag[0]
-            } else {
-                diag[i] - off[i - 1] * prev_c
-            };
-            inv_den[i] = 1.0 / den;
-            if i + 1 < n {
-                prev_c = off[i] * inv_den[i];
-                cprime[i] = prev_c;
-            }
-        }
-        Tridiagonal {
-            off: off.to_vec(),
-            cprime,
-            inv_den,
-        }
-    }
-
-    fn solve(&self, x: &mut [f64]) {
-        let n = x.len();
-        x[0] *= self.inv_den[0];
-        for i in 1..n {
-            x[i] = (x[i] - self.off[i - 1] * x[i - 1]) * self.inv_den[i];
-        }
-        for i in (0..n - 1).rev() {
-            x[i] -= self.cprime[i] * x[i + 1];
-        }
-    }
 }
 
 /// The specimen in its time-stepping state (docs/physics.md §6.12).
@@ -356,7 +312,7 @@ impl PlasticCylinder {
             })
             .collect();
         let off: Vec<f64> = b.iter().map(|&x| -x).collect();
-        self.matrix = Tridiagonal::factor(&diag, &off);
+        self.matrix = Tridiagonal::factor(&diag, off);
         for (end, node) in [(0usize, 0usize), (1, n - 1)] {
             let mut r = vec![0.0; n];
             r[node] = 1.0;
