@@ -9,6 +9,8 @@
 //! * What end friction and radial inertia contribute, as the run reports them (the `/specimen`
 //!   series `friction_stress` and `inertia_stress`), is what switching each off takes away.
 
+mod common;
+
 use shpb::prelude::*;
 use shpb::run::RunOutput;
 use shpb::scene::Params;
@@ -158,4 +160,34 @@ fn the_run_reports_what_friction_and_inertia_contribute() {
     assert!(worst_friction < 0.03, "friction {worst_friction}");
     assert!(peak_inertia < 1e-3 * peak, "inertia {peak_inertia} Pa");
     assert!(worst_inertia < 1e-3, "inertia {worst_inertia}");
+}
+
+/// `shpb run --plot` of the shipped copper scene draws the cylinder test's figure: three panels
+/// of 800 × 620 pixels across (gauge signals; true stress against true strain; true strain rate
+/// against true strain) above the bars' x–t diagram, 2400 × 1300 in all. The specimen's own
+/// curves (solid orange) and the 1-wave reduction (dashed dark red) are in both specimen panels.
+#[test]
+fn a_cylinder_run_plots_its_true_and_reduced_stress_strain_and_rate() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = common::repo_path("scenes/shpb-cylinder-copper.toml");
+    let out = common::shpb(tmp.path(), &["run", &scene, "--plot", "cu.png"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let png = std::fs::read(tmp.path().join("cu.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
+    let img = image::load_from_memory(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (2400, 1300));
+    let pixels_in = |panel: u32, rgb: [u8; 3]| {
+        (800 * panel..800 * (panel + 1))
+            .flat_map(|x| (0..620).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == rgb)
+            .count()
+    };
+    for panel in [1, 2] {
+        let own = pixels_in(panel, [230, 140, 20]);
+        let reduced = pixels_in(panel, [140, 20, 20]);
+        assert!(
+            own > 300 && reduced > 300,
+            "panel {panel}: {own}, {reduced}"
+        );
+    }
 }

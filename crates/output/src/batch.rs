@@ -2,7 +2,9 @@
 //! R.md`): one summary row per record, a Markdown report with one figure per record.
 
 use crate::atomic::write_text_atomically;
-use crate::plot::{Axes, Curve, panels_figure};
+use crate::plot::{
+    Axes, Curve, Measure, curve, panels_figure, strain_rate_panel, stress_strain_panel,
+};
 use shpb_core::reduce::{BarProperties, Reduction, WaveMetrics, wave_metrics};
 use shpb_core::reduce_cylinder::CylinderReduction;
 use shpb_input::Result;
@@ -420,27 +422,15 @@ pub fn record_figure(
                 ("2-wave", &c.two_wave),
                 ("3-wave", &c.three_wave),
             ];
-            panels.push((
-                Axes {
-                    title: "cylinder: engineering stress against strain",
-                    x_label: "engineering strain (%), compression positive",
-                    y_label: "engineering stress (MPa), compression positive",
-                    x_scale: 1e2,
-                    y_scale: 1e-6,
-                },
+            panels.push(stress_strain_panel(
+                Measure::Engineering,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &a.strain, &a.stress_pa))
                     .collect(),
             ));
-            panels.push((
-                Axes {
-                    title: "cylinder: engineering strain rate",
-                    x_label: "time at the faces (µs)",
-                    y_label: "strain rate (1/s), compression positive",
-                    x_scale: 1e6,
-                    y_scale: 1.0,
-                },
+            panels.push(strain_rate_panel(
+                Measure::Engineering,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &r.time_s, &a.strain_rate_per_s))
@@ -471,16 +461,6 @@ fn file_name(record: &str) -> String {
     Path::new(record)
         .file_name()
         .map_or_else(|| record.to_string(), |n| n.to_string_lossy().into_owned())
-}
-
-/// A model-line curve.
-fn curve<'a>(label: &str, x: &'a [f64], y: &'a [f64]) -> Curve<'a> {
-    Curve {
-        label: label.into(),
-        x,
-        y,
-        measured: false,
-    }
 }
 
 #[cfg(test)]

@@ -2,8 +2,10 @@
 
 use crate::atomic::write_atomically;
 use plotters::prelude::*;
+use shpb_core::reduce_cylinder::{CylinderReduction, WaveAnalysis};
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
+use shpb_core::solver::SpecimenSeries;
 use shpb_input::{Error, Result};
 use std::path::Path;
 
@@ -131,7 +133,11 @@ fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()
         let series = if c.measured {
             chart.draw_series(DashedLineSeries::new(pts, 8, 5, color.stroke_width(3)))
         } else {
-            chart.draw_series(LineSeries::new(pts, color.stroke_width(2)))
+            let runs = unreversed_runs(&pts, |p| chart.backend_coord(p));
+            chart.draw_series(
+                runs.into_iter()
+                    .map(|run| PathElement::new(run, color.stroke_width(2))),
+            )
         }
         .map_err(perr(path))?;
         series.label(c.label.clone()).legend(move |(x, y)| {
@@ -147,6 +153,41 @@ fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()
         .draw()
         .map_err(perr(path))?;
     Ok(())
+}
+
+/// A polyline cut where it turns back by more than a right angle (on the bitmap, `pixel` of each
+/// point), each piece starting where the last ends. Plotters joins the segments of a wide line
+/// with miters that grow without bound as a turn nears a reversal, so a curve that doubles back
+/// (a stress–strain curve unloading at constant strain, a pulse's sharp edge) would shoot a
+/// spike off the panel.
+fn unreversed_runs(
+    points: &[(f64, f64)],
+    pixel: impl Fn(&(f64, f64)) -> (i32, i32),
+) -> Vec<Vec<(f64, f64)>> {
+    let mut runs = Vec::new();
+    let mut run: Vec<(f64, f64)> = Vec::new();
+    let mut last: Option<(i32, i32)> = None;
+    let mut heading: Option<(i64, i64)> = None;
+    for p in points {
+        let px = pixel(p);
+        if let Some(q) = last {
+            if q == px {
+                continue;
+            }
+            let d = (i64::from(px.0 - q.0), i64::from(px.1 - q.1));
+            if heading.is_some_and(|h| h.0 * d.0 + h.1 * d.1 < 0) {
+                let start = run[run.len() - 1];
+                runs.push(std::mem::replace(&mut run, vec![start]));
+            }
+            heading = Some(d);
+        }
+        run.push(*p);
+        last = Some(px);
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    runs
 }
 
 /// Draws curves into a PNG (written atomically), scaled as `axes` says.
@@ -292,22 +333,23 @@ fn draw_field(area: &Area, path: &Path, title: &str, fields: &[Field]) -> Result
     Ok(())
 }
 
-/// The figure of a full virtual test: gauge signals, force–displacement (true and
-/// reconstructed), and the x–t diagram of the bars' stress.
+/// The figure of a full virtual test: a row of x–y panels (gauge signals, then what the
+/// specimen did: force–approach for spheres, stress–strain and strain rate for a cylinder),
+/// 800 × 620 pixels each, above the x–t diagram of the bars' stress across the whole width.
 pub fn test_figure(
     path: &Path,
     force: bool,
-    gauges: (&Axes, &[Curve]),
-    force_displacement: (&Axes, &[Curve]),
+    panels: &[(Axes, Vec<Curve>)],
     fields: &[Field],
 ) -> Result<()> {
+    let columns = panels.len().max(1);
     write_atomically(path, force, |tmp| {
-        let root = BitMapBackend::new(tmp, (1600, 1300)).into_drawing_area();
+        let root = BitMapBackend::new(tmp, (800 * columns as u32, 1300)).into_drawing_area();
         root.fill(&WHITE).map_err(perr(path))?;
         let (top, bottom) = root.split_vertically(620);
-        let (left, right) = top.split_horizontally(800);
-        draw_xy(&left, path, gauges.0, gauges.1)?;
-        draw_xy(&right, path, force_displacement.0, force_displacement.1)?;
+        for (area, (axes, curves)) in top.split_evenly((1, columns)).iter().zip(panels) {
+            draw_xy(area, path, axes, curves)?;
+        }
         draw_field(
             &bottom,
             path,
@@ -573,8 +615,17 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
     if let Some(chain) = &out.chain {
         return chain_figure(path, force, &title, chain);
     }
-    if let (Some(contact), SceneParams::Pulse { apparatus, .. }) = (&out.contact, &params.params) {
-        return plot_test(path, force, &title, apparatus, out, contact);
+    if let SceneParams::Pulse { apparatus, .. } = &params.params {
+        if let Some(contact) = &out.contact {
+            let panel = force_approach_panel(contact, out.reduction.as_ref());
+            return plot_test(path, force, &title, apparatus, out, vec![panel]);
+        }
+        if let Some(specimen) = &out.specimen {
+            let cylinder = out.cylinder_reduction.as_ref();
+            let reduced_rate = cylinder.map_or_else(Vec::new, |c| true_strain_rate(&c.one_wave));
+            let panels = cylinder_test_panels(specimen, cylinder, &reduced_rate);
+            return plot_test(path, force, &title, apparatus, out, panels);
+        }
     }
     if let Some(contact) = &out.contact {
         let mut curves = vec![Curve {
@@ -648,18 +699,18 @@ fn gauge_curves<'a>(out: &'a RunOutput, stresses: &'a [Vec<f64>]) -> Vec<Curve<'
         .collect()
 }
 
-/// The three-panel figure of a full virtual test (gauges, F–δ, x–t diagram).
-fn plot_test(
+/// The figure of a full virtual test ([`test_figure`]): the gauge signals, then `specimen`'s
+/// panels, above the x–t diagram of the bars.
+fn plot_test<'a>(
     path: &Path,
     force: bool,
     title: &str,
     apparatus: &shpb_core::apparatus::Apparatus,
-    out: &RunOutput,
-    contact: &shpb_core::solver::ContactSeries,
+    out: &'a RunOutput,
+    specimen: Vec<(Axes<'a>, Vec<Curve<'a>>)>,
 ) -> Result<()> {
     let e = apparatus.material.youngs_modulus_pa;
     let stresses = gauge_stresses(out, e);
-    let gauge_curves = gauge_curves(out, &stresses);
     let gauge_title = format!("{title}: gauge signals");
     let gauge_axes = Axes {
         title: &gauge_title,
@@ -668,27 +719,8 @@ fn plot_test(
         x_scale: 1e6,
         y_scale: 1e-6,
     };
-    let mut fd_curves = vec![Curve {
-        label: "true contact (simulation)".into(),
-        x: &contact.displacement_m,
-        y: &contact.force_n,
-        measured: false,
-    }];
-    if let Some(r) = &out.reduction {
-        fd_curves.push(Curve {
-            label: "reduced from the gauges (back force)".into(),
-            x: &r.displacement_m,
-            y: &r.force_back_n,
-            measured: true,
-        });
-    }
-    let fd_axes = Axes {
-        title: "force against sphere approach",
-        x_label: "sphere approach δ (mm)",
-        y_label: "force F (kN)",
-        x_scale: 1e3,
-        y_scale: 1e-3,
-    };
+    let mut panels = vec![(gauge_axes, gauge_curves(out, &stresses))];
+    panels.extend(specimen);
     // Positions along the apparatus with the specimen at 0: striker and incident bar to the left.
     let (li, ls) = (apparatus.incident.length_m, apparatus.striker.length_m);
     let shifted: Vec<Vec<f64>> = out
@@ -713,13 +745,163 @@ fn plot_test(
             stress_pa: &b.stress_pa,
         })
         .collect();
-    crate::plot::test_figure(
-        path,
-        force,
-        (&gauge_axes, &gauge_curves),
-        (&fd_axes, &fd_curves),
-        &fields,
-    )
+    test_figure(path, force, &panels, &fields)
+}
+
+/// Force against sphere approach: the true contact force and, when the run reduced its gauges,
+/// the back force reduced from them (dashed).
+fn force_approach_panel<'a>(
+    contact: &'a shpb_core::solver::ContactSeries,
+    reduction: Option<&'a shpb_core::reduce::Reduction>,
+) -> (Axes<'a>, Vec<Curve<'a>>) {
+    let mut curves = vec![curve(
+        "true contact (simulation)",
+        &contact.displacement_m,
+        &contact.force_n,
+    )];
+    if let Some(r) = reduction {
+        curves.push(Curve {
+            measured: true,
+            ..curve(
+                "reduced from the gauges (back force)",
+                &r.displacement_m,
+                &r.force_back_n,
+            )
+        });
+    }
+    let axes = Axes {
+        title: "force against sphere approach",
+        x_label: "sphere approach δ (mm)",
+        y_label: "force F (kN)",
+        x_scale: 1e3,
+        y_scale: 1e-3,
+    };
+    (axes, curves)
+}
+
+/// Which stress and strain a cylinder's panels show: engineering (as the lab reduces them) or
+/// true (constant volume, docs/physics.md §7.8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Measure {
+    /// Engineering stress, strain and strain rate.
+    Engineering,
+    /// True stress, strain and strain rate.
+    True,
+}
+
+/// A cylinder's stress–strain panel: `curves` of stress (Pa) against strain, drawn in MPa
+/// against %, compression positive.
+pub(crate) fn stress_strain_panel(
+    measure: Measure,
+    curves: Vec<Curve<'_>>,
+) -> (Axes<'_>, Vec<Curve<'_>>) {
+    let (title, x_label, y_label) = match measure {
+        Measure::Engineering => (
+            "cylinder: engineering stress against strain",
+            "engineering strain (%), compression positive",
+            "engineering stress (MPa), compression positive",
+        ),
+        Measure::True => (
+            "cylinder: true stress against true strain",
+            "true strain (%), compression positive",
+            "true stress (MPa), compression positive",
+        ),
+    };
+    let axes = Axes {
+        title,
+        x_label,
+        y_label,
+        x_scale: 1e2,
+        y_scale: 1e-6,
+    };
+    (axes, curves)
+}
+
+/// A cylinder's strain-rate panel, compression positive: the engineering rate against the time
+/// at the faces (µs; `curves` against the reduction's time in s), or the true rate against the
+/// true strain (%; `curves` against the true strain, which needs no common clock between the
+/// specimen and the reduction).
+pub(crate) fn strain_rate_panel(
+    measure: Measure,
+    curves: Vec<Curve<'_>>,
+) -> (Axes<'_>, Vec<Curve<'_>>) {
+    let axes = match measure {
+        Measure::Engineering => Axes {
+            title: "cylinder: engineering strain rate",
+            x_label: "time at the faces (µs)",
+            y_label: "strain rate (1/s), compression positive",
+            x_scale: 1e6,
+            y_scale: 1.0,
+        },
+        Measure::True => Axes {
+            title: "cylinder: true strain rate against true strain",
+            x_label: "true strain (%), compression positive",
+            y_label: "true strain rate (1/s), compression positive",
+            x_scale: 1e2,
+            y_scale: 1.0,
+        },
+    };
+    (axes, curves)
+}
+
+/// The true strain rate of a reduced analysis, d/dt[−ln(1 − ε)] = ε̇/(1 − ε), 1/s.
+pub(crate) fn true_strain_rate(a: &WaveAnalysis) -> Vec<f64> {
+    a.strain_rate_per_s
+        .iter()
+        .zip(&a.strain)
+        .map(|(rate, e)| rate / (1.0 - e))
+        .collect()
+}
+
+/// A cylinder test's own panels: true stress against true strain, the specimen's (simulation)
+/// beside the lab's 1-wave (dashed) and 3-wave reductions, and the true strain rate against the
+/// true strain, the specimen's beside the 1-wave one (`reduced_rate`, from [`true_strain_rate`]).
+fn cylinder_test_panels<'a>(
+    s: &'a SpecimenSeries,
+    c: Option<&'a CylinderReduction>,
+    reduced_rate: &'a [f64],
+) -> Vec<(Axes<'a>, Vec<Curve<'a>>)> {
+    let own = "true (specimen, simulation)";
+    let mut stress = vec![curve(own, &s.true_strain, &s.face_stress_pa)];
+    let mut rate = vec![curve(own, &s.true_strain, &s.true_strain_rate_per_s)];
+    if let Some(c) = c {
+        let (one, three) = (&c.one_wave, &c.three_wave);
+        stress.push(Curve {
+            measured: true,
+            ..curve(
+                "1-wave reduction of the gauges",
+                &one.true_strain,
+                &one.true_stress_pa,
+            )
+        });
+        stress.push(curve(
+            "3-wave reduction of the gauges",
+            &three.true_strain,
+            &three.true_stress_pa,
+        ));
+        rate.push(Curve {
+            measured: true,
+            ..curve(
+                "1-wave reduction of the gauges",
+                &one.true_strain,
+                reduced_rate,
+            )
+        });
+    }
+    vec![
+        stress_strain_panel(Measure::True, stress),
+        strain_rate_panel(Measure::True, rate),
+    ]
+}
+
+/// A model-line curve (solid, in the palette's colour of its place).
+pub(crate) fn curve<'a>(label: &str, x: &'a [f64], y: &'a [f64]) -> Curve<'a> {
+    Curve {
+        label: label.into(),
+        x,
+        y,
+        measured: false,
+    }
 }
 
 /// Rows of the x–t picture of a chain at most: longer series are binned in time, each cell
@@ -914,6 +1096,28 @@ mod tests {
     }
 
     #[test]
+    fn a_polyline_is_cut_where_it_turns_back() {
+        let px = |p: &(f64, f64)| (p.0 as i32, p.1 as i32);
+        // Up, a right-angle turn (kept), a repeated pixel (skipped), then back down.
+        let pts = [
+            (0.0, 0.0),
+            (10.0, 0.0),
+            (10.0, 10.0),
+            (10.2, 10.4),
+            (9.0, 0.0),
+        ];
+        let runs = unreversed_runs(&pts, px);
+        assert_eq!(
+            runs,
+            vec![
+                vec![(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
+                vec![(10.0, 10.0), (9.0, 0.0)]
+            ]
+        );
+        assert_eq!(unreversed_runs(&[], px), Vec::<Vec<(f64, f64)>>::new());
+    }
+
+    #[test]
     fn the_x_t_diagram_has_a_colour_bar_from_compression_to_tension() {
         let dir = tempfile::TempDir::new().unwrap();
         let path = dir.path().join("xt.png");
@@ -932,20 +1136,18 @@ mod tests {
             time_s: &t,
             stress_pa: &rows,
         };
-        let axes = Axes {
-            title: "t",
-            x_label: "x",
-            y_label: "y",
-            x_scale: 1.0,
-            y_scale: 1.0,
+        let panel = || {
+            let axes = Axes {
+                title: "t",
+                x_label: "x",
+                y_label: "y",
+                x_scale: 1.0,
+                y_scale: 1.0,
+            };
+            (axes, vec![curve("c", &x, &x)])
         };
-        let curve = [Curve {
-            label: "c".into(),
-            x: &x,
-            y: &x,
-            measured: false,
-        }];
-        test_figure(&path, false, (&axes, &curve), (&axes, &curve), &[field]).unwrap();
+        let panels = [panel(), panel()];
+        test_figure(&path, false, &panels, &[field]).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         // The colour bar sits in the last 130 px of the bottom panel: its column holds
         // saturated blue (compression) and saturated red (tension).
