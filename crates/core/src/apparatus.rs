@@ -576,6 +576,54 @@ impl Apparatus {
     }
 }
 
+/// Puts a specimen into a bar chain after the last of `bodies` (the incident bar or its insert)
+/// and before the transmission side; returns the masses to add to the end nodes of bodies, as
+/// (body index, right end, mass in kg).
+fn join_specimen(
+    specimen: &crate::specimen::Specimen,
+    bodies: &mut Vec<crate::solver::BodySpec>,
+    joints: &mut Vec<crate::solver::Joint>,
+) -> Vec<(usize, bool, f64)> {
+    use crate::solver::{BodySpec, Joint, MassSpec};
+    use crate::specimen::Specimen;
+    match specimen {
+        // The first and last spheres' masses join the end nodes of the bodies they touch (the
+        // paper's DEM); the spheres between are rigid masses, every two neighbours joined by a
+        // contact (docs/physics.md §8).
+        Specimen::Spheres(sp) => {
+            let front = bodies.len() - 1;
+            let n = sp.chain.len();
+            for k in 0..n - 1 {
+                joints.push(Joint::Spheres {
+                    props: sp.chain.contact_properties(k),
+                    law: sp.law,
+                    seating: sp.seating,
+                });
+                if k + 2 < n {
+                    bodies.push(BodySpec::Mass(MassSpec {
+                        name: format!("sphere {}", k + 2),
+                        mass_kg: sp.chain.spheres[k + 1].mass_kg,
+                    }));
+                }
+            }
+            let back = bodies.len();
+            vec![
+                (front, true, sp.chain.spheres[0].mass_kg),
+                (back, false, sp.chain.spheres[n - 1].mass_kg),
+            ]
+        }
+        // A cylinder is a body of its own between two butt joints, as an insert; elastic without
+        // friction or radial inertia it is a bar segment step for step (docs/physics.md §6.9,
+        // §6.12).
+        Specimen::Cylinder(c) => {
+            bodies.push(BodySpec::Cylinder(c.clone()));
+            joints.push(Joint::Butt);
+            joints.push(Joint::Butt);
+            Vec::new()
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -648,53 +696,5 @@ mod tests {
         assert_eq!(d.stress_at_pa(-1e-9), 0.0);
         assert_eq!(d.stress_at_pa(2.5e-6), 0.0);
         assert_eq!(d.stress_at_pa(f64::NAN), 0.0);
-    }
-}
-
-/// Puts a specimen into a bar chain after the last of `bodies` (the incident bar or its insert)
-/// and before the transmission side; returns the masses to add to the end nodes of bodies, as
-/// (body index, right end, mass in kg).
-fn join_specimen(
-    specimen: &crate::specimen::Specimen,
-    bodies: &mut Vec<crate::solver::BodySpec>,
-    joints: &mut Vec<crate::solver::Joint>,
-) -> Vec<(usize, bool, f64)> {
-    use crate::solver::{BodySpec, Joint, MassSpec};
-    use crate::specimen::Specimen;
-    match specimen {
-        // The first and last spheres' masses join the end nodes of the bodies they touch (the
-        // paper's DEM); the spheres between are rigid masses, every two neighbours joined by a
-        // contact (docs/physics.md §8).
-        Specimen::Spheres(sp) => {
-            let front = bodies.len() - 1;
-            let n = sp.chain.len();
-            for k in 0..n - 1 {
-                joints.push(Joint::Spheres {
-                    props: sp.chain.contact_properties(k),
-                    law: sp.law,
-                    seating: sp.seating,
-                });
-                if k + 2 < n {
-                    bodies.push(BodySpec::Mass(MassSpec {
-                        name: format!("sphere {}", k + 2),
-                        mass_kg: sp.chain.spheres[k + 1].mass_kg,
-                    }));
-                }
-            }
-            let back = bodies.len();
-            vec![
-                (front, true, sp.chain.spheres[0].mass_kg),
-                (back, false, sp.chain.spheres[n - 1].mass_kg),
-            ]
-        }
-        // A cylinder is a body of its own between two butt joints, as an insert; elastic without
-        // friction or radial inertia it is a bar segment step for step (docs/physics.md §6.9,
-        // §6.12).
-        Specimen::Cylinder(c) => {
-            bodies.push(BodySpec::Cylinder(c.clone()));
-            joints.push(Joint::Butt);
-            joints.push(Joint::Butt);
-            Vec::new()
-        }
     }
 }

@@ -8,7 +8,6 @@ use crate::error::{Result, Validator};
 use crate::material::MaterialFile;
 use crate::toml_file::parse_as;
 use serde::Deserialize;
-use shpb_core::contact::LawSpec;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::material::Material;
 use shpb_core::scene::SceneParams;
@@ -184,11 +183,7 @@ fn parse(
     };
     let mut setup = FreeChainSetup {
         chain,
-        law: LawSpec {
-            kind: f.law,
-            region2: f.region2,
-            unloading: f.unloading,
-        },
+        law: f.law_spec(),
         velocity1_m_s,
         striker,
         wall,

@@ -67,10 +67,7 @@ fn parse(
         max_displacement_m: check_max_displacement(v, f.max_displacement_m, &pair)?,
         points: check_points(v, f.points)?,
     };
-    Ok((
-        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
-        p,
-    ))
+    Ok((super::pair_specimen(&pair, f.law_spec()), p))
 }
 
 #[cfg(test)]

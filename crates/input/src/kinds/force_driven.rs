@@ -213,7 +213,7 @@ fn parse(
         output_every: check_every(v, f.output_every)?,
     };
     Ok((
-        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
+        super::pair_specimen(&pair, f.law_spec()),
         SceneParams::ForceDriven {
             setup,
             measured_displacement_m,

@@ -46,6 +46,17 @@ macro_rules! sphere_scene_file {
             unloading: shpb_core::contact::Unloading,
             $($(#[$fmeta])* $field: $ty,)*
         }
+
+        impl $name {
+            /// The scene's contact law with its own parameters (`law`, `region2`, `unloading`).
+            fn law_spec(&self) -> shpb_core::contact::LawSpec {
+                shpb_core::contact::LawSpec {
+                    kind: self.law,
+                    region2: self.region2,
+                    unloading: self.unloading,
+                }
+            }
+        }
     };
 }
 pub(crate) use sphere_scene_file;
@@ -54,22 +65,9 @@ pub(crate) use sphere_scene_file;
 /// the kind-specific parameters (the rest of [`shpb_core::scene::Params`] is common to all kinds).
 pub type Parsed = (Option<Specimen>, SceneParams);
 
-/// A pair of spheres touching at rest as a scene's specimen, with its contact law (the scene keys
-/// `law`, `region2`, `unloading`).
-pub(crate) fn pair_specimen(
-    pair: &SpherePair,
-    kind: LawKind,
-    region2: Region2Form,
-    unloading: Unloading,
-) -> Option<Specimen> {
-    Some(Specimen::Spheres(SphereSpecimen::pair(
-        pair,
-        LawSpec {
-            kind,
-            region2,
-            unloading,
-        },
-    )))
+/// A pair of spheres touching at rest as a scene's specimen, with its contact law.
+pub(crate) fn pair_specimen(pair: &SpherePair, law: LawSpec) -> Option<Specimen> {
+    Some(Specimen::Spheres(SphereSpecimen::pair(pair, law)))
 }
 
 /// A kind's parser: `(text, file, base_dir, fidelity, v)` → validated parameters. `text` is the

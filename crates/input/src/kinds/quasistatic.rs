@@ -67,10 +67,7 @@ fn parse(
         points: check_points(v, f.points)?,
         strain_rate_per_s: v.in_range("strain_rate_per_s", f.strain_rate_per_s, 0.0, 1e9, "1/s")?,
     };
-    Ok((
-        super::pair_specimen(&pair, f.law, f.region2, f.unloading),
-        p,
-    ))
+    Ok((super::pair_specimen(&pair, f.law_spec()), p))
 }
 
 #[cfg(test)]
