@@ -189,6 +189,12 @@ pub enum Command {
         /// over both).
         #[arg(long, value_enum)]
         fidelity: Option<FidelityArg>,
+        /// Set a scene key for this run: KEY=VALUE, as one value of `shpb sweep --set` (units
+        /// as in scenes; lengths of `_m` keys in mm/um/m), e.g. pressure=12.5psi. Repeatable;
+        /// `striker_velocity_m_s` replaces the scene's `pressure` and `pressure` its
+        /// `striker_velocity_m_s`. The run file stores the scene with the values set.
+        #[arg(long = "set")]
+        set: Vec<String>,
     },
     /// Run a scene on a ladder of resolutions: error of each level against the finest, run
     /// time, observed order of convergence and Richardson extrapolation.
@@ -577,6 +583,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             plot,
             force,
             fidelity,
+            set,
         } => cmd::run::run(
             &scene,
             output.as_deref(),
@@ -584,6 +591,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             plot.as_deref(),
             force,
             fidelity.map(Fidelity::from),
+            &set,
         ),
         Command::Bench {
             scene,

@@ -177,6 +177,27 @@ impl Params {
                         format_si(options.striker_velocity_m_s, "m/s"),
                     ));
                 }
+                // A striker velocity given in the scene (no gun, pressure NaN): the shaper's
+                // calibrated pressures as the striker velocities the set-up's gun gives at them.
+                if let Some((lo, hi)) = options.shaper.and_then(|s| s.calibrated_pressure_pa)
+                    && !driven
+                    && pressure_pa.is_nan()
+                    && let (Ok(v_lo), Ok(v_hi)) = (
+                        apparatus.striker_velocity_m_s(lo),
+                        apparatus.striker_velocity_m_s(hi),
+                    )
+                    && (options.striker_velocity_m_s < v_lo || options.striker_velocity_m_s > v_hi)
+                {
+                    w.push(format!(
+                        "striker velocity {} is outside {}, the striker velocities the gun of {} \
+                         gives at the pressures its pulse shaper was calibrated at \
+                         (validation/pulse/REPORT.md): the incident pulse is an extrapolation of \
+                         the shaper model",
+                        format_si(options.striker_velocity_m_s, "m/s"),
+                        crate::error::format_range(v_lo, v_hi, "m/s"),
+                        apparatus.source,
+                    ));
+                }
                 if let Some((lo, hi)) = options.shaper.and_then(|s| s.calibrated_pressure_pa)
                     && !driven
                     && (*pressure_pa < lo || *pressure_pa > hi)
@@ -493,16 +514,20 @@ fn run_pulse(
             "J",
         )]
     } else {
-        vec![
-            item("pressure", pressure_pa, "Pa"),
-            item("striker_velocity", options.striker_velocity_m_s, "m/s"),
-            item("striker_energy", r.striker_energy_j, "J"),
-            item(
-                "striker_final_velocity",
-                r.striker_final_velocity_m_s,
-                "m/s",
-            ),
-        ]
+        // A striker velocity given in the scene: no gun, no pressure (NaN) to print.
+        let pressure = (!pressure_pa.is_nan()).then(|| item("pressure", pressure_pa, "Pa"));
+        pressure
+            .into_iter()
+            .chain([
+                item("striker_velocity", options.striker_velocity_m_s, "m/s"),
+                item("striker_energy", r.striker_energy_j, "J"),
+                item(
+                    "striker_final_velocity",
+                    r.striker_final_velocity_m_s,
+                    "m/s",
+                ),
+            ])
+            .collect()
     };
     summary.push(item("time_step", chain.dt_s, "s"));
     // A seated specimen says how (§6.11): with a preload, `/contact` holds the whole force and

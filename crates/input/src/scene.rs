@@ -115,7 +115,24 @@ pub fn with_overrides(
 ) -> Result<String> {
     let v = Validator::new(file);
     let mut table: toml::Table = parse_as(text, file)?;
+    // The gun's pressure and the striker's velocity are alternatives: setting one replaces the
+    // other (a 10 psi scene with `striker_velocity_m_s` set runs at that velocity); both set is
+    // refused rather than one silently winning.
+    const EXCLUSIVE: [&str; 2] = ["pressure", "striker_velocity_m_s"];
+    if EXCLUSIVE
+        .iter()
+        .all(|k| overrides.iter().any(|(path, _)| path == k))
+    {
+        return Err(v.error(
+            "striker_velocity_m_s",
+            "set with pressure",
+            "one of pressure and striker_velocity_m_s (setting one replaces the other)",
+        ));
+    }
     for (path, value) in overrides {
+        if let Some(i) = EXCLUSIVE.iter().position(|k| k == path) {
+            table.remove(EXCLUSIVE[1 - i]);
+        }
         let parts: Vec<&str> = path.split('.').collect();
         let (last, tables) = parts.split_last().expect("split yields at least one part");
         let mut t = &mut table;

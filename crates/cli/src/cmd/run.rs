@@ -11,7 +11,8 @@ use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::writer::{Csv, Hdf5, Png, Writer};
 use std::path::{Path, PathBuf};
 
-/// `shpb run SCENE [-o OUT.h5] [--csv OUT.csv] [--plot OUT.png] [--force] [--fidelity F]`;
+/// `shpb run SCENE [-o OUT.h5] [--csv OUT.csv] [--plot OUT.png] [--force] [--fidelity F]
+/// [--set KEY=VALUE …]`;
 /// SCENE may be a run file (`.h5` written by `shpb run -o`): the test is run again from the
 /// scene and input files stored in its `/provenance`, not from the disk.
 pub fn run(
@@ -21,7 +22,9 @@ pub fn run(
     plot: Option<&Path>,
     force: bool,
     fidelity: Option<Fidelity>,
+    set: &[String],
 ) -> Result<()> {
+    let overrides = overrides(set)?;
     let outputs = [
         (output, "--output", &["h5", "hdf5"][..]),
         (csv, "--csv", &["csv"][..]),
@@ -33,7 +36,7 @@ pub fn run(
         }
     }
     let data_on_stdout = stdout_once(&[output, csv, plot])?;
-    let (params, provenance) = load(scene, fidelity)?;
+    let (params, provenance) = load(scene, fidelity, &overrides)?;
     // An output may never be one of the inputs (not even with --force).
     let mut inputs: Vec<PathBuf> = vec![scene.to_path_buf()];
     inputs.extend(
@@ -80,14 +83,36 @@ pub fn run(
 }
 
 /// Reads the scene (recording every input it reads), or a run file's stored scene and inputs.
-fn load(scene: &Path, fidelity: Option<Fidelity>) -> Result<(Params, Provenance)> {
+fn load(
+    scene: &Path,
+    fidelity: Option<Fidelity>,
+    overrides: &[(String, shpb_input::scene::Value)],
+) -> Result<(Params, Provenance)> {
     let command_line = std::env::args().collect::<Vec<_>>().join(" ");
     shpb_study::api::load_scene(
         shpb_study::api::Scene::File(scene),
         fidelity,
-        &[],
+        overrides,
         command_line,
     )
+}
+
+/// The `--set KEY=VALUE` overrides: each parsed as a `shpb sweep --set` of one value (aliases,
+/// units, a key once).
+fn overrides(set: &[String]) -> Result<Vec<(String, shpb_input::scene::Value)>> {
+    shpb_study::sweep::parse_axes(set)?
+        .into_iter()
+        .zip(set)
+        .map(|(axis, spec)| match <[_; 1]>::try_from(axis.values) {
+            Ok([value]) => Ok((axis.key, value)),
+            Err(values) => Err(shpb_input::Error::Input {
+                file: "command line".into(),
+                key: format!("--set {spec}"),
+                problem: format!("{} values", values.len()),
+                allowed: "one value, KEY=VALUE (shpb sweep runs several)".into(),
+            }),
+        })
+        .collect()
 }
 
 /// Prints the run summary; a closed pipe (`shpb run … | head`) is not an error.

@@ -23,6 +23,7 @@ pub(super) const KIND: SceneKind = SceneKind {
     keys: &[
         BARS,
         PRESSURE,
+        STRIKER_VELOCITY,
         SHAPER,
         CELL_SIZE,
         Key {
@@ -52,8 +53,16 @@ pub(super) const BARS: Key = Key {
 pub(super) const PRESSURE: Key = Key {
     key: "pressure",
     unit: "psi, Pa, kPa, MPa or bar",
-    default: "required (shpb: unless [incident_record])",
+    default: "required, unless striker_velocity_m_s (shpb: or [incident_record])",
     meaning: "gas-gun gauge pressure with its unit, e.g. \"10psi\" (within the set-up gun's range)",
+};
+
+/// `striker_velocity_m_s` (pulse and shpb).
+pub(super) const STRIKER_VELOCITY: Key = Key {
+    key: "striker_velocity_m_s",
+    unit: "m/s",
+    default: "none: the gun gives it from pressure",
+    meaning: "the striker's impact velocity, given instead of pressure (the set-up's gun is not used), greater than 0, at most 100 m/s",
 };
 
 /// `[shaper]` (pulse and shpb).
@@ -101,7 +110,7 @@ pub(super) const INCIDENT_RECORD: Key = Key {
     key: "incident_record",
     unit: "",
     default: "none: the gun, striker and shaper make the incident pulse",
-    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record (time_s, incident_V, transmission_V, read through the set-up's incident gauge channel) relative to the scene file; layout = a record layout .toml for another file format, as `shpb reduce --layout`; baseline_samples (default 900). Exclusive with pressure; bars: none or pochhammer-chree (which takes the recorded dispersion back)",
+    meaning: "a measured incident wave drives the incident bar instead (docs/physics.md §6.10): file = a gauge record (time_s, incident_V, transmission_V, read through the set-up's incident gauge channel) relative to the scene file; layout = a record layout .toml for another file format, as `shpb reduce --layout`; baseline_samples (default 900). Exclusive with pressure and striker_velocity_m_s; bars: none or pochhammer-chree (which takes the recorded dispersion back)",
 };
 
 /// `smooth_s` (shpb only).
@@ -128,6 +137,7 @@ struct PulseFile {
     unloading: Unloading,
     bars: String,
     pressure: Option<String>,
+    striker_velocity_m_s: Option<f64>,
     incident_record: Option<IncidentRecordFile>,
     shaper: Option<ShaperOverride>,
     cell_size_m: Option<f64>,
@@ -222,45 +232,54 @@ pub(super) fn parse_bars(
     }
     let apparatus = Apparatus::resolve(&f.bars, base_dir)?;
     // The incident wave: the gun at a pressure, or a measured record (docs/physics.md §6.10).
-    let (pressure_pa, velocity, drive) = match (&f.pressure, &f.incident_record) {
-        (Some(p), None) => {
-            let pressure_pa = crate::units::pressure_from_text(p, v, "pressure")?;
-            let velocity = apparatus
-                .striker_velocity_m_s(pressure_pa)
-                .map_err(v.core("pressure"))?;
-            (pressure_pa, velocity, None)
-        }
-        (None, Some(r)) if is_test => (
-            f64::NAN,
-            0.0,
-            Some(incident_drive(r, &apparatus, base_dir, v)?),
-        ),
-        (None, Some(_)) => {
-            return Err(v.error(
+    // Exactly one of pressure, striker_velocity_m_s and [incident_record].
+    let given: Vec<&str> = [
+        ("pressure", f.pressure.is_some()),
+        ("striker_velocity_m_s", f.striker_velocity_m_s.is_some()),
+        ("incident_record", f.incident_record.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(k, g)| g.then_some(k))
+    .collect();
+    let one_of = if is_test {
+        "exactly one of pressure (the gun fires the striker), striker_velocity_m_s (the striker's impact velocity) or [incident_record] (a measured incident wave drives the bar)"
+    } else {
+        "exactly one of pressure (the gun fires the striker) or striker_velocity_m_s (the striker's impact velocity)"
+    };
+    if given.len() > 1 {
+        return Err(v.error(given[1], format!("given with {}", given[0]), one_of));
+    }
+    let (pressure_pa, velocity, drive) =
+        match (&f.pressure, f.striker_velocity_m_s, &f.incident_record) {
+            (Some(p), _, _) => {
+                let pressure_pa = crate::units::pressure_from_text(p, v, "pressure")?;
+                let velocity = apparatus
+                    .striker_velocity_m_s(pressure_pa)
+                    .map_err(v.core("pressure"))?;
+                (pressure_pa, velocity, None)
+            }
+            // No gun: no pressure (NaN, as a record-driven run has none).
+            (None, Some(speed), _) => (
+                f64::NAN,
+                v.positive("striker_velocity_m_s", speed, 100.0, "m/s")?,
+                None,
+            ),
+            (None, None, Some(r)) if is_test => (
+                f64::NAN,
+                0.0,
+                Some(incident_drive(r, &apparatus, base_dir, v)?),
+            ),
+            (None, None, Some(_)) => {
+                return Err(v.error(
                 "incident_record",
                 "given in a pulse scene, whose incident pulse is the gun's",
-                "[incident_record] only in shpb scenes (or pressure here)",
+                "[incident_record] only in shpb scenes (or pressure or striker_velocity_m_s here)",
             ));
-        }
-        (Some(_), Some(_)) => {
-            return Err(v.error(
-                "incident_record",
-                "given with pressure",
-                "either pressure (the gun fires the striker) or [incident_record] (a measured incident wave drives the bar)",
-            ));
-        }
-        (None, None) => {
-            return Err(v.error(
-                "pressure",
-                "missing",
-                if is_test {
-                    "a gas-gun gauge pressure with its unit, e.g. \"10psi\", or an [incident_record]"
-                } else {
-                    "a gas-gun gauge pressure with its unit, e.g. \"10psi\""
-                },
-            ));
-        }
-    };
+            }
+            (None, None, None) => {
+                return Err(v.error("pressure", "missing (and no striker_velocity_m_s)", one_of));
+            }
+        };
     let face_modulus_pa =
         apparatus.material.youngs_modulus_pa / (1.0 - apparatus.material.poisson_ratio.powi(2));
     if drive.is_some() && f.shaper.is_some() {

@@ -3,7 +3,7 @@
 
 use super::pulse::{
     self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, INCIDENT_RECORD, PRESSURE, SHAPER,
-    SMOOTH,
+    SMOOTH, STRIKER_VELOCITY,
 };
 use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
@@ -21,6 +21,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         UNLOADING,
         BARS,
         PRESSURE,
+        STRIKER_VELOCITY,
         INCIDENT_RECORD,
         SHAPER,
         CELL_SIZE,
