@@ -158,3 +158,46 @@ pub fn with_overrides(
         message: e.to_string(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::with_overrides;
+    use toml::Value;
+
+    #[test]
+    fn pressure_and_striker_velocity_replace_each_other() {
+        let text = "kind = \"pulse\"\nbars = \"authors\"\npressure = \"10psi\"\n";
+        let set = |k: &str, v: Value| with_overrides(text, "a.toml", &[(k.to_string(), v)]);
+        let t: toml::Table =
+            toml::from_str(&set("striker_velocity_m_s", Value::Float(6.0)).unwrap()).unwrap();
+        assert!(!t.contains_key("pressure"));
+        assert_eq!(t["striker_velocity_m_s"], Value::Float(6.0));
+        let back = with_overrides(
+            &toml::to_string(&t).unwrap(),
+            "a.toml",
+            &[("pressure".into(), Value::String("12psi".into()))],
+        )
+        .unwrap();
+        let t: toml::Table = toml::from_str(&back).unwrap();
+        assert!(!t.contains_key("striker_velocity_m_s"));
+        // Both at once: refused, naming both keys.
+        let both = with_overrides(
+            text,
+            "a.toml",
+            &[
+                ("pressure".into(), Value::String("12psi".into())),
+                ("striker_velocity_m_s".into(), Value::Float(6.0)),
+            ],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            both.contains("striker_velocity_m_s") && both.contains("pressure"),
+            "{both}"
+        );
+        // A key in a table of that name is not the top-level one.
+        let t: toml::Table =
+            toml::from_str(&set("shaper.thickness_m", Value::Float(1e-3)).unwrap()).unwrap();
+        assert!(t.contains_key("pressure"));
+    }
+}

@@ -583,7 +583,8 @@ mod tests {
             ],
         );
         check_bar_key_docs();
-        assert_eq!(KIND.keys[4].default, default_incident_end());
+        let incident_end = KIND.keys.iter().find(|k| k.key == "incident_end").unwrap();
+        assert_eq!(incident_end.default, default_incident_end());
     }
 
     #[test]
