@@ -105,22 +105,6 @@ impl Interior for Leapfrog {
         add_lumped_forces(self.inv_ends(), &mut c.w, f);
     }
 
-    fn advance(&mut self, c: &mut Nodes) {
-        advance_nodes(c);
-    }
-
-    fn displacement(&self, c: &Nodes, i: usize) -> f64 {
-        c.u[i]
-    }
-
-    fn stretch(&self, c: &Nodes, e: usize) -> f64 {
-        c.u[e + 1] - c.u[e]
-    }
-
-    fn half_step_velocity(&self, c: &Nodes, i: usize) -> f64 {
-        c.v[i]
-    }
-
     fn kinetic_energy(&self, c: &Nodes) -> f64 {
         // Σ m v² is never −0, so adding no lateral term changes nothing.
         0.5 * lumped_kinetic(c)

@@ -3,7 +3,7 @@
 //! (Thomas algorithm) and solved each step in O(N); the field is the leapfrog's on every node
 //! ([`super::leapfrog`]).
 
-use super::leapfrog::{advance_nodes, lumped_kinetic, node_strain_energy, tensions};
+use super::leapfrog::{lumped_kinetic, node_strain_energy, tensions};
 use super::{Interior, Nodes};
 use crate::numeric::Tridiagonal;
 
@@ -92,22 +92,6 @@ impl Interior for LoveRod {
                 }
             }
         }
-    }
-
-    fn advance(&mut self, c: &mut Nodes) {
-        advance_nodes(c);
-    }
-
-    fn displacement(&self, c: &Nodes, i: usize) -> f64 {
-        c.u[i]
-    }
-
-    fn stretch(&self, c: &Nodes, e: usize) -> f64 {
-        c.u[e + 1] - c.u[e]
-    }
-
-    fn half_step_velocity(&self, c: &Nodes, i: usize) -> f64 {
-        c.v[i]
     }
 
     fn kinetic_energy(&self, c: &Nodes) -> f64 {

@@ -274,14 +274,21 @@ trait Interior {
     /// Adds the response to the end forces `f` to the free rate w.
     fn add_end_forces(&self, c: &mut Nodes, f: [f64; 2]);
 
-    /// One step of the field: v^{n+1/2} = v^{n−1/2} + Δt w, u^{n+1} = u^n + Δt v^{n+1/2}.
-    fn advance(&mut self, c: &mut Nodes);
+    /// One step of the field: v^{n+1/2} = v^{n−1/2} + Δt w, u^{n+1} = u^n + Δt v^{n+1/2}
+    /// (default: the leapfrog on every node).
+    fn advance(&mut self, c: &mut Nodes) {
+        leapfrog::advance_nodes(c);
+    }
 
-    /// Displacement u_i^n, m.
-    fn displacement(&self, c: &Nodes, i: usize) -> f64;
+    /// Displacement u_i^n, m (default: the node's own, when every node is stepped).
+    fn displacement(&self, c: &Nodes, i: usize) -> f64 {
+        c.u[i]
+    }
 
     /// Stretch u_{e+1}^n − u_e^n of element e, m.
-    fn stretch(&self, c: &Nodes, e: usize) -> f64;
+    fn stretch(&self, c: &Nodes, e: usize) -> f64 {
+        c.u[e + 1] - c.u[e]
+    }
 
     /// u(b) − u(a) with u linear between nodes, the points given as (node, weight of the next), m.
     fn stretch_between(&self, c: &Nodes, a: (usize, f64), b: (usize, f64)) -> f64 {
@@ -292,7 +299,9 @@ trait Interior {
     }
 
     /// Leapfrog velocity v_i^{n−1/2}, m/s.
-    fn half_step_velocity(&self, c: &Nodes, i: usize) -> f64;
+    fn half_step_velocity(&self, c: &Nodes, i: usize) -> f64 {
+        c.v[i]
+    }
 
     /// Velocity at level n, (v^{n−1/2} + v^{n+1/2})/2 with v^{n+1/2} predicted from the current
     /// internal forces and the end forces of the previous step, m/s.
