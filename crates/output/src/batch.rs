@@ -21,6 +21,8 @@ pub struct BatchRecord<'a> {
     pub bars: Option<(BarProperties, BarProperties)>,
     /// The record's figure, as the report links it (relative to the report).
     pub figure: Option<String>,
+    /// A cylinder's 1/2/3-wave reduction, when the record was reduced for a cylinder.
+    pub cylinder: Option<&'a CylinderReduction>,
 }
 
 /// Metrics of the incident, reflected and transmitted waves at the faces of a reduction.
@@ -76,7 +78,7 @@ fn num(v: Option<f64>) -> String {
 }
 
 /// Column names of the batch summary (SI units in the names).
-pub const SUMMARY_COLUMNS: [&str; 35] = [
+pub const SUMMARY_COLUMNS: [&str; 40] = [
     "record",
     "status",
     "alignment",
@@ -112,7 +114,35 @@ pub const SUMMARY_COLUMNS: [&str; 35] = [
     "warnings",
     "balance_incident_path_m",
     "balance_transmission_path_m",
+    "peak_stress_one_wave_Pa",
+    "peak_stress_two_wave_Pa",
+    "peak_stress_three_wave_Pa",
+    "strain_at_peak_stress_three_wave",
+    "mean_strain_rate_per_s",
 ];
+
+/// A cylinder record's summary values (docs/physics.md §7.8, engineering, compression positive):
+/// the 1-, 2- and 3-wave peak stresses, the 3-wave strain at its peak stress and the 1-wave mean
+/// strain rate over the loading ([`CylinderReduction::mean_strain_rate_per_s`]); None for spheres.
+fn cylinder_columns(c: Option<&CylinderReduction>) -> [Option<f64>; 5] {
+    let Some(c) = c else {
+        return [None; 5];
+    };
+    let peak = |a: &shpb_core::reduce_cylinder::WaveAnalysis| {
+        a.stress_pa
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let k = shpb_core::numeric::argmax(&c.three_wave.stress_pa);
+    [
+        Some(peak(&c.one_wave)),
+        Some(peak(&c.two_wave)),
+        Some(peak(&c.three_wave)),
+        c.three_wave.strain.get(k).copied(),
+        Some(c.mean_strain_rate_per_s),
+    ]
+}
 
 /// The summary CSV text: a header of [`SUMMARY_COLUMNS`], then one row per record.
 pub fn summary_csv(records: &[BatchRecord]) -> String {
@@ -163,6 +193,7 @@ pub fn summary_csv(records: &[BatchRecord]) -> String {
                 row.push(csv_field(&r.warnings.join("; ")));
                 row.push(num(a.balance_paths_m.map(|p| p.0)));
                 row.push(num(a.balance_paths_m.map(|p| p.1)));
+                row.extend(cylinder_columns(b.cylinder).map(num));
             }
         }
         text.push_str(&row.join(","));
@@ -481,6 +512,7 @@ mod tests {
             reduction: Err("no incident pulse".into()),
             bars: None,
             figure: None,
+            cylinder: None,
         }];
         let text = summary_csv(&rows);
         let line = text.lines().nth(1).unwrap();

@@ -192,6 +192,7 @@ pub fn reduce_command(
                 Err(_) => None,
             },
             figure,
+            cylinder: result.as_ref().ok().and_then(|r| r.cylinder.as_ref()),
         });
     }
     if let Some(s) = o.summary {
