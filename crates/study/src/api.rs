@@ -7,8 +7,7 @@ use shpb_core::apparatus::Apparatus;
 use shpb_core::contact::LawKind;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::reduce::{
-    PAPER_SPHERE_RADII_M, ReducedSpecimen, Reduction, ReductionInput, ReductionOptions,
-    ReductionSetup,
+    ReducedSpecimen, Reduction, ReductionInput, ReductionOptions, ReductionSetup,
 };
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
@@ -484,8 +483,8 @@ pub fn reduce_record_with(
     }
     let run = if hdf5_input { run_setup(record)? } else { None };
     let own_set_up = run.is_some();
-    let (apparatus, radii, run_cylinder) = match run {
-        Some((run_apparatus, radii, run_cylinder)) => {
+    let (apparatus, run_specimen) = match run {
+        Some((run_apparatus, run_specimen)) => {
             if let Some(flag) = bars_flag {
                 let given = load_apparatus(flag)?;
                 if ReductionSetup::from_apparatus(&given)?
@@ -505,17 +504,17 @@ pub fn reduce_record_with(
                     ));
                 }
             }
-            (run_apparatus, radii, run_cylinder)
+            (run_apparatus, run_specimen)
         }
-        None => (load_apparatus(bars)?, PAPER_SPHERE_RADII_M, None),
+        None => (load_apparatus(bars)?, ReducedSpecimen::default()),
     };
     // The specimen: a specimen file's, the cylinder flags', else the run file's own (a cylinder
     // or its spheres), else the paper's spheres. A cylinder's rate is its own (its 1/2/3-wave
     // analysis); the spheres' is δ̇/Σrᵢ.
-    let specimen = match (&choices.specimen, choices.cylinder, run_cylinder) {
-        (Some(file), _, _) => file.specimen,
-        (None, Some(g), _) | (None, None, Some(g)) => ReducedSpecimen::Cylinder(g),
-        (None, None, None) => ReducedSpecimen::Spheres { radii_m: radii },
+    let specimen = match (&choices.specimen, choices.cylinder) {
+        (Some(file), _) => file.specimen,
+        (None, Some(g)) => ReducedSpecimen::Cylinder(g),
+        (None, None) => run_specimen,
     };
     options.specimen_radii_m = specimen.radii_m();
     let reduction = if hdf5_input {
@@ -584,19 +583,10 @@ pub fn reduce_record_with(
     })
 }
 
-/// The set-up, sphere radii and cylinder (if any) a run file was simulated with, from the scene
-/// and inputs stored in its `/provenance` (None for a file without a stored bar scene, e.g.
-/// `shpb strain`'s).
-#[allow(clippy::type_complexity)]
-fn run_setup(
-    record: &Path,
-) -> Result<
-    Option<(
-        Apparatus,
-        (f64, f64),
-        Option<shpb_core::reduce_cylinder::CylinderGeometry>,
-    )>,
-> {
+/// The set-up and specimen a run file was simulated with (its spheres' radii or its cylinder;
+/// the paper's spheres for a pulse run), from the scene and inputs stored in its `/provenance`
+/// (None for a file without a stored bar scene, e.g. `shpb strain`'s).
+fn run_setup(record: &Path) -> Result<Option<(Apparatus, ReducedSpecimen)>> {
     let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
         return Ok(None);
     };
@@ -606,20 +596,14 @@ fn run_setup(
     // The run's own scene, inputs and fidelity, as `shpb run RUN.h5` reruns it.
     let (params, _) = load_scene(Scene::File(record), None, &[], String::new())?;
     Ok(match params.params {
-        SceneParams::Pulse { apparatus, .. } => {
-            // A chain specimen's strain rate is δ̇/Σ rᵢ, as the run's own reduction took it.
-            let specimen = params.specimen.as_ref();
-            let radii = specimen
-                .and_then(shpb_core::specimen::Specimen::spheres)
-                .map_or(PAPER_SPHERE_RADII_M, |sp| sp.strain_rate_radii_m());
-            let cylinder = specimen
-                .and_then(shpb_core::specimen::Specimen::cylinder)
-                .map(|c| shpb_core::reduce_cylinder::CylinderGeometry {
-                    length_m: c.length_m,
-                    diameter_m: c.diameter_m,
-                });
-            Some((*apparatus, radii, cylinder))
-        }
+        // A chain specimen's strain rate is δ̇/Σ rᵢ, as the run's own reduction took it.
+        SceneParams::Pulse { apparatus, .. } => Some((
+            *apparatus,
+            params
+                .specimen
+                .as_ref()
+                .map_or_else(ReducedSpecimen::default, ReducedSpecimen::of),
+        )),
         _ => None,
     })
 }
