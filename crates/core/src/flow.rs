@@ -110,18 +110,30 @@ impl JohnsonCook {
         Ok(())
     }
 
-    /// σ_f(ε̄p, ε̇p, T), Pa (Johnson & Cook 1983, Eq. 1).
+    /// The law without its thermal term: the isothermal Johnson–Cook law the pulse shaper's
+    /// crushed disc flows by ([`crate::shaper::JohnsonCook`]).
+    pub fn isothermal(&self) -> crate::shaper::JohnsonCook {
+        crate::shaper::JohnsonCook {
+            a_pa: self.a_pa,
+            b_pa: self.b_pa,
+            n: self.n,
+            c: self.c,
+            reference_rate_per_s: self.reference_rate_per_s,
+        }
+    }
+
+    /// σ_f(ε̄p, ε̇p, T), Pa (Johnson & Cook 1983, Eq. 1): the isothermal law times the thermal
+    /// factor.
     pub fn flow_stress_pa(
         &self,
         plastic_strain: f64,
         plastic_rate_per_s: f64,
         temperature_k: f64,
     ) -> f64 {
-        let hardening = self.a_pa + self.b_pa * plastic_strain.max(0.0).powf(self.n);
-        let ratio = (plastic_rate_per_s / self.reference_rate_per_s).max(1.0);
-        let rate = 1.0 + self.c * ratio.ln();
         let thermal = self.thermal.map_or(1.0, |t| t.factor(temperature_k));
-        hardening * rate * thermal
+        self.isothermal()
+            .flow_stress_pa(plastic_strain, plastic_rate_per_s)
+            * thermal
     }
 }
 
