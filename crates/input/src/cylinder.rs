@@ -5,13 +5,10 @@
 //! `design_true_strain`.
 
 use crate::error::{Result, Validator};
-use crate::material::{
-    DEFAULT_TAYLOR_QUINNEY, MaterialFile, johnson_cook_from_value, material_johnson_cook_table,
-};
+use crate::material::{DEFAULT_TAYLOR_QUINNEY, johnson_cook_from_value, resolve_with_johnson_cook};
 use crate::specimen::{CYLINDER_FORM, SpecimenSpec};
 use shpb_core::bar::BarMaterial;
 use shpb_core::flow::{FlowModel, FlowTable, Friction, FrictionModel};
-use shpb_core::material::Material;
 use shpb_core::specimen::{CylinderSpecimen, DEFAULT_DESIGN_TRUE_STRAIN};
 use std::path::Path;
 
@@ -53,16 +50,13 @@ pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<Cyli
     };
     let (elastic, material_jc) = match material {
         toml::Value::String(name) => {
-            let m = Material::resolve(name, base_dir, v, "material")?;
+            let (m, jc) = resolve_with_johnson_cook(name, base_dir, v, "material")?;
             let elastic = BarMaterial {
                 density_kg_m3: m.density_kg_m3,
                 youngs_modulus_pa: m.youngs_modulus_pa,
                 poisson_ratio: m.poisson_ratio,
             };
-            (
-                elastic,
-                material_johnson_cook_table(name, base_dir, v, "material")?,
-            )
+            (elastic, jc)
         }
         table @ toml::Value::Table(_) => (crate::setup::bar_material_value(table, v)?, None),
         other => {

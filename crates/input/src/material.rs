@@ -23,7 +23,6 @@ struct MaterialToml {
     #[serde(default = "default_reference_rate")]
     jc_reference_rate_per_s: f64,
     /// The flow stress of a cylinder of this material (docs/physics.md §6.12); spheres ignore it.
-    #[allow(dead_code)]
     johnson_cook: Option<toml::Value>,
 }
 
@@ -109,24 +108,6 @@ pub fn johnson_cook_from_value(
     .map_err(tv.core_named())
 }
 
-/// The `[johnson_cook]` table of a material reference (a built-in name or a `.toml` file, as
-/// [`MaterialFile::resolve`] reads it), if it has one.
-pub fn material_johnson_cook_table(
-    reference: &str,
-    base_dir: &Path,
-    v: &Validator,
-    key: &str,
-) -> Result<Option<toml::Value>> {
-    let Some((text, file)) = material_source(reference, base_dir, v, key)? else {
-        return Ok(None);
-    };
-    let raw: MaterialToml = toml::from_str(&text).map_err(|e| Error::Parse {
-        file,
-        message: e.to_string(),
-    })?;
-    Ok(raw.johnson_cook)
-}
-
 fn default_reference_rate() -> f64 {
     1e-3
 }
@@ -168,33 +149,7 @@ pub trait MaterialFile: Sized {
 impl MaterialFile for Material {
     /// Parses and validates a material from TOML text; `file` names the source in errors.
     fn from_toml(text: &str, file: &str) -> Result<Material> {
-        let raw: MaterialToml = toml::from_str(text).map_err(|e| Error::Parse {
-            file: file.to_string(),
-            message: e.to_string(),
-        })?;
-        let v = Validator::new(file);
-        let m = Material {
-            name: raw.name,
-            density_kg_m3: v.positive("density_kg_m3", raw.density_kg_m3, 1e5, "kg/m³")?,
-            youngs_modulus_pa: v.positive(
-                "youngs_modulus_pa",
-                raw.youngs_modulus_pa,
-                1e13,
-                "Pa",
-            )?,
-            poisson_ratio: v.in_range("poisson_ratio", raw.poisson_ratio, -0.99, 0.4999, "")?,
-            yield_stress_pa: v.positive("yield_stress_pa", raw.yield_stress_pa, 1e20, "Pa")?,
-            rate: JohnsonCook {
-                c: v.in_range("jc_c", raw.jc_c, 0.0, 1.0, "")?,
-                reference_rate_per_s: v.positive(
-                    "jc_reference_rate_per_s",
-                    raw.jc_reference_rate_per_s,
-                    1e9,
-                    "1/s",
-                )?,
-            },
-        };
-        Ok(m)
+        parse(text, file).map(|(m, _)| m)
     }
 
     /// A built-in material by name (`ss440c`, `ss302`, `al2017`).
@@ -211,14 +166,52 @@ impl MaterialFile for Material {
 
     /// Resolves a material reference: a path to a `.toml` file (relative to `base_dir`) or a built-in name.
     fn resolve(reference: &str, base_dir: &Path, v: &Validator, key: &str) -> Result<Material> {
-        match material_source(reference, base_dir, v, key)? {
-            Some((text, file)) => Material::from_toml(&text, &file),
-            None => Err(v.error(
-                key,
-                format!("unknown material `{reference}`"),
-                format!("{} or a path to a material .toml file", builtin_names()),
-            )),
-        }
+        resolve_with_johnson_cook(reference, base_dir, v, key).map(|(m, _)| m)
+    }
+}
+
+/// Parses and validates a material file's text (`file` names it in errors): the material and
+/// its `[johnson_cook]` table, if any (a cylinder's flow, docs/physics.md §6.12).
+fn parse(text: &str, file: &str) -> Result<(Material, Option<toml::Value>)> {
+    let raw: MaterialToml = toml::from_str(text).map_err(|e| Error::Parse {
+        file: file.to_string(),
+        message: e.to_string(),
+    })?;
+    let v = Validator::new(file);
+    let m = Material {
+        name: raw.name,
+        density_kg_m3: v.positive("density_kg_m3", raw.density_kg_m3, 1e5, "kg/m³")?,
+        youngs_modulus_pa: v.positive("youngs_modulus_pa", raw.youngs_modulus_pa, 1e13, "Pa")?,
+        poisson_ratio: v.in_range("poisson_ratio", raw.poisson_ratio, -0.99, 0.4999, "")?,
+        yield_stress_pa: v.positive("yield_stress_pa", raw.yield_stress_pa, 1e20, "Pa")?,
+        rate: JohnsonCook {
+            c: v.in_range("jc_c", raw.jc_c, 0.0, 1.0, "")?,
+            reference_rate_per_s: v.positive(
+                "jc_reference_rate_per_s",
+                raw.jc_reference_rate_per_s,
+                1e9,
+                "1/s",
+            )?,
+        },
+    };
+    Ok((m, raw.johnson_cook))
+}
+
+/// A material reference (as [`MaterialFile::resolve`] reads it) with its `[johnson_cook]` table,
+/// if it has one: the file is read and parsed once.
+pub fn resolve_with_johnson_cook(
+    reference: &str,
+    base_dir: &Path,
+    v: &Validator,
+    key: &str,
+) -> Result<(Material, Option<toml::Value>)> {
+    match material_source(reference, base_dir, v, key)? {
+        Some((text, file)) => parse(&text, &file),
+        None => Err(v.error(
+            key,
+            format!("unknown material `{reference}`"),
+            format!("{} or a path to a material .toml file", builtin_names()),
+        )),
     }
 }
 
