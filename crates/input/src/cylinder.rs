@@ -71,12 +71,13 @@ pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<Cyli
         Some(b) => v.in_range("taylor_quinney", b, 0.0, 1.0, "")?,
         None => DEFAULT_TAYLOR_QUINNEY,
     };
-    // The scene's own constants win over the material file's.
+    // The scene's own constants win over the material file's; each table's errors name where
+    // it stands (`specimen.johnson_cook` or `specimen.material.johnson_cook`).
     let jc_table = spec
         .johnson_cook
         .as_ref()
-        .map(|t| (t, "johnson_cook"))
-        .or(material_jc.as_ref().map(|t| (t, "material")));
+        .map(|t| (t, v.clone()))
+        .or(material_jc.as_ref().map(|t| (t, v.table("material"))));
     let model = match spec.model.as_deref() {
         Some(m) => m,
         None if jc_table.is_some() => "johnson-cook",
@@ -86,21 +87,19 @@ pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<Cyli
     let flow = match model {
         "elastic" => FlowModel::Elastic,
         "johnson-cook" => {
-            let Some((table, key)) = jc_table else {
+            let Some((table, tv)) = jc_table else {
                 return Err(v.error(
                     "johnson_cook",
                     "model = \"johnson-cook\" needs constants: the material has no [johnson_cook] table",
                     "a [specimen.johnson_cook] table { a_pa, b_pa, n, c, reference_rate_per_s, m, melt_temperature_k, specific_heat_j_kg_k }, or a material with one (ofhc-copper, al6061-t6, al7075-t6, ti6al4v, steel4340)",
                 ));
             };
-            let mv;
-            let (tv, key) = if key == "material" {
-                mv = v.table("material");
-                (&mv, "johnson_cook")
-            } else {
-                (v, key)
-            };
-            FlowModel::JohnsonCook(johnson_cook_from_value(table, taylor_quinney, tv, key)?)
+            FlowModel::JohnsonCook(johnson_cook_from_value(
+                table,
+                taylor_quinney,
+                &tv,
+                "johnson_cook",
+            )?)
         }
         "table" => {
             let Some(curve) = &spec.flow_curve else {
