@@ -605,7 +605,7 @@ fn gauge_file_errors_name_file_key_and_allowed_range() {
             "bad.toml",
             "channel[1].bridge",
             "half",
-            "\"quarter-axial\", \"half-poisson\", \"full-poisson\"",
+            "\"quarter-axial\", \"half-poisson\", \"half-axial\", \"full-poisson\"",
         ],
     );
     let msg = toml_error(&second("polarity = -1.0", "polarity = 0.5"));

@@ -1,6 +1,7 @@
 //! A lab's input deck in the LANL/HopPyBar form (`PMMA_13_Input.dat`): tab-separated lines
-//! `key<TAB>value<TAB>unit<TAB>note`, in UTF-8 or Windows-1252 (its `°C` is one byte), read into
-//! the bars, gauges and specimen a reduction needs ([`Deck`]). `shpb reduce --bars DECK`
+//! `key<TAB>value<TAB>unit<TAB>note`, in UTF-8 or Windows-1252 (PMMA-13's `ºC` and `µs` are the
+//! single bytes 0xBA and 0xB5), read into the bars, gauges and specimen a reduction needs
+//! ([`Deck`]). `shpb reduce --bars DECK`
 //! recognises it by its content ([`is_deck`]); every error names the deck's line and key.
 //!
 //! What the deck states and how it is used (HopPyBar.py, the mini-Kolsky branch, reads the same
