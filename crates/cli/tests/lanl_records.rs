@@ -199,3 +199,60 @@ fn lab_files_are_read_as_kept_and_mismatches_are_named() {
         "{err}"
     );
 }
+
+/// `shpb strain --bars DECK` reads volts through the deck's channels: a half bridge of two axial
+/// gauges behind the deck's gain 100 and 10 V excitation, GF 2.1, so −1.3 V recorded is
+/// ε = 2V_b/(GF (Vex − V_b)) with V_b = −13 mV (HopPyBar's 2V/(GF·gain·Vex) to 0.13 %).
+#[test]
+fn shpb_strain_reads_volts_through_the_decks_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec.csv");
+    std::fs::write(
+        &rec,
+        "time_s,incident_V,transmission_V\n0,-1.3,0.5\n1e-8,-1.3,0.5\n2e-8,-1.3,0.5\n",
+    )
+    .unwrap();
+    let bars = data().join("PMMA_13_Input.dat").display().to_string();
+    let args: Vec<String> = [
+        "strain",
+        "rec.csv",
+        "--bars",
+        &bars,
+        "--baseline-samples",
+        "0",
+        "--csv",
+        "out.csv",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let o = shpb(dir.path(), &args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = std::fs::read_to_string(dir.path().join("out.csv")).unwrap();
+    let mut lines = out.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let row: Vec<f64> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let col = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+    let exact = |v: f64| {
+        let vb = v / 100.0;
+        2.0 * vb / (2.1 * (10.0 - vb))
+    };
+    for (name, v) in [("incident_strain", -1.3), ("transmission_strain", 0.5)] {
+        let eps = col(name);
+        assert!(
+            (eps / exact(v) - 1.0).abs() < 1e-12,
+            "{name}: {eps} vs {}",
+            exact(v)
+        );
+        let hoppybar = 2.0 * v / (2.1 * 100.0 * 10.0);
+        assert!(
+            (eps / hoppybar - 1.0).abs() < 2e-3,
+            "{name}: {eps} vs {hoppybar}"
+        );
+    }
+}
