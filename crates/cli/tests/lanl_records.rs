@@ -124,6 +124,10 @@ fn pmma13_from_four_channel_files_and_the_deck_matches_hoppybar() {
         (geo_t - (102.02e-3 + 101.35e-3) / c0).abs() < 1e-10,
         "{geo_t}"
     );
+    // The bars' lengths (not in the deck) do not shorten the window: it is the incident–reflected
+    // separation 2 d_I/c0, to the 8 ns sample.
+    let duration = v["windows_s"]["duration"].as_f64().unwrap();
+    assert!((duration - geo_r).abs() <= 8e-9, "{duration} vs {geo_r}");
 }
 
 /// With dispersion correction on both sides (shpb's exact Pochhammer–Chree first mode, HopPyBar's
