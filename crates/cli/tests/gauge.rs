@@ -46,6 +46,7 @@ fn bridge(kind: BridgeKind) -> Bridge {
         gauge_factor: GF,
         excitation_v: VEX,
         poisson_ratio: NU,
+        strain_per_volt: 0.0,
     }
 }
 
@@ -90,6 +91,7 @@ fn arms(kind: BridgeKind, strain: f64) -> [f64; 4] {
         BridgeKind::QuarterAxial => [axial, 1.0, 1.0, 1.0],
         BridgeKind::HalfPoisson => [axial, poisson, 1.0, 1.0],
         BridgeKind::FullPoisson => [axial, poisson, axial, poisson],
+        BridgeKind::Linear => unreachable!("a linear channel has no bridge arms"),
     }
 }
 

@@ -91,12 +91,19 @@ struct InsertsToml {
 struct ApparatusToml {
     #[serde(default)]
     inserts: InsertsToml,
-    gauges: String,
+    /// A gauge file, or …
+    gauges: Option<String>,
+    /// … the channels inline (`[[channel]]` tables, as in a gauge file): exactly one of the two.
+    channel: Option<Vec<crate::gauges::ChannelSpec>>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    description: Option<String>,
     material: MaterialToml,
     incident: BarToml,
     transmission: BarToml,
     striker: BarToml,
-    gun: GunToml,
+    /// The gas gun; without it, scenes give the striker's velocity (`striker_velocity_m_s`).
+    gun: Option<GunToml>,
     shaper: Option<ShaperToml>,
 }
 
@@ -358,116 +365,126 @@ impl ApparatusFile for Apparatus {
             ));
         }
         let gv = v.table("gun");
-        let g = &raw.gun;
-        let (pmin, pmax) = (
-            gv.positive("min_pressure_pa", g.min_pressure_pa, 1e8, "Pa")?,
-            gv.positive("max_pressure_pa", g.max_pressure_pa, 1e8, "Pa")?,
-        );
-        if pmin >= pmax {
-            return Err(gv.error(
-                "min_pressure_pa",
-                "not below max_pressure_pa",
-                "min_pressure_pa < max_pressure_pa",
-            ));
-        }
-        let gun_calibrated_pa = match (g.calibrated_min_pressure_pa, g.calibrated_max_pressure_pa) {
-            (None, None) => None,
-            (Some(lo), Some(hi)) => {
-                let lo = gv.in_range("calibrated_min_pressure_pa", lo, pmin, pmax, "Pa")?;
-                let hi = gv.in_range("calibrated_max_pressure_pa", hi, lo, pmax, "Pa")?;
-                Some((lo, hi))
-            }
-            (lo, _) => {
-                let key = if lo.is_none() {
-                    "calibrated_min_pressure_pa"
-                } else {
-                    "calibrated_max_pressure_pa"
-                };
-                return Err(gv.error(
-                    key,
-                    "missing",
-                    "both calibrated_min_pressure_pa and calibrated_max_pressure_pa, or neither",
-                ));
-            }
-        };
-        let gun_velocity_scatter = g
-            .velocity_scatter
-            .map(|s| gv.in_range("velocity_scatter", s, 0.0, 0.5, "1"))
-            .transpose()?;
-        let need = |key: &str, x: Option<f64>| {
-            x.ok_or_else(|| {
-                gv.error(
-                    key,
-                    format!("missing for model = \"{}\"", g.model),
-                    "a positive number",
-                )
-            })
-        };
         let striker = bar_geometry(&raw.striker, &v.table("striker"))?;
-        let gun = match g.model.as_str() {
-            "linear" => Gun::Linear(LinearGun {
-                k_m2_per_s2_per_pa: gv.positive(
-                    "k_m2_per_s2_per_pa",
-                    need("k_m2_per_s2_per_pa", g.k_m2_per_s2_per_pa)?,
-                    1.0,
-                    "m²/s²/Pa",
-                )?,
-                loss_pressure_pa: gv.in_range(
-                    "loss_pressure_pa",
-                    need("loss_pressure_pa", g.loss_pressure_pa)?,
-                    0.0,
-                    pmin,
-                    "Pa (below min_pressure_pa)",
-                )?,
-                // The striker the line was measured with (same material and bore as [striker]);
-                // without the key, the set-up's own striker (docs/physics.md §6.4).
-                calibration_mass_kg: material.density_kg_m3
-                    * striker.area_m2()
-                    * match g.calibration_striker_length_m {
-                        Some(l) => gv.positive("calibration_striker_length_m", l, 100.0, "m")?,
-                        None => striker.length_m,
-                    },
-                min_pressure_pa: pmin,
-                max_pressure_pa: pmax,
-            }),
-            "adiabatic" if g.calibration_striker_length_m.is_some() => {
-                return Err(gv.error(
-                    "calibration_striker_length_m",
-                    "only a calibration line (model = \"linear\") has a calibration striker",
-                    "no calibration_striker_length_m with model = \"adiabatic\"",
-                ));
-            }
-            "adiabatic" => Gun::Adiabatic(GasGun {
-                reservoir_volume_m3: gv.positive(
-                    "reservoir_volume_m3",
-                    need("reservoir_volume_m3", g.reservoir_volume_m3)?,
-                    10.0,
-                    "m³",
-                )?,
-                barrel_length_m: gv.positive(
-                    "barrel_length_m",
-                    need("barrel_length_m", g.barrel_length_m)?,
-                    100.0,
-                    "m",
-                )?,
-                friction_n: gv.in_range(
-                    "friction_n",
-                    g.friction_n.unwrap_or(0.0),
-                    0.0,
-                    1e6,
-                    "N",
-                )?,
-                gamma: gv.in_range("gamma", g.gamma.unwrap_or(1.4), 1.01, 1.67, "")?,
-                atmospheric_pa: shpb_core::striker::ATMOSPHERE_PA,
-                min_pressure_pa: pmin,
-                max_pressure_pa: pmax,
-            }),
-            other => {
-                return Err(gv.error(
-                    "model",
-                    format!("unknown gun model `{other}`"),
-                    "linear, adiabatic",
-                ));
+        let (gun, gun_calibrated_pa, gun_velocity_scatter) = match &raw.gun {
+            None => (Gun::None, None, None),
+            Some(g) => {
+                let (pmin, pmax) = (
+                    gv.positive("min_pressure_pa", g.min_pressure_pa, 1e8, "Pa")?,
+                    gv.positive("max_pressure_pa", g.max_pressure_pa, 1e8, "Pa")?,
+                );
+                if pmin >= pmax {
+                    return Err(gv.error(
+                        "min_pressure_pa",
+                        "not below max_pressure_pa",
+                        "min_pressure_pa < max_pressure_pa",
+                    ));
+                }
+                let gun_calibrated_pa = match (
+                    g.calibrated_min_pressure_pa,
+                    g.calibrated_max_pressure_pa,
+                ) {
+                    (None, None) => None,
+                    (Some(lo), Some(hi)) => {
+                        let lo = gv.in_range("calibrated_min_pressure_pa", lo, pmin, pmax, "Pa")?;
+                        let hi = gv.in_range("calibrated_max_pressure_pa", hi, lo, pmax, "Pa")?;
+                        Some((lo, hi))
+                    }
+                    (lo, _) => {
+                        let key = if lo.is_none() {
+                            "calibrated_min_pressure_pa"
+                        } else {
+                            "calibrated_max_pressure_pa"
+                        };
+                        return Err(gv.error(
+                        key,
+                        "missing",
+                        "both calibrated_min_pressure_pa and calibrated_max_pressure_pa, or neither",
+                    ));
+                    }
+                };
+                let gun_velocity_scatter = g
+                    .velocity_scatter
+                    .map(|s| gv.in_range("velocity_scatter", s, 0.0, 0.5, "1"))
+                    .transpose()?;
+                let need = |key: &str, x: Option<f64>| {
+                    x.ok_or_else(|| {
+                        gv.error(
+                            key,
+                            format!("missing for model = \"{}\"", g.model),
+                            "a positive number",
+                        )
+                    })
+                };
+                let gun = match g.model.as_str() {
+                    "linear" => Gun::Linear(LinearGun {
+                        k_m2_per_s2_per_pa: gv.positive(
+                            "k_m2_per_s2_per_pa",
+                            need("k_m2_per_s2_per_pa", g.k_m2_per_s2_per_pa)?,
+                            1.0,
+                            "m²/s²/Pa",
+                        )?,
+                        loss_pressure_pa: gv.in_range(
+                            "loss_pressure_pa",
+                            need("loss_pressure_pa", g.loss_pressure_pa)?,
+                            0.0,
+                            pmin,
+                            "Pa (below min_pressure_pa)",
+                        )?,
+                        // The striker the line was measured with (same material and bore as [striker]);
+                        // without the key, the set-up's own striker (docs/physics.md §6.4).
+                        calibration_mass_kg: material.density_kg_m3
+                            * striker.area_m2()
+                            * match g.calibration_striker_length_m {
+                                Some(l) => {
+                                    gv.positive("calibration_striker_length_m", l, 100.0, "m")?
+                                }
+                                None => striker.length_m,
+                            },
+                        min_pressure_pa: pmin,
+                        max_pressure_pa: pmax,
+                    }),
+                    "adiabatic" if g.calibration_striker_length_m.is_some() => {
+                        return Err(gv.error(
+                        "calibration_striker_length_m",
+                        "only a calibration line (model = \"linear\") has a calibration striker",
+                        "no calibration_striker_length_m with model = \"adiabatic\"",
+                    ));
+                    }
+                    "adiabatic" => Gun::Adiabatic(GasGun {
+                        reservoir_volume_m3: gv.positive(
+                            "reservoir_volume_m3",
+                            need("reservoir_volume_m3", g.reservoir_volume_m3)?,
+                            10.0,
+                            "m³",
+                        )?,
+                        barrel_length_m: gv.positive(
+                            "barrel_length_m",
+                            need("barrel_length_m", g.barrel_length_m)?,
+                            100.0,
+                            "m",
+                        )?,
+                        friction_n: gv.in_range(
+                            "friction_n",
+                            g.friction_n.unwrap_or(0.0),
+                            0.0,
+                            1e6,
+                            "N",
+                        )?,
+                        gamma: gv.in_range("gamma", g.gamma.unwrap_or(1.4), 1.01, 1.67, "")?,
+                        atmospheric_pa: shpb_core::striker::ATMOSPHERE_PA,
+                        min_pressure_pa: pmin,
+                        max_pressure_pa: pmax,
+                    }),
+                    other => {
+                        return Err(gv.error(
+                            "model",
+                            format!("unknown gun model `{other}`"),
+                            "linear, adiabatic",
+                        ));
+                    }
+                };
+                (gun, gun_calibrated_pa, gun_velocity_scatter)
             }
         };
         let shaper = match &raw.shaper {
@@ -478,7 +495,24 @@ impl ApparatusFile for Apparatus {
             )?),
             None => None,
         };
-        let gauges = gauges(&raw.gauges)?;
+        let gauges = match (&raw.gauges, &raw.channel) {
+            (Some(g), None) => gauges(g)?,
+            (None, Some(channels)) => crate::gauges::gauge_setup(channels, &v)?,
+            (Some(_), Some(_)) => {
+                return Err(v.error(
+                    "gauges",
+                    "given with [[channel]] tables",
+                    "either gauges = \"FILE\" or the [[channel]] tables inline, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(v.error(
+                    "gauges",
+                    "missing",
+                    "gauges = \"FILE\" (a gauge file) or [[channel]] tables inline",
+                ));
+            }
+        };
         let incident = bar_geometry(&raw.incident, &v.table("incident"))?;
         let insert = |side: &str, t: &Option<InsertToml>| -> Result<Option<Insert>> {
             let Some(t) = t else { return Ok(None) };

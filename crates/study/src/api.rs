@@ -559,19 +559,17 @@ pub fn reduce_record_with(
             &options,
             &record.display().to_string(),
         )?
-    } else if let Some(layout) = &choices.layout {
-        let name = record.display().to_string();
-        let input = layout
-            .read(record)?
+    } else {
+        // Every text or spreadsheet record through the one reader (a layout, the authors' CSV,
+        // or columns named with their units).
+        let input = shpb_input::sheet::read_record(record, choices.layout.as_ref())?
             .into_strains(&apparatus, options.baseline_samples)?;
         shpb_core::reduce::reduce_named(
             &input,
             &ReductionSetup::from_apparatus(&apparatus)?,
             &options,
-            &name,
+            &record.display().to_string(),
         )?
-    } else {
-        shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
     };
     let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
     Ok(Reduced {
