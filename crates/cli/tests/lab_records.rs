@@ -322,3 +322,54 @@ fn a_header_without_units_is_refused_with_the_columns_and_the_layout() {
     assert!(e.contains("columns found: `Time`, `CH1`, `CH2`"), "{e}");
     assert!(e.contains("--layout FILE"), "{e}");
 }
+
+#[test]
+fn a_layout_names_the_sheet_and_the_encoding() {
+    use shpb::layout::{LayoutRecord, RecordLayout};
+    let strains = |r: LayoutRecord| match r {
+        LayoutRecord::Strains(s) => s,
+        LayoutRecord::Voltages(_) => panic!("strains expected"),
+    };
+    let columns = "skip_lines = 1\ntime_column = 1\n[incident]\ncolumn = 2\nunit = \"microstrain\"\n\
+                   [transmission]\ncolumn = 3\nunit = \"microstrain\"\n";
+    let xls = shot("steel_945", "sample_01").strain_record;
+    let auto = strains(shpb::sheet::read_record(&xls, None).unwrap());
+    let layout =
+        RecordLayout::from_toml(&format!("sheet = \"Sheet1\"\n{columns}"), "l.toml").unwrap();
+    assert_eq!(
+        strains(shpb::sheet::read_record(&xls, Some(&layout)).unwrap()),
+        auto
+    );
+    let layout =
+        RecordLayout::from_toml(&format!("sheet = \"Nope\"\n{columns}"), "l.toml").unwrap();
+    let e = shpb::sheet::read_record(&xls, Some(&layout))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`sheet`") && e.contains("Sheet1, Sheet2, Sheet3"),
+        "{e}"
+    );
+    // The GBK CSV through a layout naming its encoding, as without one.
+    let csv = shot("epoxy_resin", "sample_01").strain_record;
+    let auto = strains(shpb::sheet::read_record(&csv, None).unwrap());
+    let columns = columns.replace("microstrain", "strain");
+    let layout =
+        RecordLayout::from_toml(&format!("encoding = \"gbk\"\n{columns}"), "l.toml").unwrap();
+    assert_eq!(
+        strains(shpb::sheet::read_record(&csv, Some(&layout)).unwrap()),
+        auto
+    );
+    let layout =
+        RecordLayout::from_toml(&format!("encoding = \"utf-8\"\n{columns}"), "l.toml").unwrap();
+    let e = shpb::sheet::read_record(&csv, Some(&layout))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not valid UTF-8"), "{e}");
+    let e = RecordLayout::from_toml(&format!("encoding = \"latin9\"\n{columns}"), "l.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`encoding`") && e.contains("utf-8, gbk or gb18030"),
+        "{e}"
+    );
+}

@@ -6,7 +6,9 @@ use crate::error::{Error, Result, Validator};
 use serde::Deserialize;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup, RawRecord};
-use shpb_core::reduce::{Reduction, ReductionOptions, ReductionSetup, reduce_named};
+use shpb_core::reduce::{
+    Reduction, ReductionOptions, ReductionSetup, record_strains, reduce_named,
+};
 use std::path::Path;
 
 /// One `[[channel]]` table of a gauge file (or of a set-up file's inline channels), before
@@ -306,16 +308,16 @@ impl RawRecordFile for RawRecord {
     }
 }
 
-/// Reduces a gauge record (the authors' CSV `time_s,incident_V,transmission_V`, or any record
-/// [`crate::sheet::read_record`] reads without a layout) with the bars and gauge channels of
-/// `apparatus`.
+/// Reduces a raw gauge record in the authors' CSV format (`time_s,incident_V,transmission_V`)
+/// with the bars and gauge channels of `apparatus` (`shpb reduce` reads any record through
+/// `sheet::read_record`).
 pub fn reduce_record_file(
     record: &Path,
     apparatus: &Apparatus,
     options: &ReductionOptions,
 ) -> Result<Reduction> {
-    let input = crate::sheet::read_record(record, None)?
-        .into_strains(apparatus, options.baseline_samples)?;
+    let rec = RawRecord::read(record)?;
+    let input = record_strains(&rec, apparatus, options.baseline_samples)?;
     reduce_named(
         &input,
         &ReductionSetup::from_apparatus(apparatus)?,

@@ -102,6 +102,29 @@ pub enum TimeSource {
     },
 }
 
+/// The encoding of a text record (layout key `encoding`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextEncoding {
+    /// UTF-8 (a leading byte-order mark is dropped).
+    Utf8,
+    /// GB18030, the superset of GBK (what `gbk` names too).
+    Gb18030,
+}
+
+impl TextEncoding {
+    /// The names a layout may give, for messages.
+    pub const ALLOWED: &'static str = "utf-8, gbk or gb18030";
+
+    /// The encoding called `name` in a layout (`utf-8`, `utf8`, `gbk`, `gb18030`, any case).
+    pub fn from_name(name: &str) -> Option<TextEncoding> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "utf-8" | "utf8" => Some(TextEncoding::Utf8),
+            "gbk" | "gb18030" | "gb2312" | "cp936" => Some(TextEncoding::Gb18030),
+            _ => None,
+        }
+    }
+}
+
 /// A validated record layout (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordLayout {
@@ -121,8 +144,8 @@ pub struct RecordLayout {
     pub transmission: ChannelLayout,
     /// The sheet of a spreadsheet record (None: the first).
     pub sheet: Option<String>,
-    /// The encoding of a text record (None: UTF-8 if valid, else GB18030; [`crate::sheet`]).
-    pub encoding: Option<crate::sheet::TextEncoding>,
+    /// The encoding of a text record (None: UTF-8 if valid, else GB18030).
+    pub encoding: Option<TextEncoding>,
 }
 
 /// A record read through a layout: bridge voltages (to go through the set-up's bridges) or bar
@@ -329,16 +352,13 @@ impl RecordLayout {
                 "both channels bridge voltages (V, mV) or both bar strains (strain, microstrain)",
             ));
         }
-        let encoding = match raw.encoding.as_deref() {
-            None => None,
-            Some(name) => Some(crate::sheet::TextEncoding::from_name(name).ok_or_else(|| {
-                v.error(
-                    "encoding",
-                    format!("`{name}`"),
-                    crate::sheet::TextEncoding::ALLOWED,
-                )
-            })?),
-        };
+        let encoding =
+            match raw.encoding.as_deref() {
+                None => None,
+                Some(name) => Some(TextEncoding::from_name(name).ok_or_else(|| {
+                    v.error("encoding", format!("`{name}`"), TextEncoding::ALLOWED)
+                })?),
+            };
         Ok(RecordLayout {
             source: file.to_string(),
             delimiter,
@@ -488,12 +508,6 @@ impl RecordLayout {
                 transmission_strain: transmission,
             })
         })
-    }
-
-    /// Reads a record file through the layout: a text file ([`RecordLayout::parse`]) or a
-    /// spreadsheet ([`crate::sheet::read_record`]).
-    pub fn read(&self, path: &Path) -> Result<LayoutRecord> {
-        crate::sheet::read_record(path, Some(self))
     }
 }
 

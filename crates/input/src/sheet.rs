@@ -21,33 +21,11 @@
 //!   (`--layout FILE`, [`crate::layout`]).
 
 use crate::error::{Error, Result};
+pub use crate::layout::TextEncoding;
 use crate::layout::{
     ChannelLayout, ChannelUnit, Delimiter, LayoutRecord, RecordLayout, TimeSource,
 };
 use std::path::Path;
-
-/// The encoding of a text record (layout key `encoding`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TextEncoding {
-    /// UTF-8 (a leading byte-order mark is dropped).
-    Utf8,
-    /// GB18030, the superset of GBK (what `gbk` names too).
-    Gb18030,
-}
-
-impl TextEncoding {
-    /// The names a layout may give, for messages.
-    pub const ALLOWED: &'static str = "utf-8, gbk or gb18030";
-
-    /// The encoding called `name` in a layout (`utf-8`, `utf8`, `gbk`, `gb18030`, any case).
-    pub fn from_name(name: &str) -> Option<TextEncoding> {
-        match name.trim().to_ascii_lowercase().as_str() {
-            "utf-8" | "utf8" => Some(TextEncoding::Utf8),
-            "gbk" | "gb18030" | "gb2312" | "cp936" => Some(TextEncoding::Gb18030),
-            _ => None,
-        }
-    }
-}
 
 /// Whether `path` names a spreadsheet by its extension (xls, xlsx, xlsm, xlsb, ods).
 pub fn is_spreadsheet(path: &Path) -> bool {

@@ -486,7 +486,8 @@ fn incident_drive(
                     "a record layout .toml (README, *Record layouts*) relative to the scene file",
                 ));
             }
-            crate::layout::RecordLayout::from_file(&layout_path)?.read(&path)?
+            let layout = crate::layout::RecordLayout::from_file(&layout_path)?;
+            crate::sheet::read_record(&path, Some(&layout))?
         }
     };
     let samples = record.samples();
