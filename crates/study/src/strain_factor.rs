@@ -130,7 +130,7 @@ mod tests {
     fn the_slope_its_error_and_the_residual_of_a_known_line() {
         // ε = 4.96e-4·V − 2e-6 plus alternating ±1e-7 noise, over a ramp of volts.
         let volts: Vec<f64> = (0..2001).map(|i| -1.0 + i as f64 * 1e-3).collect();
-        let noise = |i: usize| if i % 2 == 0 { 1e-7 } else { -1e-7 };
+        let noise = |i: usize| if i.is_multiple_of(2) { 1e-7 } else { -1e-7 };
         let strains: Vec<f64> = volts
             .iter()
             .enumerate()
