@@ -681,6 +681,95 @@ impl ShaperOverride {
 mod tests {
     use super::*;
 
+    /// The authors' set-up with its gauge file's channels written inline instead.
+    fn inline_channels() -> String {
+        let text = crate::builtin::setup("authors").unwrap();
+        let channels = crate::builtin::gauges("gauges-authors.toml")
+            .unwrap()
+            .replace("description = ", "# description = ");
+        format!(
+            "{}\n{channels}",
+            text.replace("gauges = \"gauges-authors.toml\"", "")
+        )
+    }
+
+    #[test]
+    fn inline_channels_read_as_the_gauge_file_and_exactly_one_of_the_two() {
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let from_file =
+            Apparatus::from_toml(crate::builtin::setup("authors").unwrap(), "a.toml", &gauges)
+                .unwrap();
+        let inline = Apparatus::from_toml(&inline_channels(), "a.toml", &gauges).unwrap();
+        assert_eq!(inline.gauges, from_file.gauges);
+        let both = format!("gauges = \"gauges-authors.toml\"\n{}", inline_channels());
+        let e = Apparatus::from_toml(&both, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`gauges`") && e.contains("not both"), "{e}");
+        let neither = crate::builtin::setup("authors")
+            .unwrap()
+            .replace("gauges = \"gauges-authors.toml\"", "");
+        let e = Apparatus::from_toml(&neither, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`gauges`: missing"), "{e}");
+    }
+
+    #[test]
+    fn a_linear_channel_takes_its_factor_and_only_that() {
+        let gauges = |_: &str| -> Result<GaugeSetup> { unreachable!() };
+        // Both channels' bridge keys replaced by `keys` (the rest of the line commented out).
+        let linear = |keys: &str| {
+            let bridge = "bridge = \"full-poisson\"\ngauge_factor = 2.12\nexcitation_v = 15.0\n\
+                          poisson_ratio = 0.31";
+            let text = inline_channels();
+            assert_eq!(text.matches(bridge).count(), 2);
+            text.replace(bridge, &format!("bridge = \"linear\"\n{keys}#"))
+        };
+        let a = Apparatus::from_toml(&linear("strain_per_volt = 4.96e-4\n"), "a.toml", &gauges)
+            .unwrap();
+        let c = a.gauges.channel("incident").unwrap();
+        assert_eq!(c.bridge.kind, shpb_core::gauge::BridgeKind::Linear);
+        assert_eq!(c.bridge.strain_per_volt, 4.96e-4);
+        let err = |keys: &str| {
+            Apparatus::from_toml(&linear(keys), "a.toml", &gauges)
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err("strain_per_volt = 4.96e-4\npoisson_ratio = 0.31\n");
+        assert!(
+            e.contains("`channel[0].poisson_ratio`") && e.contains("linear"),
+            "{e}"
+        );
+        let e = err("");
+        assert!(e.contains("`channel[0].strain_per_volt`: missing"), "{e}");
+        let e = err("strain_per_volt = 0.0\n");
+        assert!(e.contains("non-zero"), "{e}");
+        let wheatstone = inline_channels().replace(
+            "excitation_v = 15.0\n",
+            "excitation_v = 15.0\nstrain_per_volt = 1e-3\n",
+        );
+        let e = Apparatus::from_toml(&wheatstone, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("only with bridge = \"linear\""), "{e}");
+    }
+
+    #[test]
+    fn a_set_up_without_gun_loads_and_refuses_a_pressure() {
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let text = crate::builtin::setup("authors").unwrap();
+        let start = text.find("[gun]").unwrap();
+        let end = text.find("# Copper pulse shaper").unwrap();
+        let no_gun = format!("{}{}", &text[..start], &text[end..]);
+        let a = Apparatus::from_toml(&no_gun, "a.toml", &gauges).unwrap();
+        assert_eq!(a.gun, Gun::None);
+        let e = a.striker_velocity_m_s(1e5).unwrap_err().to_string();
+        assert!(e.contains("no [gun]"), "{e}");
+    }
+
     #[test]
     fn editing_the_striker_length_shares_the_gun_work_with_the_new_striker() {
         // ½ m v² = W(p) whatever the mass (docs/physics.md §6.4): doubling the striker's length
