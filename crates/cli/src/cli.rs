@@ -565,6 +565,79 @@ pub enum Command {
     },
     /// List the built-in materials, the built-in bar set-ups and the scene kinds.
     List,
+    /// Set-up files: `shpb setup new` writes one from the numbers a lab states.
+    Setup {
+        /// What to do.
+        #[command(subcommand)]
+        action: SetupAction,
+    },
+}
+
+/// `shpb setup` subcommands.
+#[derive(Subcommand, Debug)]
+pub enum SetupAction {
+    /// Write a complete, commented set-up file (bars, inline gauge channels, no gun) from a
+    /// lab's stated numbers, in SI units; `--bars FILE` then reads it. Without a gauge factor or
+    /// --strain-per-volt the channels read records in strain or microstrain only.
+    New(SetupNewArgs),
+}
+
+/// The flags of `shpb setup new` (SI values).
+#[derive(Args, Debug)]
+#[command(allow_negative_numbers = true)]
+pub struct SetupNewArgs {
+    /// The set-up file to write (.toml).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Overwrite an existing file.
+    #[arg(long)]
+    force: bool,
+    /// Bar diameter, m (incident, transmission and striker).
+    #[arg(long)]
+    diameter: f64,
+    /// Bar Young's modulus, Pa.
+    #[arg(long)]
+    modulus: f64,
+    /// Bar density, kg/m³.
+    #[arg(long)]
+    density: f64,
+    /// Bar Poisson's ratio (default 0.3, said in the file).
+    #[arg(long)]
+    poisson: Option<f64>,
+    /// Incident bar length, m.
+    #[arg(long)]
+    incident_length: f64,
+    /// Transmission bar length, m.
+    #[arg(long)]
+    transmission_length: f64,
+    /// Incident gauge distance from the specimen face, m.
+    #[arg(long)]
+    incident_gauge: f64,
+    /// Transmission gauge distance from the specimen face, m.
+    #[arg(long)]
+    transmission_gauge: f64,
+    /// Striker length, m (without it: a placeholder, said in the file).
+    #[arg(long)]
+    striker_length: Option<f64>,
+    /// Bridge of both channels: quarter-axial, half-poisson, full-poisson (with --gauge-factor
+    /// and --excitation) or linear (with --strain-per-volt).
+    #[arg(long)]
+    bridge: Option<String>,
+    /// Gauge factor of the gauges.
+    #[arg(long)]
+    gauge_factor: Option<f64>,
+    /// Bridge excitation, V.
+    #[arg(long)]
+    excitation: Option<f64>,
+    /// Amplifier gain between bridge and recorder.
+    #[arg(long)]
+    gain: Option<f64>,
+    /// Strain per volt at the recorder, tension positive (a linear channel).
+    #[arg(long)]
+    strain_per_volt: Option<f64>,
+    /// Recorder sample rate, Hz (only virtual tests use it).
+    #[arg(long)]
+    sample_rate: Option<f64>,
 }
 
 /// Parses the command line, runs it, prints errors; returns the process exit code.
@@ -585,6 +658,29 @@ pub fn main() -> i32 {
 pub fn dispatch(cli: Cli) -> Result<()> {
     cmd::common::set_output_mode(cli.quiet, cli.json);
     match cli.command {
+        Command::Setup {
+            action: SetupAction::New(a),
+        } => cmd::setup::new(
+            &cmd::setup::SetupNew {
+                diameter_m: a.diameter,
+                modulus_pa: a.modulus,
+                density_kg_m3: a.density,
+                poisson: a.poisson,
+                incident_length_m: a.incident_length,
+                transmission_length_m: a.transmission_length,
+                incident_gauge_m: a.incident_gauge,
+                transmission_gauge_m: a.transmission_gauge,
+                striker_length_m: a.striker_length,
+                bridge: a.bridge,
+                gauge_factor: a.gauge_factor,
+                excitation_v: a.excitation,
+                gain: a.gain,
+                strain_per_volt: a.strain_per_volt,
+                sample_rate_hz: a.sample_rate,
+            },
+            &a.output,
+            a.force,
+        ),
         Command::Run {
             scene,
             output,

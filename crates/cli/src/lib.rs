@@ -20,11 +20,13 @@ pub use shpb_core::{
     solver, specimen, striker,
 };
 pub use shpb_input::{
-    Error, Result, Validator, csv, distribution, error, gauges, kinds, provenance, resources, units,
+    Error, Result, Validator, csv, distribution, error, gauges, kinds, layout, provenance,
+    resources, sheet, units,
 };
 pub use shpb_output::{batch, io, plot, study as study_table, writer};
 pub use shpb_study::{
-    api, bench, convergence, file as study_file, identity as study_identity, sweep, uq,
+    api, bench, convergence, file as study_file, identity as study_identity, strain_factor, sweep,
+    uq,
 };
 pub use shpb_validate as validate;
 

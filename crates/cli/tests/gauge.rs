@@ -47,6 +47,7 @@ fn bridge(kind: BridgeKind) -> Bridge {
         gauge_factor: GF,
         excitation_v: VEX,
         poisson_ratio: NU,
+        strain_per_volt: 0.0,
     }
 }
 
@@ -92,6 +93,7 @@ fn arms(kind: BridgeKind, strain: f64) -> [f64; 4] {
         BridgeKind::HalfPoisson => [axial, poisson, 1.0, 1.0],
         BridgeKind::HalfAxial => [axial, 1.0, axial, 1.0],
         BridgeKind::FullPoisson => [axial, poisson, axial, poisson],
+        BridgeKind::Linear => unreachable!("a linear channel has no bridge arms"),
     }
 }
 

@@ -42,15 +42,19 @@ pub enum BridgeKind {
     HalfAxial,
     /// Two axial + two Poisson gauges: `V = Vex·x(1+ν)/(2+x(1−ν))`; the authors' formula exactly.
     FullPoisson,
+    /// A calibrated linear channel, no bridge model: `ε = k·V` with k = [`Bridge::strain_per_volt`]
+    /// (a lab's stated or fitted factor; gauge factor, excitation and ν unused).
+    Linear,
 }
 
 impl BridgeKind {
     /// Every kind with its name in a gauge file (`bridge = "half-poisson"`).
-    pub const ALL: [(BridgeKind, &'static str); 4] = [
+    pub const ALL: [(BridgeKind, &'static str); 5] = [
         (BridgeKind::QuarterAxial, "quarter-axial"),
         (BridgeKind::HalfPoisson, "half-poisson"),
         (BridgeKind::HalfAxial, "half-axial"),
         (BridgeKind::FullPoisson, "full-poisson"),
+        (BridgeKind::Linear, "linear"),
     ];
 
     /// The kind called `name` in a gauge file, if any.
@@ -82,6 +86,9 @@ pub struct Bridge {
     pub excitation_v: f64,
     /// Poisson's ratio ν of the bar (the transverse gauges see −ν·ε).
     pub poisson_ratio: f64,
+    /// Strain per volt of bridge output, tension positive: the factor of a
+    /// [`BridgeKind::Linear`] channel (0 and unused for the Wheatstone kinds).
+    pub strain_per_volt: f64,
 }
 
 impl Bridge {
@@ -95,6 +102,7 @@ impl Bridge {
             BridgeKind::HalfPoisson => vex * x * (1.0 + nu) / (2.0 * (2.0 + x * (1.0 - nu))),
             BridgeKind::HalfAxial => vex * x / (2.0 + x),
             BridgeKind::FullPoisson => vex * x * (1.0 + nu) / (2.0 + x * (1.0 - nu)),
+            BridgeKind::Linear => strain / self.strain_per_volt,
         }
     }
 
@@ -109,11 +117,12 @@ impl Bridge {
             }
             BridgeKind::HalfAxial => 2.0 * v / (gf * (vex - v)),
             BridgeKind::FullPoisson => 2.0 * v / (vex * gf * ((1.0 + nu) + v * (nu - 1.0) / vex)),
+            BridgeKind::Linear => self.strain_per_volt * v,
         }
     }
 
     /// Small-strain sensitivity dV/dε at ε = 0, V: Vex·GF/4, Vex·GF(1+ν)/4, Vex·GF/2,
-    /// Vex·GF(1+ν)/2.
+    /// Vex·GF(1+ν)/2, 1/k.
     pub fn sensitivity_v(&self) -> f64 {
         let base = self.excitation_v * self.gauge_factor / 4.0;
         match self.kind {
@@ -121,6 +130,7 @@ impl Bridge {
             BridgeKind::HalfPoisson => base * (1.0 + self.poisson_ratio),
             BridgeKind::HalfAxial => 2.0 * base,
             BridgeKind::FullPoisson => 2.0 * base * (1.0 + self.poisson_ratio),
+            BridgeKind::Linear => 1.0 / self.strain_per_volt,
         }
     }
 }
@@ -656,17 +666,32 @@ mod tests {
     }
 
     #[test]
+    fn a_linear_channel_is_its_factor() {
+        let b = Bridge {
+            kind: BridgeKind::Linear,
+            gauge_factor: 0.0,
+            excitation_v: 0.0,
+            poisson_ratio: 0.0,
+            strain_per_volt: 4.96e-4,
+        };
+        // Yao et al.'s 945-steel shot: -0.0145833 V is -7.23333 µε in their paired files.
+        assert_relative_eq!(
+            b.strain_from_output(-0.0145833),
+            -7.2333e-6,
+            max_relative = 1e-4
+        );
+        assert_relative_eq!(b.sensitivity_v(), 1.0 / 4.96e-4);
+    }
+
+    #[test]
     fn bridges_invert_exactly() {
-        for kind in [
-            BridgeKind::QuarterAxial,
-            BridgeKind::HalfPoisson,
-            BridgeKind::FullPoisson,
-        ] {
+        for (kind, _) in BridgeKind::ALL {
             let b = Bridge {
                 kind,
                 gauge_factor: 2.1,
                 excitation_v: 10.0,
                 poisson_ratio: 0.3,
+                strain_per_volt: 4.96e-4,
             };
             for strain in [-2e-3, -1e-5, 0.0, 4e-4] {
                 assert_relative_eq!(

@@ -809,6 +809,14 @@ fn reduce_simulated_records(
         let trace = gauges.iter().find(|g| g.name == name);
         let channel = apparatus.gauges.channel(name);
         match (trace, channel) {
+            // A linear channel whose factor is not stated (nan) records no volts: its
+            // noise-free gauge strain is reduced, as a lab's record in strain would be.
+            (Some(g), Some(ch))
+                if ch.bridge.kind == crate::gauge::BridgeKind::Linear
+                    && ch.bridge.strain_per_volt.is_nan() =>
+            {
+                Ok(g.strain.clone())
+            }
             (Some(g), Some(ch)) => Ok(ch.strains_from_voltages(&g.voltage_v)),
             _ => Err(crate::error::Named::new(apparatus.source.clone()).error(
                 "gauges",

@@ -169,23 +169,28 @@ pub enum Gun {
     Linear(LinearGun),
     /// Adiabatic reservoir expansion over the barrel (Rohrbach et al. 2012).
     Adiabatic(GasGun),
+    /// No gun: a set-up without `[gun]`, whose scenes give the striker's velocity
+    /// (`striker_velocity_m_s`); any pressure is refused.
+    None,
 }
 
 impl Gun {
-    /// The allowed gauge-pressure range (min, max), Pa.
+    /// The allowed gauge-pressure range (min, max), Pa (NaN, NaN without a gun).
     pub fn range_pa(&self) -> (f64, f64) {
         match self {
             Gun::Linear(g) => (g.min_pressure_pa, g.max_pressure_pa),
             Gun::Adiabatic(g) => (g.min_pressure_pa, g.max_pressure_pa),
+            Gun::None => (f64::NAN, f64::NAN),
         }
     }
 
     /// Work the gas does on a striker of bore `area_m2` at gauge pressure `p_gauge_pa`, whatever
-    /// its mass (½ m v² = W(p), docs/physics.md §6.4), J.
+    /// its mass (½ m v² = W(p), docs/physics.md §6.4), J (NaN without a gun).
     pub fn kinetic_energy_j(&self, p_gauge_pa: f64, area_m2: f64) -> f64 {
         match self {
             Gun::Linear(g) => g.kinetic_energy_j(p_gauge_pa),
             Gun::Adiabatic(g) => g.kinetic_energy_j(p_gauge_pa, area_m2),
+            Gun::None => f64::NAN,
         }
     }
 
@@ -195,6 +200,12 @@ impl Gun {
     pub fn striker_velocity_m_s(&self, p_gauge_pa: f64, mass_kg: f64, area_m2: f64) -> Result<f64> {
         match self {
             Gun::Adiabatic(g) => g.velocity_m_s(p_gauge_pa, mass_kg, area_m2),
+            Gun::None => Err(Error::invalid(
+                PRESSURE,
+                "given, but the set-up has no [gun]",
+                "the striker's velocity (striker_velocity_m_s) instead of a pressure, or a set-up \
+                 with a [gun] table",
+            )),
             Gun::Linear(g) => {
                 let allowed = check_range(p_gauge_pa, g.min_pressure_pa, g.max_pressure_pa)?;
                 let v2 = 2.0 * g.kinetic_energy_j(p_gauge_pa) / mass_kg;

@@ -19,9 +19,9 @@
 //!   far end free. A reduction's window is bounded by the incident–reflected separation
 //!   2 d_I/c0 at the incident gauge; with these lengths no far-end reflection reaches a gauge
 //!   sooner (2 (L − d)/c0 ≥ 2 d_I/c0), so the lengths do not enter the reduction.
-//! - the gun: a deck states a breech pressure but no gun calibration, so the set-up's gun is a
-//!   zero line (`k = 0`: no pressure moves the striker). A deck is a set-up for reducing records
-//!   (`shpb reduce`), not for firing virtual shots.
+//! - the gun: a deck states a breech pressure but no gun calibration, so the set-up has no gun
+//!   (`Gun::None`: a pressure is refused). A deck is a set-up for reducing records
+//!   (`shpb reduce`, `shpb strain`), not for firing virtual shots.
 //! - the digitiser: the records carry their own clock; the channels state 8 bits over ±10 V at
 //!   125 MHz (the LANL files' 8 ns), which no reduction uses.
 
@@ -30,7 +30,7 @@ use shpb_core::apparatus::{Apparatus, BarGeometry, Inserts};
 use shpb_core::bar::BarMaterial;
 use shpb_core::gauge::{Bridge, BridgeKind, Digitiser, GaugeChannel, GaugeSetup};
 use shpb_core::reduce_cylinder::CylinderGeometry;
-use shpb_core::striker::{Gun, LinearGun, PSI_PA};
+use shpb_core::striker::{Gun, PSI_PA};
 use std::path::Path;
 
 /// The key whose presence tells a deck from other files ([`is_deck`]).
@@ -270,6 +270,7 @@ impl Deck {
                 gauge_factor: b.gauge_factor,
                 excitation_v: b.excitation_v,
                 poisson_ratio: b.poisson,
+                strain_per_volt: 0.0,
             },
             amplifier_gain: b.gain,
             polarity: 1.0,
@@ -297,17 +298,7 @@ impl Deck {
                 length_m: striker_length_m,
                 diameter_m: inc.diameter_m,
             },
-            gun: Gun::Linear(LinearGun {
-                k_m2_per_s2_per_pa: 0.0,
-                loss_pressure_pa: 0.0,
-                calibration_mass_kg: material.density_kg_m3
-                    * std::f64::consts::PI
-                    * 0.25
-                    * inc.diameter_m.powi(2)
-                    * striker_length_m,
-                min_pressure_pa: 0.0,
-                max_pressure_pa: 1e8,
-            }),
+            gun: Gun::None,
             gun_calibrated_pa: None,
             gun_velocity_scatter: None,
             shaper: None,

@@ -11,17 +11,20 @@ use shpb_core::reduce::{
 };
 use std::path::Path;
 
-/// One `[[channel]]` table of a gauge file, before validation.
+/// One `[[channel]]` table of a gauge file (or of a set-up file's inline channels), before
+/// validation. `bridge = "linear"` takes `strain_per_volt` instead of `gauge_factor`,
+/// `excitation_v` and `poisson_ratio`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct ChannelSpec {
+pub(crate) struct ChannelSpec {
     name: String,
     bar: String,
     distance_from_specimen_m: f64,
     bridge: String,
-    gauge_factor: f64,
-    excitation_v: f64,
-    poisson_ratio: f64,
+    gauge_factor: Option<f64>,
+    excitation_v: Option<f64>,
+    poisson_ratio: Option<f64>,
+    strain_per_volt: Option<f64>,
     #[serde(default = "unit_gain")]
     amplifier_gain: f64,
     polarity: f64,
@@ -103,12 +106,7 @@ impl ChannelSpec {
                 100.0,
                 "m",
             )?,
-            bridge: Bridge {
-                kind,
-                gauge_factor: v.positive("gauge_factor", self.gauge_factor, 1000.0, "")?,
-                excitation_v: v.positive("excitation_v", self.excitation_v, 1000.0, "V")?,
-                poisson_ratio: v.in_range("poisson_ratio", self.poisson_ratio, 0.0, 0.5, "")?,
-            },
+            bridge: self.bridge(kind, v)?,
             amplifier_gain: v.positive("amplifier_gain", self.amplifier_gain, 1e6, "")?,
             polarity: self.polarity,
             digitiser: Digitiser {
@@ -120,6 +118,110 @@ impl ChannelSpec {
             },
         })
     }
+}
+
+impl ChannelSpec {
+    /// The bridge of a channel: a Wheatstone kind with its gauge factor, excitation and ν, or
+    /// a linear channel with its `strain_per_volt` (each key only where it is used).
+    fn bridge(&self, kind: BridgeKind, v: &Validator) -> Result<Bridge> {
+        let wheatstone = [
+            ("gauge_factor", self.gauge_factor),
+            ("excitation_v", self.excitation_v),
+            ("poisson_ratio", self.poisson_ratio),
+        ];
+        if kind == BridgeKind::Linear {
+            if let Some((key, _)) = wheatstone.iter().find(|(_, x)| x.is_some()) {
+                return Err(v.error(
+                    key,
+                    "not a constant of bridge = \"linear\"",
+                    "strain_per_volt only (the gauge factor, excitation and gain are in it)",
+                ));
+            }
+            let k = self.strain_per_volt.ok_or_else(|| {
+                v.error(
+                    "strain_per_volt",
+                    "missing for bridge = \"linear\"",
+                    "the channel's strain per volt at the recorder, tension positive",
+                )
+            })?;
+            // nan: not stated (a set-up for strain records); volt records are then refused.
+            if !(k.is_nan() || (k.is_finite() && k != 0.0 && k.abs() <= 1e3)) {
+                return Err(v.error(
+                    "strain_per_volt",
+                    format!("{k}"),
+                    "a non-zero finite factor, |k| <= 1000 per V (nan: not stated)",
+                ));
+            }
+            return Ok(Bridge {
+                kind,
+                gauge_factor: 0.0,
+                excitation_v: 0.0,
+                poisson_ratio: 0.0,
+                strain_per_volt: k,
+            });
+        }
+        if self.strain_per_volt.is_some() {
+            return Err(v.error(
+                "strain_per_volt",
+                format!("given with bridge = \"{}\"", kind.name()),
+                "strain_per_volt only with bridge = \"linear\"",
+            ));
+        }
+        let need = |key: &str, x: Option<f64>| {
+            x.ok_or_else(|| {
+                v.error(
+                    key,
+                    format!("missing for bridge = \"{}\"", kind.name()),
+                    "a positive number",
+                )
+            })
+        };
+        Ok(Bridge {
+            kind,
+            gauge_factor: v.positive(
+                "gauge_factor",
+                need("gauge_factor", self.gauge_factor)?,
+                1000.0,
+                "",
+            )?,
+            excitation_v: v.positive(
+                "excitation_v",
+                need("excitation_v", self.excitation_v)?,
+                1000.0,
+                "V",
+            )?,
+            poisson_ratio: v.in_range(
+                "poisson_ratio",
+                need("poisson_ratio", self.poisson_ratio)?,
+                0.0,
+                0.5,
+                "",
+            )?,
+            strain_per_volt: 0.0,
+        })
+    }
+}
+
+/// Validates the `[[channel]]` tables of a gauge file or a set-up file; `root` names the file
+/// (keys `channel[i].*`).
+pub(crate) fn gauge_setup(channels: &[ChannelSpec], root: &Validator) -> Result<GaugeSetup> {
+    if channels.is_empty() {
+        return Err(root.error("channel", "no channels", "one or more [[channel]] tables"));
+    }
+    let mut built: Vec<GaugeChannel> = Vec::with_capacity(channels.len());
+    for (i, c) in channels.iter().enumerate() {
+        let v = root.table(&format!("channel[{i}]"));
+        let ch = c.build(i, &v)?;
+        if built.iter().any(|o| o.name == ch.name) {
+            return Err(v.error(
+                "name",
+                format!("`{}` is used by an earlier channel", ch.name),
+                "a name unique in the file",
+            ));
+        }
+        built.push(ch);
+    }
+    Ok(GaugeSetup { channels: built })
 }
 
 /// Reading and validating gauge files.
@@ -137,24 +239,7 @@ impl GaugeSetupFile for GaugeSetup {
             file: file.to_string(),
             message: e.to_string(),
         })?;
-        let root = Validator::new(file);
-        if spec.channel.is_empty() {
-            return Err(root.error("channel", "no channels", "one or more [[channel]] tables"));
-        }
-        let mut channels: Vec<GaugeChannel> = Vec::with_capacity(spec.channel.len());
-        for (i, c) in spec.channel.iter().enumerate() {
-            let v = root.table(&format!("channel[{i}]"));
-            let ch = c.build(i, &v)?;
-            if channels.iter().any(|o| o.name == ch.name) {
-                return Err(v.error(
-                    "name",
-                    format!("`{}` is used by an earlier channel", ch.name),
-                    "a name unique in the file",
-                ));
-            }
-            channels.push(ch);
-        }
-        Ok(GaugeSetup { channels })
+        gauge_setup(&spec.channel, &Validator::new(file))
     }
 
     /// Reads and validates a gauge file.
@@ -224,7 +309,8 @@ impl RawRecordFile for RawRecord {
 }
 
 /// Reduces a raw gauge record in the authors' CSV format (`time_s,incident_V,transmission_V`)
-/// with the bars and gauge channels of `apparatus`.
+/// with the bars and gauge channels of `apparatus` (`shpb reduce` reads any record through
+/// `sheet::read_record`).
 pub fn reduce_record_file(
     record: &Path,
     apparatus: &Apparatus,

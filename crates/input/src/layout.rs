@@ -19,6 +19,12 @@
 //! unit = "mV"
 //! polarity = -1
 //! ```
+//!
+//! Two more keys for spreadsheets and other encodings ([`crate::sheet`]): `sheet = "Sheet2"`
+//! (an XLS/XLSX record's sheet; default the first), `encoding = "gbk"` (a text record's encoding:
+//! `utf-8`, `gbk` or `gb18030`; default: UTF-8 if the bytes are valid UTF-8, else GB18030).
+//! A time column printed with too few digits (equal neighbours, never decreasing) is replaced by
+//! its least-squares line t₀ + k·Δt over the sample index k.
 
 use crate::error::{Error, Result, Validator};
 use serde::Deserialize;
@@ -63,7 +69,7 @@ impl ChannelUnit {
     }
 
     /// Whether the channel is a bridge voltage (else a strain).
-    fn is_voltage(self) -> bool {
+    pub fn is_voltage(self) -> bool {
         matches!(self, ChannelUnit::Volt | ChannelUnit::Millivolt)
     }
 }
@@ -96,6 +102,29 @@ pub enum TimeSource {
     },
 }
 
+/// The encoding of a text record (layout key `encoding`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextEncoding {
+    /// UTF-8 (a leading byte-order mark is dropped).
+    Utf8,
+    /// GB18030, the superset of GBK (what `gbk` names too).
+    Gb18030,
+}
+
+impl TextEncoding {
+    /// The names a layout may give, for messages.
+    pub const ALLOWED: &'static str = "utf-8, gbk or gb18030";
+
+    /// The encoding called `name` in a layout (`utf-8`, `utf8`, `gbk`, `gb18030`, any case).
+    pub fn from_name(name: &str) -> Option<TextEncoding> {
+        match name.trim().to_ascii_lowercase().as_str() {
+            "utf-8" | "utf8" => Some(TextEncoding::Utf8),
+            "gbk" | "gb18030" | "gb2312" | "cp936" => Some(TextEncoding::Gb18030),
+            _ => None,
+        }
+    }
+}
+
 /// A validated record layout (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordLayout {
@@ -113,6 +142,10 @@ pub struct RecordLayout {
     pub incident: ChannelLayout,
     /// Transmission-gauge channel.
     pub transmission: ChannelLayout,
+    /// The sheet of a spreadsheet record (None: the first).
+    pub sheet: Option<String>,
+    /// The encoding of a text record (None: UTF-8 if valid, else GB18030).
+    pub encoding: Option<TextEncoding>,
 }
 
 /// A record read through a layout: bridge voltages (to go through the set-up's bridges) or bar
@@ -179,6 +212,10 @@ struct LayoutFile {
     #[serde(default)]
     time_unit: Option<String>,
     sample_rate_hz: Option<f64>,
+    #[serde(default)]
+    sheet: Option<String>,
+    #[serde(default)]
+    encoding: Option<String>,
     incident: ChannelFile,
     transmission: ChannelFile,
 }
@@ -315,6 +352,13 @@ impl RecordLayout {
                 "both channels bridge voltages (V, mV) or both bar strains (strain, microstrain)",
             ));
         }
+        let encoding =
+            match raw.encoding.as_deref() {
+                None => None,
+                Some(name) => Some(TextEncoding::from_name(name).ok_or_else(|| {
+                    v.error("encoding", format!("`{name}`"), TextEncoding::ALLOWED)
+                })?),
+            };
         Ok(RecordLayout {
             source: file.to_string(),
             delimiter,
@@ -323,6 +367,8 @@ impl RecordLayout {
             time,
             incident,
             transmission,
+            sheet: raw.sheet,
+            encoding,
         })
     }
 
@@ -346,6 +392,25 @@ impl RecordLayout {
     /// `file:line` and the layout key of the column at fault.
     pub fn parse(&self, text: &str, file: &str) -> Result<LayoutRecord> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let rows = text.lines().enumerate().map(|(n, line)| {
+            let trimmed = line.trim();
+            if trimmed.is_empty() || trimmed.starts_with('#') {
+                (n + 1, Vec::new())
+            } else {
+                (n + 1, self.fields(line.trim_end_matches('\r')))
+            }
+        });
+        self.parse_rows(rows, file)
+    }
+
+    /// Parses a record's rows (1-based line or row number, the row's fields; a row without
+    /// fields is skipped) through the layout: the text lines of [`RecordLayout::parse`] or a
+    /// spreadsheet's rows ([`crate::sheet`]). The first `skip_lines` rows are skipped.
+    pub fn parse_rows<S: AsRef<str>>(
+        &self,
+        rows: impl Iterator<Item = (usize, Vec<S>)>,
+        file: &str,
+    ) -> Result<LayoutRecord> {
         let (mut time_s, mut incident, mut transmission) = (Vec::new(), Vec::new(), Vec::new());
         let number = |field: &str, line: usize, key: &str| -> Result<f64> {
             let t = field.trim();
@@ -367,17 +432,15 @@ impl RecordLayout {
                 }),
             }
         };
-        for (n, line) in text.lines().enumerate().skip(self.skip_lines) {
-            let trimmed = line.trim();
-            if trimmed.is_empty() || trimmed.starts_with('#') {
+        for (line, fields) in rows.skip(self.skip_lines) {
+            if fields.is_empty() {
                 continue;
             }
-            let fields = self.fields(line.trim_end_matches('\r'));
             let get = |c: usize, key: &str| -> Result<f64> {
                 match fields.get(c) {
-                    Some(f) => number(f, n + 1, key),
+                    Some(f) => number(f.as_ref(), line, key),
                     None => Err(Error::Input {
-                        file: format!("{file}:{}", n + 1),
+                        file: format!("{file}:{line}"),
                         key: key.to_string(),
                         problem: format!(
                             "the line has {} fields, the layout reads column {}",
@@ -407,6 +470,18 @@ impl RecordLayout {
                 allowed: format!("at least two data lines (layout {})", self.source),
             });
         }
+        if time_s.windows(2).all(|w| w[1] >= w[0]) && time_s.first() < time_s.last() {
+            // Times printed with too few digits (e.g. `-1.98E-04` for many samples in a row):
+            // the least-squares line through them over the sample index (module docs).
+            let index: Vec<f64> = (0..time_s.len()).map(|k| k as f64).collect();
+            let ones = vec![1.0; time_s.len()];
+            if time_s.windows(2).any(|w| w[1] == w[0])
+                && let Some(line) = shpb_core::numeric::least_squares(&[&ones, &index], &time_s)
+                && line[1] > 0.0
+            {
+                time_s = index.iter().map(|k| line[0] + line[1] * k).collect();
+            }
+        }
         if let Some(i) = time_s.windows(2).position(|w| w[1] <= w[0]) {
             return Err(Error::Input {
                 file: file.to_string(),
@@ -433,12 +508,6 @@ impl RecordLayout {
                 transmission_strain: transmission,
             })
         })
-    }
-
-    /// Reads a record file through the layout (see [`RecordLayout::parse`]).
-    pub fn read(&self, path: &Path) -> Result<LayoutRecord> {
-        let text = crate::csv::read_text(path)?;
-        self.parse(&text, &path.display().to_string())
     }
 }
 

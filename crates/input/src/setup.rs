@@ -91,12 +91,19 @@ struct InsertsToml {
 struct ApparatusToml {
     #[serde(default)]
     inserts: InsertsToml,
-    gauges: String,
+    /// A gauge file, or …
+    gauges: Option<String>,
+    /// … the channels inline (`[[channel]]` tables, as in a gauge file): exactly one of the two.
+    channel: Option<Vec<crate::gauges::ChannelSpec>>,
+    #[serde(default)]
+    #[allow(dead_code)]
+    description: Option<String>,
     material: MaterialToml,
     incident: BarToml,
     transmission: BarToml,
     striker: BarToml,
-    gun: GunToml,
+    /// The gas gun; without it, scenes give the striker's velocity (`striker_velocity_m_s`).
+    gun: Option<GunToml>,
     shaper: Option<ShaperToml>,
 }
 
@@ -358,116 +365,126 @@ impl ApparatusFile for Apparatus {
             ));
         }
         let gv = v.table("gun");
-        let g = &raw.gun;
-        let (pmin, pmax) = (
-            gv.positive("min_pressure_pa", g.min_pressure_pa, 1e8, "Pa")?,
-            gv.positive("max_pressure_pa", g.max_pressure_pa, 1e8, "Pa")?,
-        );
-        if pmin >= pmax {
-            return Err(gv.error(
-                "min_pressure_pa",
-                "not below max_pressure_pa",
-                "min_pressure_pa < max_pressure_pa",
-            ));
-        }
-        let gun_calibrated_pa = match (g.calibrated_min_pressure_pa, g.calibrated_max_pressure_pa) {
-            (None, None) => None,
-            (Some(lo), Some(hi)) => {
-                let lo = gv.in_range("calibrated_min_pressure_pa", lo, pmin, pmax, "Pa")?;
-                let hi = gv.in_range("calibrated_max_pressure_pa", hi, lo, pmax, "Pa")?;
-                Some((lo, hi))
-            }
-            (lo, _) => {
-                let key = if lo.is_none() {
-                    "calibrated_min_pressure_pa"
-                } else {
-                    "calibrated_max_pressure_pa"
-                };
-                return Err(gv.error(
-                    key,
-                    "missing",
-                    "both calibrated_min_pressure_pa and calibrated_max_pressure_pa, or neither",
-                ));
-            }
-        };
-        let gun_velocity_scatter = g
-            .velocity_scatter
-            .map(|s| gv.in_range("velocity_scatter", s, 0.0, 0.5, "1"))
-            .transpose()?;
-        let need = |key: &str, x: Option<f64>| {
-            x.ok_or_else(|| {
-                gv.error(
-                    key,
-                    format!("missing for model = \"{}\"", g.model),
-                    "a positive number",
-                )
-            })
-        };
         let striker = bar_geometry(&raw.striker, &v.table("striker"))?;
-        let gun = match g.model.as_str() {
-            "linear" => Gun::Linear(LinearGun {
-                k_m2_per_s2_per_pa: gv.positive(
-                    "k_m2_per_s2_per_pa",
-                    need("k_m2_per_s2_per_pa", g.k_m2_per_s2_per_pa)?,
-                    1.0,
-                    "m²/s²/Pa",
-                )?,
-                loss_pressure_pa: gv.in_range(
-                    "loss_pressure_pa",
-                    need("loss_pressure_pa", g.loss_pressure_pa)?,
-                    0.0,
-                    pmin,
-                    "Pa (below min_pressure_pa)",
-                )?,
-                // The striker the line was measured with (same material and bore as [striker]);
-                // without the key, the set-up's own striker (docs/physics.md §6.4).
-                calibration_mass_kg: material.density_kg_m3
-                    * striker.area_m2()
-                    * match g.calibration_striker_length_m {
-                        Some(l) => gv.positive("calibration_striker_length_m", l, 100.0, "m")?,
-                        None => striker.length_m,
-                    },
-                min_pressure_pa: pmin,
-                max_pressure_pa: pmax,
-            }),
-            "adiabatic" if g.calibration_striker_length_m.is_some() => {
-                return Err(gv.error(
-                    "calibration_striker_length_m",
-                    "only a calibration line (model = \"linear\") has a calibration striker",
-                    "no calibration_striker_length_m with model = \"adiabatic\"",
-                ));
-            }
-            "adiabatic" => Gun::Adiabatic(GasGun {
-                reservoir_volume_m3: gv.positive(
-                    "reservoir_volume_m3",
-                    need("reservoir_volume_m3", g.reservoir_volume_m3)?,
-                    10.0,
-                    "m³",
-                )?,
-                barrel_length_m: gv.positive(
-                    "barrel_length_m",
-                    need("barrel_length_m", g.barrel_length_m)?,
-                    100.0,
-                    "m",
-                )?,
-                friction_n: gv.in_range(
-                    "friction_n",
-                    g.friction_n.unwrap_or(0.0),
-                    0.0,
-                    1e6,
-                    "N",
-                )?,
-                gamma: gv.in_range("gamma", g.gamma.unwrap_or(1.4), 1.01, 1.67, "")?,
-                atmospheric_pa: shpb_core::striker::ATMOSPHERE_PA,
-                min_pressure_pa: pmin,
-                max_pressure_pa: pmax,
-            }),
-            other => {
-                return Err(gv.error(
-                    "model",
-                    format!("unknown gun model `{other}`"),
-                    "linear, adiabatic",
-                ));
+        let (gun, gun_calibrated_pa, gun_velocity_scatter) = match &raw.gun {
+            None => (Gun::None, None, None),
+            Some(g) => {
+                let (pmin, pmax) = (
+                    gv.positive("min_pressure_pa", g.min_pressure_pa, 1e8, "Pa")?,
+                    gv.positive("max_pressure_pa", g.max_pressure_pa, 1e8, "Pa")?,
+                );
+                if pmin >= pmax {
+                    return Err(gv.error(
+                        "min_pressure_pa",
+                        "not below max_pressure_pa",
+                        "min_pressure_pa < max_pressure_pa",
+                    ));
+                }
+                let gun_calibrated_pa = match (
+                    g.calibrated_min_pressure_pa,
+                    g.calibrated_max_pressure_pa,
+                ) {
+                    (None, None) => None,
+                    (Some(lo), Some(hi)) => {
+                        let lo = gv.in_range("calibrated_min_pressure_pa", lo, pmin, pmax, "Pa")?;
+                        let hi = gv.in_range("calibrated_max_pressure_pa", hi, lo, pmax, "Pa")?;
+                        Some((lo, hi))
+                    }
+                    (lo, _) => {
+                        let key = if lo.is_none() {
+                            "calibrated_min_pressure_pa"
+                        } else {
+                            "calibrated_max_pressure_pa"
+                        };
+                        return Err(gv.error(
+                        key,
+                        "missing",
+                        "both calibrated_min_pressure_pa and calibrated_max_pressure_pa, or neither",
+                    ));
+                    }
+                };
+                let gun_velocity_scatter = g
+                    .velocity_scatter
+                    .map(|s| gv.in_range("velocity_scatter", s, 0.0, 0.5, "1"))
+                    .transpose()?;
+                let need = |key: &str, x: Option<f64>| {
+                    x.ok_or_else(|| {
+                        gv.error(
+                            key,
+                            format!("missing for model = \"{}\"", g.model),
+                            "a positive number",
+                        )
+                    })
+                };
+                let gun = match g.model.as_str() {
+                    "linear" => Gun::Linear(LinearGun {
+                        k_m2_per_s2_per_pa: gv.positive(
+                            "k_m2_per_s2_per_pa",
+                            need("k_m2_per_s2_per_pa", g.k_m2_per_s2_per_pa)?,
+                            1.0,
+                            "m²/s²/Pa",
+                        )?,
+                        loss_pressure_pa: gv.in_range(
+                            "loss_pressure_pa",
+                            need("loss_pressure_pa", g.loss_pressure_pa)?,
+                            0.0,
+                            pmin,
+                            "Pa (below min_pressure_pa)",
+                        )?,
+                        // The striker the line was measured with (same material and bore as [striker]);
+                        // without the key, the set-up's own striker (docs/physics.md §6.4).
+                        calibration_mass_kg: material.density_kg_m3
+                            * striker.area_m2()
+                            * match g.calibration_striker_length_m {
+                                Some(l) => {
+                                    gv.positive("calibration_striker_length_m", l, 100.0, "m")?
+                                }
+                                None => striker.length_m,
+                            },
+                        min_pressure_pa: pmin,
+                        max_pressure_pa: pmax,
+                    }),
+                    "adiabatic" if g.calibration_striker_length_m.is_some() => {
+                        return Err(gv.error(
+                        "calibration_striker_length_m",
+                        "only a calibration line (model = \"linear\") has a calibration striker",
+                        "no calibration_striker_length_m with model = \"adiabatic\"",
+                    ));
+                    }
+                    "adiabatic" => Gun::Adiabatic(GasGun {
+                        reservoir_volume_m3: gv.positive(
+                            "reservoir_volume_m3",
+                            need("reservoir_volume_m3", g.reservoir_volume_m3)?,
+                            10.0,
+                            "m³",
+                        )?,
+                        barrel_length_m: gv.positive(
+                            "barrel_length_m",
+                            need("barrel_length_m", g.barrel_length_m)?,
+                            100.0,
+                            "m",
+                        )?,
+                        friction_n: gv.in_range(
+                            "friction_n",
+                            g.friction_n.unwrap_or(0.0),
+                            0.0,
+                            1e6,
+                            "N",
+                        )?,
+                        gamma: gv.in_range("gamma", g.gamma.unwrap_or(1.4), 1.01, 1.67, "")?,
+                        atmospheric_pa: shpb_core::striker::ATMOSPHERE_PA,
+                        min_pressure_pa: pmin,
+                        max_pressure_pa: pmax,
+                    }),
+                    other => {
+                        return Err(gv.error(
+                            "model",
+                            format!("unknown gun model `{other}`"),
+                            "linear, adiabatic",
+                        ));
+                    }
+                };
+                (gun, gun_calibrated_pa, gun_velocity_scatter)
             }
         };
         let shaper = match &raw.shaper {
@@ -478,7 +495,24 @@ impl ApparatusFile for Apparatus {
             )?),
             None => None,
         };
-        let gauges = gauges(&raw.gauges)?;
+        let gauges = match (&raw.gauges, &raw.channel) {
+            (Some(g), None) => gauges(g)?,
+            (None, Some(channels)) => crate::gauges::gauge_setup(channels, &v)?,
+            (Some(_), Some(_)) => {
+                return Err(v.error(
+                    "gauges",
+                    "given with [[channel]] tables",
+                    "either gauges = \"FILE\" or the [[channel]] tables inline, not both",
+                ));
+            }
+            (None, None) => {
+                return Err(v.error(
+                    "gauges",
+                    "missing",
+                    "gauges = \"FILE\" (a gauge file) or [[channel]] tables inline",
+                ));
+            }
+        };
         let incident = bar_geometry(&raw.incident, &v.table("incident"))?;
         let insert = |side: &str, t: &Option<InsertToml>| -> Result<Option<Insert>> {
             let Some(t) = t else { return Ok(None) };
@@ -646,6 +680,95 @@ impl ShaperOverride {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The authors' set-up with its gauge file's channels written inline instead.
+    fn inline_channels() -> String {
+        let text = crate::builtin::setup("authors").unwrap();
+        let channels = crate::builtin::gauges("gauges-authors.toml")
+            .unwrap()
+            .replace("description = ", "# description = ");
+        format!(
+            "{}\n{channels}",
+            text.replace("gauges = \"gauges-authors.toml\"", "")
+        )
+    }
+
+    #[test]
+    fn inline_channels_read_as_the_gauge_file_and_exactly_one_of_the_two() {
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let from_file =
+            Apparatus::from_toml(crate::builtin::setup("authors").unwrap(), "a.toml", &gauges)
+                .unwrap();
+        let inline = Apparatus::from_toml(&inline_channels(), "a.toml", &gauges).unwrap();
+        assert_eq!(inline.gauges, from_file.gauges);
+        let both = format!("gauges = \"gauges-authors.toml\"\n{}", inline_channels());
+        let e = Apparatus::from_toml(&both, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`gauges`") && e.contains("not both"), "{e}");
+        let neither = crate::builtin::setup("authors")
+            .unwrap()
+            .replace("gauges = \"gauges-authors.toml\"", "");
+        let e = Apparatus::from_toml(&neither, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`gauges`: missing"), "{e}");
+    }
+
+    #[test]
+    fn a_linear_channel_takes_its_factor_and_only_that() {
+        let gauges = |_: &str| -> Result<GaugeSetup> { unreachable!() };
+        // Both channels' bridge keys replaced by `keys` (the rest of the line commented out).
+        let linear = |keys: &str| {
+            let bridge = "bridge = \"full-poisson\"\ngauge_factor = 2.12\nexcitation_v = 15.0\n\
+                          poisson_ratio = 0.31";
+            let text = inline_channels();
+            assert_eq!(text.matches(bridge).count(), 2);
+            text.replace(bridge, &format!("bridge = \"linear\"\n{keys}#"))
+        };
+        let a = Apparatus::from_toml(&linear("strain_per_volt = 4.96e-4\n"), "a.toml", &gauges)
+            .unwrap();
+        let c = a.gauges.channel("incident").unwrap();
+        assert_eq!(c.bridge.kind, shpb_core::gauge::BridgeKind::Linear);
+        assert_eq!(c.bridge.strain_per_volt, 4.96e-4);
+        let err = |keys: &str| {
+            Apparatus::from_toml(&linear(keys), "a.toml", &gauges)
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err("strain_per_volt = 4.96e-4\npoisson_ratio = 0.31\n");
+        assert!(
+            e.contains("`channel[0].poisson_ratio`") && e.contains("linear"),
+            "{e}"
+        );
+        let e = err("");
+        assert!(e.contains("`channel[0].strain_per_volt`: missing"), "{e}");
+        let e = err("strain_per_volt = 0.0\n");
+        assert!(e.contains("non-zero"), "{e}");
+        let wheatstone = inline_channels().replace(
+            "excitation_v = 15.0\n",
+            "excitation_v = 15.0\nstrain_per_volt = 1e-3\n",
+        );
+        let e = Apparatus::from_toml(&wheatstone, "a.toml", &gauges)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("only with bridge = \"linear\""), "{e}");
+    }
+
+    #[test]
+    fn a_set_up_without_gun_loads_and_refuses_a_pressure() {
+        let gauges =
+            |g: &str| GaugeSetup::from_toml(crate::builtin::gauges(g).unwrap(), "gauges.toml");
+        let text = crate::builtin::setup("authors").unwrap();
+        let start = text.find("[gun]").unwrap();
+        let end = text.find("# Copper pulse shaper").unwrap();
+        let no_gun = format!("{}{}", &text[..start], &text[end..]);
+        let a = Apparatus::from_toml(&no_gun, "a.toml", &gauges).unwrap();
+        assert_eq!(a.gun, Gun::None);
+        let e = a.striker_velocity_m_s(1e5).unwrap_err().to_string();
+        assert!(e.contains("no [gun]"), "{e}");
+    }
 
     #[test]
     fn editing_the_striker_length_shares_the_gun_work_with_the_new_striker() {

@@ -456,6 +456,23 @@ fn flag_err(e: shpb_core::Error) -> Error {
     }
 }
 
+/// A record that is one oscilloscope channel with a header block: say how to give its files.
+fn channel_file_hint(record: &Path, e: Error) -> Error {
+    let text = std::fs::read(record).unwrap_or_default();
+    if shpb_input::channel_file::is_channel_file(&String::from_utf8_lossy(&text)) {
+        input_err(
+            "RECORD",
+            format!(
+                "{} is one oscilloscope channel with a header block (a record kept one file per channel)",
+                record.display()
+            ),
+            "the record's channel files as --channel incident=FILE --channel transmission=FILE (a gauge's several files are averaged)",
+        )
+    } else {
+        e
+    }
+}
+
 /// [`reduce_record`] with every choice of `shpb reduce` ([`RecordOptions`]).
 pub fn reduce_record_with(
     record: &Path,
@@ -618,34 +635,18 @@ pub fn reduce_record_with(
             &options,
             &record.display().to_string(),
         )?
-    } else if let Some(layout) = &choices.layout {
-        let name = record.display().to_string();
-        let input = layout
-            .read(record)?
+    } else {
+        // Every text or spreadsheet record through the one reader (a layout, the authors' CSV,
+        // or columns named with their units).
+        let input = shpb_input::sheet::read_record(record, choices.layout.as_ref())
+            .map_err(|e| channel_file_hint(record, e))?
             .into_strains(&apparatus, options.baseline_samples)?;
         shpb_core::reduce::reduce_named(
             &input,
             &ReductionSetup::from_apparatus(&apparatus)?,
             &options,
-            &name,
+            &record.display().to_string(),
         )?
-    } else {
-        shpb_input::gauges::reduce_record_file(record, &apparatus, &options).map_err(|e| {
-            // One oscilloscope channel of a record kept one file per channel: say how to give it.
-            let text = std::fs::read(record).unwrap_or_default();
-            if shpb_input::channel_file::is_channel_file(&String::from_utf8_lossy(&text)) {
-                input_err(
-                    "RECORD",
-                    format!(
-                        "{} is one oscilloscope channel with a header block (a record kept one file per channel)",
-                        record.display()
-                    ),
-                    "the record's channel files as --channel incident=FILE --channel transmission=FILE (a gauge's several files are averaged)",
-                )
-            } else {
-                e
-            }
-        })?
     };
     let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
     Ok(Reduced {

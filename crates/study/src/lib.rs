@@ -12,6 +12,7 @@ pub mod convergence;
 pub mod design;
 pub mod file;
 pub mod identity;
+pub mod strain_factor;
 pub mod sweep;
 pub mod uq;
 

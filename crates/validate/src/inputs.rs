@@ -50,6 +50,7 @@ pub fn section(ctx: &Context) -> Result<String> {
                 calibrated,
             );
         }
+        Gun::None => {}
     }
     match a.shaper {
         Some(s) => {

@@ -75,6 +75,7 @@ pub fn gun(pressure: &str, bars: &Path) -> Result<()> {
                 g.gamma, g.reservoir_volume_m3, g.barrel_length_m, g.friction_n
             ))?;
         }
+        Gun::None => {}
     }
     Ok(())
 }

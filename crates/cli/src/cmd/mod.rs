@@ -11,6 +11,7 @@ pub mod list;
 pub mod merge;
 pub mod reduce;
 pub mod run;
+pub mod setup;
 pub mod strain;
 pub mod study;
 pub mod sweep;

@@ -2,7 +2,6 @@
 
 use super::common::say;
 use shpb_core::run::RunOutput;
-use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, check_output_path};
 use std::path::Path;
@@ -41,25 +40,23 @@ pub fn strain(
     let (read, inputs) = shpb_input::files::capture(|| -> Result<_> {
         // A set-up, or a lab's input deck (its bridges and gains; `load_record_apparatus`).
         let (apparatus, _) = shpb_study::api::load_record_apparatus(bars)?;
-        let rec = match read_as.layout {
-            None => shpb_core::gauge::RawRecord::read(record)?,
-            Some(l) => {
-                let layout = shpb_input::layout::RecordLayout::from_file(l)?;
-                match layout.read(record)? {
-                    shpb_input::layout::LayoutRecord::Voltages(r) => r,
-                    shpb_input::layout::LayoutRecord::Strains(_) => {
-                        return Err(Error::Input {
-                            file: layout.source.clone(),
-                            key: "incident.unit".into(),
-                            problem: "the layout reads bar strains; `shpb strain` converts bridge \
-                                      voltages"
-                                .into(),
-                            allowed: "a layout with V or mV channels (strain records go to \
-                                      `shpb reduce --layout` directly)"
-                                .into(),
-                        });
-                    }
-                }
+        let layout = read_as
+            .layout
+            .map(shpb_input::layout::RecordLayout::from_file)
+            .transpose()?;
+        let rec = match shpb_input::sheet::read_record(record, layout.as_ref())? {
+            shpb_input::layout::LayoutRecord::Voltages(r) => r,
+            shpb_input::layout::LayoutRecord::Strains(_) => {
+                return Err(Error::Input {
+                    file: layout.map_or(record.display().to_string(), |l| l.source),
+                    key: "incident.unit".into(),
+                    problem: "the record holds bar strains; `shpb strain` converts bridge \
+                              voltages"
+                        .into(),
+                    allowed: "a record or layout with V or mV channels (strain records go to \
+                              `shpb reduce` directly)"
+                        .into(),
+                });
             }
         };
         Ok((apparatus, rec))

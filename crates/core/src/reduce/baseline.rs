@@ -149,6 +149,19 @@ pub fn record_strains(
     let n = baseline_samples.min(record.time_s.len() / 2);
     let inc = channel(apparatus, "incident")?;
     let tra = channel(apparatus, "transmission")?;
+    for c in [inc, tra] {
+        if c.bridge.kind == crate::gauge::BridgeKind::Linear && c.bridge.strain_per_volt.is_nan() {
+            return Err(crate::error::Named::new(apparatus.source.clone()).error(
+                "strain_per_volt",
+                format!(
+                    "the `{}` channel states no strain per volt (nan), and the record is in volts",
+                    c.name
+                ),
+                "the channel's factor (`shpb setup new --strain-per-volt K`, or `shpb calibrate` \
+                 from paired volt and strain files), or a record in strain or microstrain",
+            ));
+        }
+    }
     Ok(ReductionInput {
         time_s: record.time_s.clone(),
         incident_strain: inc.strains_from_voltages(&debias(&record.incident_v, n)),

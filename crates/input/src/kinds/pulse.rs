@@ -464,7 +464,6 @@ fn incident_drive(
     base_dir: &Path,
     v: &Validator,
 ) -> Result<shpb_core::apparatus::IncidentDrive> {
-    use crate::gauges::RawRecordFile as _;
     let rv = v.table("incident_record");
     let path = base_dir.join(&r.file);
     if !crate::files::is_file(&path) {
@@ -477,7 +476,7 @@ fn incident_drive(
     // The record as bridge voltages (through the set-up's bridges) or, through a layout, as
     // voltages or bar strains.
     let mut record = match &r.layout {
-        None => crate::layout::LayoutRecord::Voltages(shpb_core::gauge::RawRecord::read(&path)?),
+        None => crate::sheet::read_record(&path, None)?,
         Some(l) => {
             let layout_path = base_dir.join(l);
             if !crate::files::is_file(&layout_path) {
@@ -487,7 +486,8 @@ fn incident_drive(
                     "a record layout .toml (README, *Record layouts*) relative to the scene file",
                 ));
             }
-            crate::layout::RecordLayout::from_file(&layout_path)?.read(&path)?
+            let layout = crate::layout::RecordLayout::from_file(&layout_path)?;
+            crate::sheet::read_record(&path, Some(&layout))?
         }
     };
     let samples = record.samples();

@@ -673,7 +673,7 @@ fn main() {
     let (m, k, loss) = if only_shipped {
         let (k, loss) = match a.gun {
             Gun::Linear(g) => (g.k_m2_per_s2_per_pa, g.loss_pressure_pa),
-            Gun::Adiabatic(_) => (f64::NAN, f64::NAN),
+            Gun::Adiabatic(_) | Gun::None => (f64::NAN, f64::NAN),
         };
         (shipped, k, loss)
     } else {
