@@ -7,10 +7,13 @@ use argmin::core::{CostFunction, Executor};
 use argmin::solver::neldermead::NelderMead;
 use std::cell::RefCell;
 
+/// An objective: the value at a point.
+type Objective<'f> = &'f mut dyn FnMut(&[f64]) -> f64;
+
 /// The closure as argmin's cost function, counting evaluations and keeping the best point;
 /// past the budget it stops the run (an error argmin returns, caught by [`nelder_mead`]).
 struct Budgeted<'f, 's> {
-    f: RefCell<&'f mut dyn FnMut(&[f64]) -> f64>,
+    f: RefCell<Objective<'f>>,
     /// Evaluations, best value, best point.
     state: &'s RefCell<(usize, f64, Vec<f64>)>,
     budget: usize,
