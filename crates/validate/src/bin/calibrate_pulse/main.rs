@@ -541,7 +541,9 @@ fn optimiser_section(
         shipped.velocity_m_s[2],
         if all {
             "Every constant agrees within its 1-sigma, so bars/authors.toml keeps the hand-written optimiser's \
-             values, and every table below evaluates them."
+             values, and every table below evaluates them. The leave-one-out fits below \
+             (`shaper_loo -- --refit`, validation/pulse/shaper_loo_fits.toml) run on the same argmin \
+             minimiser."
         } else {
             "**Not every constant agrees within its 1-sigma**: see the table."
         }
