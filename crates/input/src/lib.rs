@@ -24,6 +24,7 @@ pub mod resources;
 pub mod scene;
 pub mod setup;
 pub mod sheet;
+pub mod shots;
 pub mod specimen;
 pub mod specimen_file;
 mod toml_file;

@@ -584,16 +584,58 @@ pub fn reduce_record_with(
         (None, None) => run_specimen,
     };
     options.specimen_radii_m = specimen.radii_m();
-    let reduction = if hdf5_input {
+    let input = match &choices.channels {
+        // A record kept one file per oscilloscope channel (`--channel ROLE=FILE`).
+        Some(set) => {
+            shpb_core::reduce::record_strains(&set.read()?, &apparatus, options.baseline_samples)?
+        }
+        None => record_input(
+            record,
+            &apparatus,
+            choices.layout.as_ref(),
+            own_set_up,
+            options.baseline_samples,
+        )?,
+    };
+    let reduction = shpb_core::reduce::reduce_named(
+        &input,
+        &ReductionSetup::from_apparatus(&apparatus)?,
+        &options,
+        &record.display().to_string(),
+    )?;
+    let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
+    Ok(Reduced {
+        reduction,
+        apparatus,
+        hdf5_input,
+        cylinder,
+        specimen,
+    })
+}
+
+/// The gauge strains of a record, the one way every command reads one (`shpb reduce`,
+/// `shpb calibrate`): an HDF5 file of `shpb run` (its digitised voltages through `apparatus`'s
+/// bridges when `run_voltages`, else its strains), or a text or spreadsheet record through
+/// `shpb_input::sheet::read_record` (a layout, the authors' CSV, columns named with their units);
+/// voltage baselines are the mean of the first
+/// `baseline_samples` samples.
+pub fn record_input(
+    record: &Path,
+    apparatus: &Apparatus,
+    layout: Option<&shpb_input::layout::RecordLayout>,
+    run_voltages: bool,
+    baseline_samples: usize,
+) -> Result<ReductionInput> {
+    if shpb_output::reduction::is_hdf5(record)? {
         // A run file with its own set-up is read as the lab reads a record: its digitised
         // voltages through the set-up's bridges, exactly as the run reduced them; otherwise (a
         // file of `shpb strain`, or without voltages) its strains.
-        let voltages = if own_set_up {
+        let voltages = if run_voltages {
             shpb_output::reduction::read_hdf5_voltages(record)?
         } else {
             None
         };
-        let input = match voltages {
+        return match voltages {
             Some(shpb_core::gauge::RawRecord {
                 time_s,
                 incident_v,
@@ -603,59 +645,26 @@ pub fn reduce_record_with(
                     apparatus.gauges.channel(name).ok_or_else(|| {
                         input_err(
                             "RECORD",
-                            format!(
-                                "the run's set-up {} has no `{name}` gauge",
-                                apparatus.source
-                            ),
-                            "a run file of a set-up with incident and transmission gauges",
+                            format!("the set-up {} has no `{name}` gauge", apparatus.source),
+                            "a set-up with incident and transmission gauges",
                         )
                     })
                 };
-                ReductionInput {
+                Ok(ReductionInput {
                     time_s,
                     incident_strain: channel("incident")?.strains_from_voltages(&incident_v),
                     transmission_strain: channel("transmission")?
                         .strains_from_voltages(&transmission_v),
-                }
+                })
             }
-            None => shpb_output::reduction::read_hdf5_strains(record)?,
+            None => shpb_output::reduction::read_hdf5_strains(record),
         };
-        shpb_core::reduce::reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &record.display().to_string(),
-        )?
-    } else if let Some(set) = &choices.channels {
-        let input =
-            shpb_core::reduce::record_strains(&set.read()?, &apparatus, options.baseline_samples)?;
-        shpb_core::reduce::reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &record.display().to_string(),
-        )?
-    } else {
-        // Every text or spreadsheet record through the one reader (a layout, the authors' CSV,
-        // or columns named with their units).
-        let input = shpb_input::sheet::read_record(record, choices.layout.as_ref())
-            .map_err(|e| channel_file_hint(record, e))?
-            .into_strains(&apparatus, options.baseline_samples)?;
-        shpb_core::reduce::reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &record.display().to_string(),
-        )?
-    };
-    let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
-    Ok(Reduced {
-        reduction,
-        apparatus,
-        hdf5_input,
-        cylinder,
-        specimen,
-    })
+    }
+    // Every text or spreadsheet record through the one reader (a layout, the authors' CSV, or
+    // columns named with their units).
+    Ok(shpb_input::sheet::read_record(record, layout)
+        .map_err(|e| channel_file_hint(record, e))?
+        .into_strains(apparatus, baseline_samples)?)
 }
 
 /// The set-up and specimen a run file was simulated with (its spheres' radii or its cylinder;
