@@ -387,8 +387,12 @@ pub enum Command {
     /// (comments kept), an [uncertainty] table, and its gauge file beside it
     /// (SETUP-gauges.toml).
     Calibrate {
-        /// The shots manifest (.toml).
-        shots: PathBuf,
+        /// The shots manifest (.toml); may be left out with `--paired`.
+        shots: Option<PathBuf>,
+        /// A shot's record in volts and the same shot in strain (e.g. a lab's raw_voltage and
+        /// raw_microstrain files): each channel's strain per volt, written as a linear channel.
+        #[arg(long, num_args = 2, value_names = ["VOLTS", "STRAINS"])]
+        paired: Option<Vec<PathBuf>>,
         /// The base set-up whose other constants are kept: a built-in set-up or a set-up file.
         #[arg(long, default_value = DEFAULT_BARS)]
         bars: PathBuf,
@@ -821,10 +825,17 @@ pub fn dispatch(cli: Cli) -> Result<()> {
         } => cmd::curve::curve(&specimen, rate, to, points, law.into()),
         Command::Calibrate {
             shots,
+            paired,
             bars,
             output,
             force,
-        } => cmd::calibrate::calibrate(&shots, &bars, &output, force),
+        } => cmd::calibrate::calibrate(
+            shots.as_deref(),
+            paired.as_deref().map(|p| (p[0].as_path(), p[1].as_path())),
+            &bars,
+            &output,
+            force,
+        ),
         Command::Gun { pressure, bars } => cmd::gun::gun(&pressure, &bars),
         Command::Incident {
             record,

@@ -326,6 +326,43 @@ fn volt_records_reduce_alike_with_the_factor_of_their_paired_strain_files() {
 }
 
 #[test]
+fn volt_records_reduce_alike_through_the_set_up_shpb_calibrate_writes_from_the_pair() {
+    // `shpb calibrate --paired VOLTS STRAINS` on the set-up of `shpb setup new`: the written
+    // set-up's linear channels read the volt record to the lab's 3-wave peak (within 3 %).
+    let tmp = tempfile::tempdir().unwrap();
+    for (material, sample) in [("steel_945", "sample_01"), ("epoxy_resin", "sample_02")] {
+        let shot = shot(material, sample);
+        let base = setup(tmp.path(), material, None);
+        let calibrated = tmp
+            .path()
+            .join(format!("{material}-{sample}-calibrated.toml"));
+        let out = shpb(
+            tmp.path(),
+            &[
+                "calibrate",
+                "--paired",
+                &shot.volt_record.display().to_string(),
+                &shot.strain_record.display().to_string(),
+                "--bars",
+                &base.display().to_string(),
+                "-o",
+                &calibrated.display().to_string(),
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = std::fs::read_to_string(&calibrated).unwrap();
+        assert_eq!(text.matches("bridge = \"linear\"").count(), 2, "{text}");
+        let spec = specimen(tmp.path(), material);
+        let r = reduce(tmp.path(), &shot.volt_record, &calibrated, &spec, &shot);
+        check(
+            &format!("{material} {sample} volts through `shpb calibrate --paired`"),
+            &r,
+            &shot,
+        );
+    }
+}
+
+#[test]
 fn epoxy_sample_01s_strain_file_is_its_volts_over_four_million() {
     // The measurement behind leaving `raw_strain.csv` of epoxy sample_01 out of the stress
     // comparison: its "ε" columns are the volts times 2.5e-7, where the lab's own processing of

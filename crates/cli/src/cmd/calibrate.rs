@@ -7,7 +7,9 @@ use shpb_input::prelude::*;
 use shpb_input::shots::ShotManifest;
 use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, check_output_path, write_text_atomically};
-use shpb_study::calibrate::{Calibration, Data, calibrate as run_calibrations, setup_file};
+use shpb_study::calibrate::{
+    Calibration, Data, Fitted, SdFrom, calibrate as run_calibrations, setup_file,
+};
 use std::path::{Path, PathBuf};
 
 /// The gauge file written beside `output`: `<stem>-gauges.toml`.
@@ -28,7 +30,13 @@ pub fn gauges_path(output: &Path) -> PathBuf {
 /// shpb_study::strain_factor) is a calibration of its own: it joins the constants here, as a
 /// `gauges.<channel>.strain_per_volt` [`shpb_study::calibrate::Fitted`], before the set-up is
 /// written.
-pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Result<()> {
+pub fn calibrate(
+    shots: Option<&Path>,
+    paired: Option<(&Path, &Path)>,
+    bars: &Path,
+    output: &Path,
+    force: bool,
+) -> Result<()> {
     if shpb_output::atomic::is_stdout(output) {
         return Err(shpb_study::api::input_err(
             "-o",
@@ -38,7 +46,16 @@ pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Resul
     }
     check_output_path(output, force, "-o", &["toml"])?;
     let gauges_out = gauges_path(output);
-    if !shots.is_file() {
+    if shots.is_none() && paired.is_none() {
+        return Err(shpb_study::api::input_err(
+            "SHOTS",
+            "nothing to calibrate on",
+            "a shots manifest, --paired VOLTS STRAINS, or both",
+        ));
+    }
+    if let Some(shots) = shots
+        && !shots.is_file()
+    {
         return Err(shpb_study::api::input_err(
             "SHOTS",
             format!("cannot read {}: no such file", shots.display()),
@@ -47,24 +64,45 @@ pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Resul
         ));
     }
     let (base_name, base_text, base_gauges) = setup_file::read_base(bars)?;
-    let manifest = ShotManifest::from_file(shots)?;
+    let manifest = shots.map(ShotManifest::from_file).transpose()?;
     if base_gauges.is_some() {
         check_output_path(&gauges_out, force, "-o", &["toml"])?;
     }
-    let mut inputs: Vec<PathBuf> = vec![shots.to_path_buf(), bars.to_path_buf()];
-    inputs.extend(manifest.shots.iter().map(|s| s.file.clone()));
+    let mut inputs: Vec<PathBuf> = vec![bars.to_path_buf()];
+    inputs.extend(shots.map(Path::to_path_buf));
+    if let Some(m) = &manifest {
+        inputs.extend(m.shots.iter().map(|s| s.file.clone()));
+    }
+    if let Some((v, s)) = paired {
+        inputs.extend([v.to_path_buf(), s.to_path_buf()]);
+    }
     check_not_input(output, "-o", &inputs)?;
     check_not_input(&gauges_out, "-o", &inputs)?;
 
     let base = shpb_study::api::load_apparatus(bars)?;
-    let data = Data::read(base, &manifest)?;
-    let show = !quiet_mode();
-    let mut progress = |line: &str| {
-        if show {
-            eprintln!("calibrate: {line}");
+    let mut c = match &manifest {
+        Some(manifest) => {
+            let data = Data::read(base, manifest)?;
+            let show = !quiet_mode();
+            let mut progress = |line: &str| {
+                if show {
+                    eprintln!("calibrate: {line}");
+                }
+            };
+            run_calibrations(&data, &mut progress)?
         }
+        None => Calibration {
+            fitted_on: String::new(),
+            shots: 0,
+            constants: Vec::new(),
+            scatter: Vec::new(),
+            ran: Vec::new(),
+        },
     };
-    let c = run_calibrations(&data, &mut progress)?;
+    if let Some((volts, strains)) = paired {
+        paired_factor(&mut c, volts, strains)?;
+    }
+    let shots = shots.unwrap_or(Path::new("--paired"));
 
     let gauges_name = gauges_out
         .file_name()
@@ -97,6 +135,38 @@ pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Resul
     wrote(output);
     let gauges_written = texts.gauges.as_ref().map(|_| gauges_out.as_path());
     report(&text(&c), || json(&c, output, gauges_written))
+}
+
+/// The strain factor of each channel from a shot's paired volt and strain records
+/// (shpb_study::strain_factor: least squares ε = k·V + b), joined to the calibration as
+/// `gauges.<channel>.strain_per_volt` with its standard error.
+fn paired_factor(c: &mut Calibration, volts: &Path, strains: &Path) -> Result<()> {
+    let f = shpb_study::strain_factor::strain_factor(volts, strains)?;
+    let on = format!(
+        "paired records {} (V) and {} (strain), least squares over {} samples",
+        volts.display(),
+        strains.display(),
+        f.incident.samples
+    );
+    for (channel, k) in [("incident", &f.incident), ("transmission", &f.transmission)] {
+        c.constants.push(Fitted {
+            key: format!("gauges.{channel}.strain_per_volt"),
+            value: k.strain_per_volt,
+            unit: "1/V",
+            sd: Some(k.standard_error),
+            sd_from: SdFrom::Covariance,
+            fitted_on: format!("{on}; residual {:.3e} RMS", k.residual_rms_strain),
+            uncertain: true,
+        });
+    }
+    if c.fitted_on.is_empty() {
+        c.fitted_on = on;
+    } else {
+        c.fitted_on = format!("{}; {on}", c.fitted_on);
+    }
+    c.shots = c.shots.max(1);
+    c.ran.push(("paired-strain-factor", None));
+    Ok(())
 }
 
 /// Warns when the written set-up (without its `[uncertainty]` table, which another part of

@@ -143,9 +143,11 @@ pub fn rewrite(
         let same: Vec<&Fitted> = c.constants.iter().filter(|g| g.key == f.key).collect();
         let parts: Vec<&str> = f.key.split('.').collect();
         if parts[0] == "gauges" && parts.len() == 3 {
-            let g = gdoc
-                .as_mut()
-                .ok_or_else(|| base_err(setup_name, "gauges", "no gauge file to calibrate"))?;
+            // The channels of the gauge file, or those inline in the set-up (`[[channel]]`).
+            let g = match gdoc.as_mut() {
+                Some(g) => g,
+                None => &mut doc,
+            };
             set_gauge(g, parts[1], parts[2], f, setup_name)?;
             continue;
         }
@@ -232,7 +234,7 @@ fn set_gauge(g: &mut DocumentMut, channel: &str, key: &str, f: &Fitted, file: &s
     let channels = g
         .get_mut("channel")
         .and_then(Item::as_array_of_tables_mut)
-        .ok_or_else(|| base_err(file, "gauges", "the gauge file has no [[channel]]"))?;
+        .ok_or_else(|| base_err(file, "gauges", "no [[channel]] in the gauge file or set-up"))?;
     let t = channels
         .iter_mut()
         .find(|t| t.get("name").and_then(Item::as_str) == Some(channel))
