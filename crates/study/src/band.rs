@@ -80,9 +80,10 @@ pub struct Prediction {
     pub warnings: Vec<String>,
 }
 
-/// The uncertain inputs of `params`: its set-up's `[uncertainty]` constants and, when the scene
-/// fires the gun (a pressure, no recorded drive) of a set-up stating a velocity scatter, that
-/// scatter. Empty for a scene without bars.
+/// The uncertain inputs of `params`: its set-up's `[uncertainty]` constants that the scene uses
+/// (the gun's, `gun.*`, only when it fires the gun: a pressure; the shaper's, `shaper.*`, not in a
+/// test a recorded wave drives, which has neither) and, when the scene fires the gun of a set-up
+/// stating a velocity scatter, that scatter. Empty for a scene without bars.
 pub fn inputs(params: &Params) -> Vec<BandInput> {
     let SceneParams::Pulse {
         apparatus,
@@ -92,10 +93,13 @@ pub fn inputs(params: &Params) -> Vec<BandInput> {
     else {
         return Vec::new();
     };
+    let gun = pressure_pa.is_finite() && options.incident_drive.is_none();
+    let driven = options.incident_drive.is_some();
     let mut v: Vec<BandInput> = apparatus
         .uncertainty
         .iter()
         .flat_map(|u| &u.inputs)
+        .filter(|i| !(i.key.starts_with("gun.") && !gun || i.key.starts_with("shaper.") && driven))
         .map(|i| BandInput {
             key: i.key.clone(),
             value: i.value,
@@ -104,8 +108,7 @@ pub fn inputs(params: &Params) -> Vec<BandInput> {
         .collect();
     if let Some(s) = apparatus.gun_velocity_scatter
         && s > 0.0
-        && pressure_pa.is_finite()
-        && options.incident_drive.is_none()
+        && gun
     {
         v.push(BandInput {
             key: VELOCITY_SCATTER.into(),

@@ -1029,6 +1029,23 @@ mod tests {
     }
 
     #[test]
+    fn a_row_s_warnings_survive_the_checkpoint_line() {
+        // Warnings hold commas and quotes: one quoted cell (RFC 4180), read back as written.
+        let mut r = RunSummary::from_values(3, vec!["7psi".into()], [1.0, 2.0, 3.0, 4.0, 5.0]);
+        r.warnings = vec![
+            "gun pressure 7 psi is outside 10 to 15 psi, the pressures".into(),
+            "a \"quoted\" word".into(),
+        ];
+        let line = row_line(&r);
+        let back = parse_row(line.trim_end(), 1).unwrap();
+        assert_eq!(back, r);
+        let none = RunSummary::from_values(4, vec!["8psi".into()], [1.0; 5]);
+        assert!(row_line(&none).ends_with(",\n"));
+        assert_eq!(parse_row(row_line(&none).trim_end(), 1).unwrap(), none);
+        assert_eq!(split_csv_line("a,\"b, c\",\"\""), ["a", "b, c", ""]);
+    }
+
+    #[test]
     fn a_key_set_twice_is_an_error_naming_it() {
         for set in [
             &["pressure=7psi,8psi", "pressure=9psi"][..],
@@ -1104,7 +1121,7 @@ mod tests {
         assert_eq!(
             lines.next().unwrap(),
             "run,pressure_Pa,shaper.thickness_m,law,peak_force_N,displacement_at_peak_m,\
-             peak_strain_rate_per_s,equilibrium_ratio_at_peak_1,time_to_equilibrium_s"
+             peak_strain_rate_per_s,equilibrium_ratio_at_peak_1,time_to_equilibrium_s,warnings"
         );
         let cells: Vec<&str> = lines.next().unwrap().split(',').collect();
         let pa: f64 = cells[1].parse().unwrap();
