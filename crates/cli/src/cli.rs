@@ -166,6 +166,9 @@ pub struct Jobs {
 }
 
 /// Subcommands.
+// One value, parsed once per process: `reduce`'s many flags make it the largest variant, and
+// boxing them would buy nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Run a scene file and write its results (HDF5, optional CSV and PNG).
@@ -424,8 +427,14 @@ pub enum Command {
     /// equilibrium_ratio, approach_velocity}; several records make a batch.
     Reduce {
         /// The records (.csv or .h5); several reduce as a batch (see --summary, --report).
-        #[arg(required = true, num_args = 1..)]
+        #[arg(required_unless_present = "channel", num_args = 1..)]
         record: Vec<PathBuf>,
+        /// A record kept one file per oscilloscope channel, each with a header block (record
+        /// length, sample interval, trigger, horizontal offset): ROLE=FILE, ROLE incident or
+        /// transmission, repeated; a gauge's several files are averaged (e.g. gauges on opposite
+        /// faces). Instead of RECORD.
+        #[arg(long, value_name = "ROLE=FILE", conflicts_with_all = ["record", "layout"])]
+        channel: Vec<String>,
         /// Bar set-up (bars, gauge distances, bridge, gain, polarity): a built-in set-up
         /// (`shpb list`) or a set-up file [default: a run file's own set-up, else `authors`].
         /// For a run file, a set-up that differs from the one it was simulated with is refused.
@@ -727,7 +736,15 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             specimen,
             plot,
             force,
+            channel,
         } => {
+            let channels = (!channel.is_empty())
+                .then(|| shpb_input::channel_file::ChannelSet::from_specs(&channel, "--channel"))
+                .transpose()?;
+            let record = match &channels {
+                Some(set) => vec![set.name()],
+                None => record,
+            };
             let window = shpb_core::reduce::WindowOverride {
                 incident_start_s: incident_start,
                 reflected_delay_s: reflected_delay,
@@ -769,6 +786,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                         .as_deref()
                         .map(shpb_input::specimen_file::SpecimenFile::read)
                         .transpose()?,
+                    channels,
                 },
             )
         }

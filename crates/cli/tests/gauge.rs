@@ -18,9 +18,10 @@ const NU: f64 = 0.31;
 const VEX: f64 = 15.0;
 const GF: f64 = 2.12;
 
-const KINDS: [BridgeKind; 3] = [
+const KINDS: [BridgeKind; 4] = [
     BridgeKind::QuarterAxial,
     BridgeKind::HalfPoisson,
+    BridgeKind::HalfAxial,
     BridgeKind::FullPoisson,
 ];
 
@@ -89,6 +90,7 @@ fn arms(kind: BridgeKind, strain: f64) -> [f64; 4] {
     match kind {
         BridgeKind::QuarterAxial => [axial, 1.0, 1.0, 1.0],
         BridgeKind::HalfPoisson => [axial, poisson, 1.0, 1.0],
+        BridgeKind::HalfAxial => [axial, 1.0, axial, 1.0],
         BridgeKind::FullPoisson => [axial, poisson, axial, poisson],
     }
 }
@@ -603,7 +605,7 @@ fn gauge_file_errors_name_file_key_and_allowed_range() {
             "bad.toml",
             "channel[1].bridge",
             "half",
-            "\"quarter-axial\", \"half-poisson\", \"full-poisson\"",
+            "\"quarter-axial\", \"half-poisson\", \"half-axial\", \"full-poisson\"",
         ],
     );
     let msg = toml_error(&second("polarity = -1.0", "polarity = 0.5"));

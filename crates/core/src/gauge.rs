@@ -17,6 +17,10 @@
 //!   `V = Vex·x / (2(2 + x))`, inverse `ε = 4V / (GF·(Vex − 2V))`;
 //! * half bridge, axial (R1) and Poisson (R2) gauges in adjacent arms, R3 = R4 = R:
 //!   `V = Vex·x(1+ν) / (2(2 + x(1−ν)))`, inverse `ε = 4V / (Vex·GF·((1+ν) + 2V(ν−1)/Vex))`;
+//! * half bridge, two axial gauges in opposite arms (R1 and R3, e.g. on opposite faces of the
+//!   bar, so bending cancels), R2 = R4 = R: `V = Vex·x / (2 + x)`, inverse
+//!   `ε = 2V / (GF·(Vex − V))`; to first order `ε = 2V/(GF·Vex)`, the conversion of LANL's
+//!   HopPyBar (`2/GF` over gain·excitation);
 //! * full bridge, axial gauges in R1 and R3, Poisson gauges in R2 and R4:
 //!   `V = Vex·x(1+ν) / (2 + x(1−ν))` (exactly twice the half bridge),
 //!   inverse `ε = 2V / (Vex·GF·((1+ν) + V(ν−1)/Vex))`.
@@ -34,15 +38,18 @@ pub enum BridgeKind {
     QuarterAxial,
     /// Axial + Poisson gauge in adjacent arms: `V = Vex·x(1+ν)/(2(2+x(1−ν)))`.
     HalfPoisson,
+    /// Two axial gauges in opposite arms: `V = Vex·x/(2+x)` (HopPyBar's 2/GF to first order).
+    HalfAxial,
     /// Two axial + two Poisson gauges: `V = Vex·x(1+ν)/(2+x(1−ν))`; the authors' formula exactly.
     FullPoisson,
 }
 
 impl BridgeKind {
     /// Every kind with its name in a gauge file (`bridge = "half-poisson"`).
-    pub const ALL: [(BridgeKind, &'static str); 3] = [
+    pub const ALL: [(BridgeKind, &'static str); 4] = [
         (BridgeKind::QuarterAxial, "quarter-axial"),
         (BridgeKind::HalfPoisson, "half-poisson"),
+        (BridgeKind::HalfAxial, "half-axial"),
         (BridgeKind::FullPoisson, "full-poisson"),
     ];
 
@@ -86,6 +93,7 @@ impl Bridge {
         match self.kind {
             BridgeKind::QuarterAxial => vex * x / (2.0 * (2.0 + x)),
             BridgeKind::HalfPoisson => vex * x * (1.0 + nu) / (2.0 * (2.0 + x * (1.0 - nu))),
+            BridgeKind::HalfAxial => vex * x / (2.0 + x),
             BridgeKind::FullPoisson => vex * x * (1.0 + nu) / (2.0 + x * (1.0 - nu)),
         }
     }
@@ -99,16 +107,19 @@ impl Bridge {
             BridgeKind::HalfPoisson => {
                 4.0 * v / (vex * gf * ((1.0 + nu) + 2.0 * v * (nu - 1.0) / vex))
             }
+            BridgeKind::HalfAxial => 2.0 * v / (gf * (vex - v)),
             BridgeKind::FullPoisson => 2.0 * v / (vex * gf * ((1.0 + nu) + v * (nu - 1.0) / vex)),
         }
     }
 
-    /// Small-strain sensitivity dV/dε at ε = 0, V: Vex·GF/4, Vex·GF(1+ν)/4, Vex·GF(1+ν)/2.
+    /// Small-strain sensitivity dV/dε at ε = 0, V: Vex·GF/4, Vex·GF(1+ν)/4, Vex·GF/2,
+    /// Vex·GF(1+ν)/2.
     pub fn sensitivity_v(&self) -> f64 {
         let base = self.excitation_v * self.gauge_factor / 4.0;
         match self.kind {
             BridgeKind::QuarterAxial => base,
             BridgeKind::HalfPoisson => base * (1.0 + self.poisson_ratio),
+            BridgeKind::HalfAxial => 2.0 * base,
             BridgeKind::FullPoisson => 2.0 * base * (1.0 + self.poisson_ratio),
         }
     }

@@ -8,8 +8,10 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod channel_file;
 pub mod csv;
 pub mod cylinder;
+pub mod deck;
 pub mod distribution;
 pub mod error;
 pub mod files;

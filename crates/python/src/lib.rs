@@ -599,6 +599,7 @@ fn reduce(
                 .as_deref()
                 .map(shpb_input::specimen_file::SpecimenFile::read)
                 .transpose()?,
+            channels: None,
         };
         let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;
         let mut scene = format!(

@@ -63,6 +63,22 @@ pub fn load_apparatus(bars: &Path) -> Result<Apparatus> {
     }
 }
 
+/// The bar set-up of a reduction named by `--bars`: [`load_apparatus`]'s, or a lab's input deck
+/// (`shpb_input::deck`, recognised by its content) with the specimen it names. A deck states no
+/// gun, so only the reductions read it, not the commands that fire the gun.
+pub fn load_record_apparatus(
+    bars: &Path,
+) -> Result<(
+    Apparatus,
+    Option<shpb_core::reduce_cylinder::CylinderGeometry>,
+)> {
+    if bars.is_file() && shpb_input::deck::Deck::is_deck_file(bars) {
+        let deck = shpb_input::deck::Deck::read(bars)?;
+        return Ok((deck.apparatus, Some(deck.specimen)));
+    }
+    Ok((load_apparatus(bars)?, None))
+}
+
 /// The `--pressure` option read and checked against the set-up's gun: (gauge pressure Pa,
 /// striker velocity m/s).
 pub fn gun_shot(apparatus: &Apparatus, pressure: &str) -> Result<(f64, f64)> {
@@ -358,6 +374,9 @@ pub struct RecordOptions {
     /// The specimen of a specimen file (`--specimen FILE.toml`: spheres of any diameter, a chain,
     /// or a cylinder; for a run file it overrides the run's own). Not with `cylinder`.
     pub specimen: Option<shpb_input::specimen_file::SpecimenFile>,
+    /// A record kept one file per channel (`--channel ROLE=FILE`); the record argument is then
+    /// its name ([`shpb_input::channel_file::ChannelSet::name`]).
+    pub channels: Option<shpb_input::channel_file::ChannelSet>,
 }
 
 impl RecordOptions {
@@ -402,6 +421,9 @@ impl RecordOptions {
         if let Some(s) = &self.specimen {
             c.push_str(&format!(" --specimen {}", s.source));
         }
+        if let Some(set) = &self.channels {
+            c.push_str(&set.command_flags());
+        }
         c
     }
 }
@@ -418,6 +440,7 @@ impl Default for RecordOptions {
             cylinder: None,
             layout: None,
             specimen: None,
+            channels: None,
         }
     }
 }
@@ -498,12 +521,32 @@ pub fn reduce_record_with(
             "--layout only with text records",
         ));
     }
+    if let Some(set) = &choices.channels {
+        if hdf5_input || choices.layout.is_some() {
+            return Err(input_err(
+                "--channel",
+                "a record of channel files is read from their header blocks",
+                "--channel files without --layout, and no run file (HDF5) among them",
+            ));
+        }
+        if set.name() != record {
+            return Err(input_err(
+                "--channel",
+                format!(
+                    "the record {} is not the set's first incident file {}",
+                    record.display(),
+                    set.name().display()
+                ),
+                "the set's name (ChannelSet::name) as the record",
+            ));
+        }
+    }
     let run = if hdf5_input { run_setup(record)? } else { None };
     let own_set_up = run.is_some();
     let (apparatus, run_specimen) = match run {
         Some((run_apparatus, run_specimen)) => {
             if let Some(flag) = bars_flag {
-                let given = load_apparatus(flag)?;
+                let (given, _) = load_record_apparatus(flag)?;
                 if ReductionSetup::from_apparatus(&given)?
                     != ReductionSetup::from_apparatus(&run_apparatus)?
                 {
@@ -523,7 +566,14 @@ pub fn reduce_record_with(
             }
             (run_apparatus, run_specimen)
         }
-        None => (load_apparatus(bars)?, ReducedSpecimen::default()),
+        None => {
+            // A lab's deck names its specimen, the default of a record reduced with it.
+            let (apparatus, deck_specimen) = load_record_apparatus(bars)?;
+            (
+                apparatus,
+                deck_specimen.map_or_else(ReducedSpecimen::default, ReducedSpecimen::Cylinder),
+            )
+        }
     };
     // The specimen: a specimen file's, the cylinder flags', else the run file's own (a cylinder
     // or its spheres), else the paper's spheres. A cylinder's rate is its own (its 1/2/3-wave
@@ -576,6 +626,15 @@ pub fn reduce_record_with(
             &options,
             &record.display().to_string(),
         )?
+    } else if let Some(set) = &choices.channels {
+        let input =
+            shpb_core::reduce::record_strains(&set.read()?, &apparatus, options.baseline_samples)?;
+        shpb_core::reduce::reduce_named(
+            &input,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &options,
+            &record.display().to_string(),
+        )?
     } else if let Some(layout) = &choices.layout {
         let name = record.display().to_string();
         let input = layout
@@ -588,7 +647,22 @@ pub fn reduce_record_with(
             &name,
         )?
     } else {
-        shpb_input::gauges::reduce_record_file(record, &apparatus, &options)?
+        shpb_input::gauges::reduce_record_file(record, &apparatus, &options).map_err(|e| {
+            // One oscilloscope channel of a record kept one file per channel: say how to give it.
+            let text = std::fs::read(record).unwrap_or_default();
+            if shpb_input::channel_file::is_channel_file(&String::from_utf8_lossy(&text)) {
+                input_err(
+                    "RECORD",
+                    format!(
+                        "{} is one oscilloscope channel with a header block (a record kept one file per channel)",
+                        record.display()
+                    ),
+                    "the record's channel files as --channel incident=FILE --channel transmission=FILE (a gauge's several files are averaged)",
+                )
+            } else {
+                e
+            }
+        })?
     };
     let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
     Ok(Reduced {

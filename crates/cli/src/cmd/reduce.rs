@@ -50,8 +50,11 @@ fn figure_path(report: &Path, records: &[PathBuf], k: usize) -> PathBuf {
 /// The command line that reproduces this reduction (stored in the outputs).
 fn command_line(records: &[PathBuf], bars: &str, o: &Outputs, choices: &RecordOptions) -> String {
     let mut c = String::from("shpb reduce");
-    for r in records {
-        c.push_str(&format!(" {}", r.display()));
+    // A record of channel files is named by its first file; its --channel flags give it.
+    if choices.channels.is_none() {
+        for r in records {
+            c.push_str(&format!(" {}", r.display()));
+        }
     }
     c.push_str(&format!(" --bars {bars}"));
     for (flag, p) in [
@@ -103,6 +106,9 @@ pub fn reduce_command(
         });
     }
     let mut inputs: Vec<PathBuf> = records.to_vec();
+    if let Some(set) = &choices.channels {
+        inputs.extend(set.files.iter().map(|(_, p)| p.clone()));
+    }
     inputs.push(bars.to_path_buf());
     if let Some(s) = &choices.specimen {
         inputs.push(PathBuf::from(&s.source));

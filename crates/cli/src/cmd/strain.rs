@@ -1,6 +1,6 @@
 //! `shpb strain`: a raw gauge record converted to bar strain with the set-up's gauge channels.
 
-use super::common::{load_apparatus, say};
+use super::common::say;
 use shpb_core::run::RunOutput;
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
@@ -39,7 +39,8 @@ pub fn strain(
         }
     }
     let (read, inputs) = shpb_input::files::capture(|| -> Result<_> {
-        let apparatus = load_apparatus(bars)?;
+        // A set-up, or a lab's input deck (its bridges and gains; `load_record_apparatus`).
+        let (apparatus, _) = shpb_study::api::load_record_apparatus(bars)?;
         let rec = match read_as.layout {
             None => shpb_core::gauge::RawRecord::read(record)?,
             Some(l) => {
