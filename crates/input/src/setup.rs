@@ -105,6 +105,8 @@ struct ApparatusToml {
     /// The gas gun; without it, scenes give the striker's velocity (`striker_velocity_m_s`).
     gun: Option<GunToml>,
     shaper: Option<ShaperToml>,
+    /// Read by [`crate::uncertainty::read`] once the rest is validated.
+    uncertainty: Option<toml::Value>,
 }
 
 /// Validates a bar material given as a TOML value (a cylindrical specimen's `material` table),
@@ -495,7 +497,7 @@ impl ApparatusFile for Apparatus {
             )?),
             None => None,
         };
-        let gauges = match (&raw.gauges, &raw.channel) {
+        let gauge_setup = match (&raw.gauges, &raw.channel) {
             (Some(g), None) => gauges(g)?,
             (None, Some(channels)) => crate::gauges::gauge_setup(channels, &v)?,
             (Some(_), Some(_)) => {
@@ -533,7 +535,7 @@ impl ApparatusFile for Apparatus {
             incident: insert("incident", &raw.inserts.incident)?,
             transmission: insert("transmission", &raw.inserts.transmission)?,
         };
-        Ok(Apparatus {
+        let mut apparatus = Apparatus {
             inserts,
             source: file,
             material,
@@ -545,8 +547,16 @@ impl ApparatusFile for Apparatus {
             gun_calibrated_pa,
             gun_velocity_scatter,
             shaper,
-            gauges,
-        })
+            gauges: gauge_setup,
+            uncertainty: None,
+        };
+        if let Some(u) = &raw.uncertainty {
+            let read = crate::uncertainty::read(u, text, &apparatus.source, &apparatus, &|t| {
+                Apparatus::from_toml(t, &apparatus.source, gauges)
+            })?;
+            apparatus.uncertainty = Some(read);
+        }
+        Ok(apparatus)
     }
 }
 

@@ -149,11 +149,15 @@ fn paired_factor(c: &mut Calibration, volts: &Path, strains: &Path) -> Result<()
         f.incident.samples
     );
     for (channel, k) in [("incident", &f.incident), ("transmission", &f.transmission)] {
+        // The set-up states k to 4 significant digits: its rounding error (uniform within half
+        // a unit u of the 4th digit, sd = u / (2√3)) bounds the 1-sigma from below.
+        let unit = 10f64.powf(k.strain_per_volt.abs().log10().floor() - 3.0);
+        let rounding = unit / (2.0 * 3f64.sqrt());
         c.constants.push(Fitted {
             key: format!("gauges.{channel}.strain_per_volt"),
             value: k.strain_per_volt,
             unit: "1/V",
-            sd: Some(k.standard_error),
+            sd: Some(k.standard_error.max(rounding)),
             sd_from: SdFrom::Covariance,
             fitted_on: format!("{on}; residual {:.3e} RMS", k.residual_rms_strain),
             uncertain: true,
