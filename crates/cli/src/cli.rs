@@ -375,6 +375,30 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "burgoyne-daraio")]
         law: LawArg,
     },
+    /// Fit a set-up's constants to a lab's own shots and write the calibrated set-up.
+    ///
+    /// SHOTS is a TOML manifest: one [[shot]] table per record (`file`, and `pressure` with its
+    /// unit and/or `striker_velocity_m_s`; optional `bars_together`, `label`, `layout`). Every
+    /// calibration whose data the shots carry runs: wave speed and gauge distances from the
+    /// pulses' arrivals, the incident strain factor from measured velocities (no shaper), the gun
+    /// line from velocities against pressure, the Frew shaper (and the gun line, without
+    /// velocities) from incident pulses at several pressures. Prints each constant with its
+    /// 1-sigma and what it was fitted on; writes the --bars set-up with those values replaced
+    /// (comments kept), an [uncertainty] table, and its gauge file beside it
+    /// (SETUP-gauges.toml).
+    Calibrate {
+        /// The shots manifest (.toml).
+        shots: PathBuf,
+        /// The base set-up whose other constants are kept: a built-in set-up or a set-up file.
+        #[arg(long, default_value = DEFAULT_BARS)]
+        bars: PathBuf,
+        /// The calibrated set-up to write (.toml); its gauge file goes beside it.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Overwrite existing files.
+        #[arg(long)]
+        force: bool,
+    },
     /// Print the striker velocity the gas gun gives at a pressure (units psi, kPa, Pa, MPa, bar).
     ///
     /// The gas does the same work W(p) on any striker (½ m v² = W, docs/physics.md §6.4): also
@@ -699,6 +723,12 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             points,
             law,
         } => cmd::curve::curve(&specimen, rate, to, points, law.into()),
+        Command::Calibrate {
+            shots,
+            bars,
+            output,
+            force,
+        } => cmd::calibrate::calibrate(&shots, &bars, &output, force),
         Command::Gun { pressure, bars } => cmd::gun::gun(&pressure, &bars),
         Command::Incident {
             record,

@@ -190,6 +190,105 @@ pub struct Reduction {
     pub warnings: Vec<String>,
 }
 
+/// The arrivals of a record's pulses by the rule of the reduction's measured delays
+/// (docs/physics.md §7.6, `--align foot`): every delay is a foot (2 % of the pulse's own peak,
+/// [`crate::gauge::pulse_foot`]) minus the incident foot, on the record's clock; what
+/// `shpb calibrate` fits the wave speed and the gauge distances to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Arrivals {
+    /// Sample step of the record, s.
+    pub dt_s: f64,
+    /// Foot of the incident pulse on the record's clock, s.
+    pub incident_foot_s: f64,
+    /// Largest compressive strain of the incident pulse (0 without one).
+    pub incident_peak_strain: f64,
+    /// Foot of the reflected (first tensile) pulse after the incident foot, s; None without one
+    /// of at least 10 % of the incident peak.
+    pub reflected_delay_s: Option<f64>,
+    /// Foot of the transmitted pulse after the incident foot, s; None without one above 10 times
+    /// the transmission gauge's noise.
+    pub transmitted_delay_s: Option<f64>,
+    /// Arrival of the incident bar's far-end reflection (the reflected pulse come back from the
+    /// impact end as compression, ideally 2 L_I/c0 after the incident foot) after the incident
+    /// foot, s: the reflected foot's delay plus the time from the reflected pulse's half-peak
+    /// rising crossing to the echo's; None when the record does not show an echo of at least
+    /// 10 % of the incident peak within half to twice 2 L_I/c0.
+    pub incident_echo_delay_s: Option<f64>,
+}
+
+/// The pulse arrivals of a record ([`Arrivals`]): conditioned as [`reduce_named`] conditions it
+/// (smoothing, baseline, polarity, incident foot) and the feet searched from half to twice the
+/// delays `setup` predicts (2 d_I/c0, d_I/c0 + d_T/c0 + the options' specimen transit, and
+/// 2 L_I/c0 for the far-end reflection), as `--align foot` measures them.
+pub fn measured_arrivals(
+    input: &ReductionInput,
+    setup: &ReductionSetup,
+    options: &ReductionOptions,
+    file: &str,
+) -> Result<Arrivals> {
+    options.validate()?;
+    let strains = baseline::condition(input, options, file)?;
+    let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
+    let dt = strains.dt;
+    let (bi, bt) = (&setup.incident_bar, &setup.transmission_bar);
+    let (c_i, c_t) = (bi.wave_speed_m_s, bt.wave_speed_m_s);
+    let s_i = (incident_start_s - input.time_s[0]) / dt;
+    let peak = strains.incident_peak;
+    let foot = |eps: &[f64], sign: f64, geometric_s: f64, least: f64| {
+        align::foot_delay_s(
+            eps,
+            sign,
+            dt,
+            s_i,
+            geometric_s,
+            least,
+            options.start_fraction,
+        )
+    };
+    let geometric_r = 2.0 * setup.incident_gauge_m / c_i;
+    let geometric_t = setup.incident_gauge_m / c_i
+        + setup.transmission_gauge_m / c_t
+        + options.specimen_transit_s;
+    Ok(Arrivals {
+        dt_s: dt,
+        incident_foot_s: incident_start_s,
+        incident_peak_strain: peak,
+        reflected_delay_s: (peak > 0.0)
+            .then(|| foot(&strains.incident, 1.0, geometric_r, 0.1 * peak))
+            .flatten(),
+        transmitted_delay_s: foot(
+            &strains.transmission,
+            -1.0,
+            geometric_t,
+            10.0 * strains.transmission_noise,
+        ),
+        // The echo rides on the tail of the reflected pulse, whose 2 % level it may not leave:
+        // it is timed against the reflected pulse, itself inverted, by their half-peak rising
+        // crossings, and the reflected foot's delay added.
+        incident_echo_delay_s: match bi.length_m {
+            Some(l) if peak > 0.0 => {
+                let half = |sign: f64, geometric_s: f64| {
+                    align::foot_delay_s(
+                        &strains.incident,
+                        sign,
+                        dt,
+                        s_i,
+                        geometric_s,
+                        0.1 * peak,
+                        0.5,
+                    )
+                };
+                let reflected = foot(&strains.incident, 1.0, geometric_r, 0.1 * peak);
+                match (reflected, half(1.0, geometric_r), half(-1.0, 2.0 * l / c_i)) {
+                    (Some(r), Some(r50), Some(e50)) if e50 > r50 => Some(r + e50 - r50),
+                    _ => None,
+                }
+            }
+            _ => None,
+        },
+    })
+}
+
 /// An input error of the reduction (`file` names the record or "reduction options").
 fn input_err(
     file: &str,

@@ -23,6 +23,7 @@ pub mod provenance;
 pub mod resources;
 pub mod scene;
 pub mod setup;
+pub mod shots;
 pub mod specimen;
 pub mod specimen_file;
 mod toml_file;

@@ -567,49 +567,7 @@ pub fn reduce_record_with(
         (None, None) => run_specimen,
     };
     options.specimen_radii_m = specimen.radii_m();
-    let reduction = if hdf5_input {
-        // A run file with its own set-up is read as the lab reads a record: its digitised
-        // voltages through the set-up's bridges, exactly as the run reduced them; otherwise (a
-        // file of `shpb strain`, or without voltages) its strains.
-        let voltages = if own_set_up {
-            shpb_output::reduction::read_hdf5_voltages(record)?
-        } else {
-            None
-        };
-        let input = match voltages {
-            Some(shpb_core::gauge::RawRecord {
-                time_s,
-                incident_v,
-                transmission_v,
-            }) => {
-                let channel = |name: &str| {
-                    apparatus.gauges.channel(name).ok_or_else(|| {
-                        input_err(
-                            "RECORD",
-                            format!(
-                                "the run's set-up {} has no `{name}` gauge",
-                                apparatus.source
-                            ),
-                            "a run file of a set-up with incident and transmission gauges",
-                        )
-                    })
-                };
-                ReductionInput {
-                    time_s,
-                    incident_strain: channel("incident")?.strains_from_voltages(&incident_v),
-                    transmission_strain: channel("transmission")?
-                        .strains_from_voltages(&transmission_v),
-                }
-            }
-            None => shpb_output::reduction::read_hdf5_strains(record)?,
-        };
-        shpb_core::reduce::reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &record.display().to_string(),
-        )?
-    } else if let Some(set) = &choices.channels {
+    let reduction = if let (Some(set), false) = (&choices.channels, hdf5_input) {
         let input =
             shpb_core::reduce::record_strains(&set.read()?, &apparatus, options.baseline_samples)?;
         shpb_core::reduce::reduce_named(
@@ -618,18 +576,7 @@ pub fn reduce_record_with(
             &options,
             &record.display().to_string(),
         )?
-    } else if let Some(layout) = &choices.layout {
-        let name = record.display().to_string();
-        let input = layout
-            .read(record)?
-            .into_strains(&apparatus, options.baseline_samples)?;
-        shpb_core::reduce::reduce_named(
-            &input,
-            &ReductionSetup::from_apparatus(&apparatus)?,
-            &options,
-            &name,
-        )?
-    } else {
+    } else if !hdf5_input && choices.layout.is_none() {
         shpb_input::gauges::reduce_record_file(record, &apparatus, &options).map_err(|e| {
             // One oscilloscope channel of a record kept one file per channel: say how to give it.
             let text = std::fs::read(record).unwrap_or_default();
@@ -646,6 +593,20 @@ pub fn reduce_record_with(
                 e
             }
         })?
+    } else {
+        let input = record_input(
+            record,
+            &apparatus,
+            choices.layout.as_ref(),
+            own_set_up,
+            options.baseline_samples,
+        )?;
+        shpb_core::reduce::reduce_named(
+            &input,
+            &ReductionSetup::from_apparatus(&apparatus)?,
+            &options,
+            &record.display().to_string(),
+        )?
     };
     let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
     Ok(Reduced {
@@ -655,6 +616,67 @@ pub fn reduce_record_with(
         cylinder,
         specimen,
     })
+}
+
+/// The gauge strains of a record, the one way every command reads one (`shpb reduce`,
+/// `shpb calibrate`): an HDF5 file of `shpb run` (its digitised voltages through `apparatus`'s
+/// bridges when `run_voltages`, else its strains), a text record read by `layout`, or the
+/// authors' CSV (`time_s,incident_V,transmission_V`); voltage baselines are the mean of the first
+/// `baseline_samples` samples.
+pub fn record_input(
+    record: &Path,
+    apparatus: &Apparatus,
+    layout: Option<&shpb_input::layout::RecordLayout>,
+    run_voltages: bool,
+    baseline_samples: usize,
+) -> Result<ReductionInput> {
+    if shpb_output::reduction::is_hdf5(record)? {
+        // A run file with its own set-up is read as the lab reads a record: its digitised
+        // voltages through the set-up's bridges, exactly as the run reduced them; otherwise (a
+        // file of `shpb strain`, or without voltages) its strains.
+        let voltages = if run_voltages {
+            shpb_output::reduction::read_hdf5_voltages(record)?
+        } else {
+            None
+        };
+        return match voltages {
+            Some(shpb_core::gauge::RawRecord {
+                time_s,
+                incident_v,
+                transmission_v,
+            }) => {
+                let channel = |name: &str| {
+                    apparatus.gauges.channel(name).ok_or_else(|| {
+                        input_err(
+                            "RECORD",
+                            format!("the set-up {} has no `{name}` gauge", apparatus.source),
+                            "a set-up with incident and transmission gauges",
+                        )
+                    })
+                };
+                Ok(ReductionInput {
+                    time_s,
+                    incident_strain: channel("incident")?.strains_from_voltages(&incident_v),
+                    transmission_strain: channel("transmission")?
+                        .strains_from_voltages(&transmission_v),
+                })
+            }
+            None => shpb_output::reduction::read_hdf5_strains(record),
+        };
+    }
+    match layout {
+        Some(layout) => Ok(layout
+            .read(record)?
+            .into_strains(apparatus, baseline_samples)?),
+        None => {
+            let raw = shpb_core::gauge::RawRecord::read(record)?;
+            Ok(shpb_core::reduce::record_strains(
+                &raw,
+                apparatus,
+                baseline_samples,
+            )?)
+        }
+    }
 }
 
 /// The set-up and specimen a run file was simulated with (its spheres' radii or its cylinder;

@@ -8,6 +8,7 @@
 
 pub mod api;
 pub mod bench;
+pub mod calibrate;
 pub mod convergence;
 pub mod design;
 pub mod file;

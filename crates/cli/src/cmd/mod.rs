@@ -1,6 +1,7 @@
 //! The subcommands of `shpb`, one file each, and the helpers they share ([`common`]).
 
 pub mod bench;
+pub mod calibrate;
 pub mod common;
 pub mod convergence;
 pub mod curve;

@@ -1,0 +1,203 @@
+//! `shpb calibrate`: a set-up's constants fitted to a lab's own shots (shpb_study::calibrate).
+
+use super::common::{quiet_mode, report, warn, wrote};
+use shpb_core::apparatus::Apparatus;
+use shpb_core::gauge::GaugeSetup;
+use shpb_input::prelude::*;
+use shpb_input::shots::ShotManifest;
+use shpb_input::{Error, Result};
+use shpb_output::atomic::{check_not_input, check_output_path, write_text_atomically};
+use shpb_study::calibrate::{Calibration, Data, calibrate as run_calibrations, setup_file};
+use std::path::{Path, PathBuf};
+
+/// The gauge file written beside `output`: `<stem>-gauges.toml`.
+pub fn gauges_path(output: &Path) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or("setup".into(), |s| s.to_string_lossy().into_owned());
+    output.with_file_name(format!("{stem}-gauges.toml"))
+}
+
+/// `shpb calibrate SHOTS.toml --bars BASE -o SETUP.toml [--force]`: runs every calibration whose
+/// data the shots carry (shpb_study::calibrate::CALIBRATIONS), prints each constant with its
+/// 1-sigma and what it was fitted on, and writes the base set-up with the calibrated values
+/// replaced, the `[uncertainty]` table appended, and its gauge file beside it
+/// (`SETUP-gauges.toml`). Progress of long fits goes to stderr.
+///
+/// The strain factor from paired volt and strain files (`--paired VOLTS STRAINS`,
+/// shpb_study::strain_factor) is a calibration of its own: it joins the constants here, as a
+/// `gauges.<channel>.strain_per_volt` [`shpb_study::calibrate::Fitted`], before the set-up is
+/// written.
+pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Result<()> {
+    if shpb_output::atomic::is_stdout(output) {
+        return Err(shpb_study::api::input_err(
+            "-o",
+            "the set-up cannot go to stdout: its gauge file is written beside it",
+            "a .toml file path",
+        ));
+    }
+    check_output_path(output, force, "-o", &["toml"])?;
+    let gauges_out = gauges_path(output);
+    if !shots.is_file() {
+        return Err(shpb_study::api::input_err(
+            "SHOTS",
+            format!("cannot read {}: no such file", shots.display()),
+            "a shots manifest .toml ([[shot]] tables with file and pressure or \
+             striker_velocity_m_s)",
+        ));
+    }
+    let manifest = ShotManifest::from_file(shots)?;
+    let (base_name, base_text, base_gauges) = setup_file::read_base(bars)?;
+    if base_gauges.is_some() {
+        check_output_path(&gauges_out, force, "-o", &["toml"])?;
+    }
+    let mut inputs: Vec<PathBuf> = vec![shots.to_path_buf(), bars.to_path_buf()];
+    inputs.extend(manifest.shots.iter().map(|s| s.file.clone()));
+    check_not_input(output, "-o", &inputs)?;
+    check_not_input(&gauges_out, "-o", &inputs)?;
+
+    let base = shpb_study::api::load_apparatus(bars)?;
+    let data = Data::read(base, &manifest)?;
+    let show = !quiet_mode();
+    let mut progress = |line: &str| {
+        if show {
+            eprintln!("calibrate: {line}");
+        }
+    };
+    let c = run_calibrations(&data, &mut progress)?;
+
+    let gauges_name = gauges_out
+        .file_name()
+        .map_or("setup-gauges.toml".into(), |n| {
+            n.to_string_lossy().into_owned()
+        });
+    let header = format!(
+        "# Set-up calibrated by `shpb calibrate {} --bars {}` on {} shots ({}).\n\
+         # The base set-up's text, each calibrated value replaced (a `# shpb calibrate:` comment\n\
+         # above it says what it was fitted on; the old value follows it); [uncertainty] at the end.\n\n",
+        shots.display(),
+        bars.display(),
+        c.shots,
+        c.fitted_on
+    );
+    let texts = setup_file::rewrite(
+        &base_text,
+        &base_name,
+        base_gauges.as_deref(),
+        &gauges_name,
+        &c,
+        &header,
+    )?;
+    check_loads(&texts, &gauges_name);
+    if let Some(g) = &texts.gauges {
+        write_text_atomically(&gauges_out, force, g)?;
+        wrote(&gauges_out);
+    }
+    write_text_atomically(output, force, &texts.setup)?;
+    wrote(output);
+    let gauges_written = texts.gauges.as_ref().map(|_| gauges_out.as_path());
+    report(&text(&c), || json(&c, output, gauges_written))
+}
+
+/// Warns when the written set-up (without its `[uncertainty]` table, which another part of
+/// shpb reads) would not load as a set-up: a calibrated value out of its key's range.
+fn check_loads(texts: &setup_file::SetupTexts, gauges_name: &str) {
+    let setup = texts
+        .setup
+        .split("\n[uncertainty]\n")
+        .next()
+        .unwrap_or(&texts.setup);
+    let setup = setup
+        .strip_suffix("# calibration shots show; written by `shpb calibrate` (1-sigma, normal, independent).\n")
+        .unwrap_or(setup);
+    let gauges = |g: &str| -> Result<GaugeSetup> {
+        match &texts.gauges {
+            Some(t) if g == gauges_name => GaugeSetup::from_toml(t, g),
+            _ => Err(Error::Input {
+                file: "calibrated set-up".into(),
+                key: "gauges".into(),
+                problem: format!("unexpected gauge file {g}"),
+                allowed: gauges_name.into(),
+            }),
+        }
+    };
+    if let Err(e) = Apparatus::from_toml(setup, "calibrated set-up", &gauges) {
+        warn(&format!(
+            "the calibrated set-up does not load in this build of shpb: {e}"
+        ));
+    }
+}
+
+/// A number with 4 significant digits.
+fn g4(x: f64) -> String {
+    format!("{x:.4e}")
+}
+
+/// The printed result.
+fn text(c: &Calibration) -> String {
+    let mut t = format!("calibrated on {} shots: {}\n", c.shots, c.fitted_on);
+    for f in &c.constants {
+        let sd = match (f.sd, f.relative_sd()) {
+            (Some(sd), Some(r)) => format!(
+                " ± {} {} ({:.2} %, {})",
+                g4(sd),
+                f.unit,
+                100.0 * r,
+                f.sd_from.name()
+            ),
+            _ => String::new(),
+        };
+        t.push_str(&format!("  {:<46} {} {}{sd}\n", f.key, g4(f.value), f.unit));
+        t.push_str(&format!("      fitted on: {}\n", f.fitted_on));
+    }
+    if !c.scatter.is_empty() {
+        t.push_str("shot-to-shot scatter (1-sigma):\n");
+        for (k, v) in &c.scatter {
+            t.push_str(&format!("  {k:<46} {}\n", g4(*v)));
+        }
+    }
+    for (name, why) in &c.ran {
+        if let Some(why) = why {
+            t.push_str(&format!("not calibrated: {name}: {why}\n"));
+        }
+    }
+    t
+}
+
+/// The `--json` result.
+fn json(c: &Calibration, setup: &Path, gauges: Option<&Path>) -> serde_json::Value {
+    let constants: Vec<serde_json::Value> = c
+        .constants
+        .iter()
+        .map(|f| {
+            serde_json::json!({
+                "key": f.key,
+                "value": f.value,
+                "unit": f.unit,
+                "sd": f.sd,
+                "relative_sd": f.relative_sd(),
+                "sd_from": f.sd_from.name(),
+                "fitted_on": f.fitted_on,
+            })
+        })
+        .collect();
+    let scatter: serde_json::Map<String, serde_json::Value> = c
+        .scatter
+        .iter()
+        .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
+        .collect();
+    let skipped: serde_json::Map<String, serde_json::Value> = c
+        .ran
+        .iter()
+        .filter_map(|(n, w)| w.as_ref().map(|w| (n.to_string(), serde_json::json!(w))))
+        .collect();
+    serde_json::json!({
+        "fitted_on": c.fitted_on,
+        "shots": c.shots,
+        "constants": constants,
+        "scatter": scatter,
+        "not_calibrated": skipped,
+        "setup": setup.display().to_string(),
+        "gauges": gauges.map(|g| g.display().to_string()),
+    })
+}
