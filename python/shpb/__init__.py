@@ -66,6 +66,12 @@ class Run:
         units.update({k: u for k, _, u in items})
         self.units: Dict[str, str] = units
         """Units of every dataset path and summary key."""
+        self.bands: Dict[str, Dict[str, Any]] = {
+            k: {"value": v, "unit": u, "band_90": [lo, hi]} for k, v, u, lo, hi in data.bands()
+        }
+        """The 90 % bands the set-up's ``[uncertainty]`` gives summary values (key →
+        ``{"value", "unit", "band_90": [low, high]}``, as ``shpb run --json`` writes them;
+        docs/physics.md §10.6); empty without one, or with ``run(..., bands=False)``."""
 
     @property
     def origin(self) -> str:
@@ -188,10 +194,13 @@ class Table:
     ``equilibrium_ratio_at_peak``, ``time_to_equilibrium``; ``peak_contact_force`` and
     ``displacement_at_peak_contact_force``, the names of a run's summary, are accepted too);
     :attr:`inputs` holds each swept key's
-    values in SI units (or as written, for names), :attr:`labels` the values as written."""
+    values in SI units (or as written, for names), :attr:`labels` the values as written,
+    :attr:`warnings` each run's warnings (as ``shpb run`` prints them)."""
 
-    def __init__(self, raw: Tuple[Any, Any, Any, Any]) -> None:
-        keys, labels, inputs, columns = raw
+    def __init__(self, raw: Tuple[Any, Any, Any, Any, Any]) -> None:
+        keys, labels, inputs, columns, warnings = raw
+        self.warnings: List[List[str]] = [list(w) for w in warnings]
+        """Each run's warnings (a gun pressure outside its calibration, …), in row order."""
         self.keys_swept: List[str] = list(keys)
         self.labels: Dict[str, List[str]] = {
             k: [row[i] for row in labels] for i, k in enumerate(keys)
@@ -254,6 +263,7 @@ def run(
     scene: Union[PathLike, Mapping[str, Any]],
     fidelity: Optional[str] = None,
     set: Optional[Mapping[str, Any]] = None,
+    bands: bool = True,
 ) -> Run:
     """Runs a virtual test as ``shpb run`` does and returns its :class:`Run`.
 
@@ -262,14 +272,21 @@ def run(
     directory). ``fidelity``: ``"fast"``, ``"standard"`` or ``"reference"`` (wins over the
     scene's). ``set``: scene keys to replace, e.g. ``{"pressure": "12psi"}`` (a string is read
     with its units as ``shpb sweep --set`` reads it; dotted keys reach into tables).
-    The GIL is released while the test runs.
+    ``bands``: the 90 % bands of a set-up with an ``[uncertainty]`` table (:attr:`Run.bands`;
+    ``False`` is ``shpb run --no-bands``). The GIL is released while the test runs.
     """
     if not isinstance(scene, Mapping):
         scene = os.fspath(scene)
     else:
         scene = dict(scene)
-    line = _call("run", scene if isinstance(scene, str) else "<dict>", fidelity=fidelity, set=set)
-    return Run(_shpb.run(scene, fidelity, dict(set) if set else None, line))
+    line = _call(
+        "run",
+        scene if isinstance(scene, str) else "<dict>",
+        fidelity=fidelity,
+        set=set,
+        **({} if bands else {"no_bands": True}),
+    )
+    return Run(_shpb.run(scene, fidelity, dict(set) if set else None, line, bands))
 
 
 def load(path: PathLike) -> Run:

@@ -1,6 +1,7 @@
 """The Python package against the `shpb` binary: same numbers bit for bit, same files, same
 errors (with the command line's message)."""
 
+import json
 import pathlib
 import tomllib
 
@@ -323,6 +324,32 @@ def test_sweep_in_parallel_equals_serial():
     assert same(t1["peak_force"][2], r.summary["peak_contact_force"])
     # The issue's (and a run's) name for the column reads the same array.
     assert t1["peak_contact_force"] is t1["peak_force"]
+
+
+def test_run_gives_the_bands_of_shpb_run_json(cli, tmp_path):
+    # bars/authors.toml states [uncertainty]: the 90 % bands, as `shpb run --json` writes them.
+    scene = "scenes/shpb-ss440c-10psi.toml"
+    out = tmp_path / "r.h5"
+    j = json.loads(cli("--json", "run", scene, "--fidelity", "fast", "-o", out).stdout)
+    r = shpb.run(scene, fidelity="fast")
+    banded = {k: v for k, v in j["summary"].items() if "band_90" in v}
+    assert "incident_peak_stress" in banded and "transmitted_delay" in banded
+    assert r.bands == banded
+    for k, v in banded.items():
+        lo, hi = v["band_90"]
+        assert lo <= v["value"] <= hi, k
+    assert shpb.load(out).bands == banded
+    assert shpb.run(scene, fidelity="fast", bands=False).bands == {}
+
+
+def test_a_sweep_table_keeps_each_run_s_warnings(cli):
+    scene = "scenes/shpb-ss440c-10psi.toml"
+    t = shpb.sweep(scene, set={"pressure": ["8psi", "10psi"]}, fidelity="fast")
+    run = json.loads(
+        cli("--json", "run", scene, "--set", "pressure=8psi", "--fidelity", "fast", "--no-bands").stdout
+    )
+    assert run["warnings"] and t.warnings[0] == run["warnings"]
+    assert t.warnings[1] == []
 
 
 # --- errors: the exception of the exit code, with the command line's message ---------------

@@ -198,6 +198,11 @@ pub enum Command {
         /// `striker_velocity_m_s`. The run file stores the scene with the values set.
         #[arg(long = "set")]
         set: Vec<String>,
+        /// Skip the 90 % bands a set-up with an `[uncertainty]` table (or a gun
+        /// `velocity_scatter`) gives the summary: two more summary-only runs per uncertain
+        /// input (docs/physics.md §10.6).
+        #[arg(long)]
+        no_bands: bool,
     },
     /// Run a scene on a ladder of resolutions: error of each level against the finest, run
     /// time, observed order of convergence and Richardson extrapolation.
@@ -617,6 +622,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             force,
             fidelity,
             set,
+            no_bands,
         } => cmd::run::run(
             &scene,
             output.as_deref(),
@@ -625,6 +631,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             force,
             fidelity.map(Fidelity::from),
             &set,
+            !no_bands,
         ),
         Command::Bench {
             scene,

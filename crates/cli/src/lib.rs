@@ -17,14 +17,14 @@ pub mod interrupt;
 
 pub use shpb_core::{
     apparatus, bar, contact, estimate, fidelity, gauge, material, numeric, reduce, run, shaper,
-    solver, specimen, striker,
+    solver, specimen, striker, uncertainty,
 };
 pub use shpb_input::{
     Error, Result, Validator, csv, distribution, error, gauges, kinds, provenance, resources, units,
 };
 pub use shpb_output::{batch, io, plot, study as study_table, writer};
 pub use shpb_study::{
-    api, bench, convergence, file as study_file, identity as study_identity, sweep, uq,
+    api, band, bench, convergence, file as study_file, identity as study_identity, sweep, uq,
 };
 pub use shpb_validate as validate;
 

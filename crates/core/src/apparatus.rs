@@ -110,6 +110,9 @@ pub struct Apparatus {
     pub gauges: GaugeSetup,
     /// Inserts (platens) between the bars and the specimen.
     pub inserts: Inserts,
+    /// What the calibrated constants are uncertain by and the outputs' shot-to-shot scatter (the
+    /// set-up's `[uncertainty]`, docs/physics.md §10.6); None: not stated.
+    pub uncertainty: Option<crate::uncertainty::Uncertainty>,
 }
 
 impl Apparatus {

@@ -32,5 +32,6 @@ pub mod solver;
 pub mod specimen;
 pub mod striker;
 pub mod transit;
+pub mod uncertainty;
 
 pub use error::{Error, Result};

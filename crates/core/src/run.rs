@@ -14,6 +14,9 @@ pub struct SummaryItem {
     pub value: f64,
     /// Unit (`N`, `m`, `1`, …).
     pub unit: &'static str,
+    /// The 90 % band [low, high] the set-up's uncertainty gives the value (docs/physics.md
+    /// §10.6), in the same unit; None: not computed.
+    pub band_90: Option<[f64; 2]>,
 }
 
 /// Shorthand constructor of a [`SummaryItem`].
@@ -22,6 +25,7 @@ pub fn item(key: &str, value: f64, unit: &'static str) -> SummaryItem {
         key: key.to_string(),
         value,
         unit,
+        band_90: None,
     }
 }
 

@@ -663,7 +663,7 @@ fn run_pulse(
         (Some(_), _) | (None, Some(_)) => {
             match reduce_simulated_records(apparatus, options, radii, &t, &gauges) {
                 Ok(red) => {
-                    summary.extend(reduced_summary(&red));
+                    summary.extend(reduced_summary(&red, apparatus));
                     if let Some(c) = cylinder {
                         summary.push(item("specimen_cells", c.cells_at(chain.dt_s) as f64, "1"));
                         match reduced_cylinder_summary(apparatus, c, &red) {
@@ -1022,7 +1022,12 @@ pub fn reduced_flow_error(
 }
 
 /// Summary items of the reduction of a simulated test (`reduced_*`).
-fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
+/// The reduction's summary items: peak back and front force, the approach and equilibrium ratio
+/// at the peak, the peak strain rate; the energy of the incident wave at the face over its
+/// window, E A c0 ∫ε² dt (`reduce::wave_metrics`, as `shpb reduce` reports it); and the delays
+/// of the reflected and transmitted pulses' feet after the incident foot at the gauges, by the
+/// reduction's own foot rule (docs/physics.md §7.6: `shpb reduce`'s measured delays), when found.
+fn reduced_summary(r: &crate::reduce::Reduction, apparatus: &Apparatus) -> Vec<SummaryItem> {
     let mut v = vec![
         item("reduced_peak_back_force", r.peak_back_force_n, "N"),
         item("reduced_peak_front_force", r.peak_front_force_n, "N"),
@@ -1043,6 +1048,18 @@ fn reduced_summary(r: &crate::reduce::Reduction) -> Vec<SummaryItem> {
             rate.iter().copied().fold(0.0, f64::max),
             "1/s",
         ));
+    }
+    if let Ok(setup) = crate::reduce::ReductionSetup::from_apparatus(apparatus)
+        && let Some(m) =
+            crate::reduce::wave_metrics(&r.time_s, &r.incident_strain, &setup.incident_bar, true)
+    {
+        v.push(item("incident_energy", m.energy_j, "J"));
+    }
+    if let Some(d) = r.alignment.measured_reflected_delay_s {
+        v.push(item("reflected_delay", d, "s"));
+    }
+    if let Some(d) = r.alignment.measured_transmitted_delay_s {
+        v.push(item("transmitted_delay", d, "s"));
     }
     v
 }

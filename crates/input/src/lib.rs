@@ -27,6 +27,7 @@ pub mod shots;
 pub mod specimen;
 pub mod specimen_file;
 mod toml_file;
+pub mod uncertainty;
 pub mod units;
 
 pub use error::{Error, Result, Validator};

@@ -98,6 +98,8 @@ struct ApparatusToml {
     striker: BarToml,
     gun: GunToml,
     shaper: Option<ShaperToml>,
+    /// Read by [`crate::uncertainty::read`] once the rest is validated.
+    uncertainty: Option<toml::Value>,
 }
 
 /// Validates a bar material given as a TOML value (a cylindrical specimen's `material` table),
@@ -478,7 +480,7 @@ impl ApparatusFile for Apparatus {
             )?),
             None => None,
         };
-        let gauges = gauges(&raw.gauges)?;
+        let gauge_setup = gauges(&raw.gauges)?;
         let incident = bar_geometry(&raw.incident, &v.table("incident"))?;
         let insert = |side: &str, t: &Option<InsertToml>| -> Result<Option<Insert>> {
             let Some(t) = t else { return Ok(None) };
@@ -499,7 +501,7 @@ impl ApparatusFile for Apparatus {
             incident: insert("incident", &raw.inserts.incident)?,
             transmission: insert("transmission", &raw.inserts.transmission)?,
         };
-        Ok(Apparatus {
+        let mut apparatus = Apparatus {
             inserts,
             source: file,
             material,
@@ -511,8 +513,16 @@ impl ApparatusFile for Apparatus {
             gun_calibrated_pa,
             gun_velocity_scatter,
             shaper,
-            gauges,
-        })
+            gauges: gauge_setup,
+            uncertainty: None,
+        };
+        if let Some(u) = &raw.uncertainty {
+            let read = crate::uncertainty::read(u, text, &apparatus.source, &apparatus, &|t| {
+                Apparatus::from_toml(t, &apparatus.source, gauges)
+            })?;
+            apparatus.uncertainty = Some(read);
+        }
+        Ok(apparatus)
     }
 }
 

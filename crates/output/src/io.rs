@@ -260,6 +260,28 @@ pub fn write_hdf5(
             path,
         )?;
         string_attr(&s, "warnings", &out.warnings.join("\n"), path)?;
+        // docs/physics.md §10.6: the 90 % band of a summary value, `/summary/bands/<key>` =
+        // [low, high] with the value and its band as attributes.
+        if out.summary.iter().any(|it| it.band_90.is_some()) {
+            let g = s.create_group("bands").map_err(h5err(path))?;
+            for it in &out.summary {
+                let Some(band) = it.band_90 else { continue };
+                let ds = g
+                    .new_dataset_builder()
+                    .with_data(&band)
+                    .create(it.key.as_str())
+                    .map_err(h5err(path))?;
+                string_attr(&ds, "units", it.unit, path)?;
+                for (name, x) in [("value", it.value), ("low", band[0]), ("high", band[1])] {
+                    ds.new_attr::<f64>()
+                        .shape(())
+                        .create(name)
+                        .and_then(|a| a.write_scalar(&x))
+                        .map_err(h5err(path))?;
+                }
+                string_attr(&ds, "unit", it.unit, path)?;
+            }
+        }
         if let Some(p) = provenance {
             crate::provenance::write_provenance(&f, p, path)?;
         }

@@ -711,6 +711,9 @@ fn plot_test<'a>(
 ) -> Result<()> {
     let e = apparatus.material.youngs_modulus_pa;
     let stresses = gauge_stresses(out, e);
+    // The incident peak's 90 % band (docs/physics.md §10.6), when the run has one: a box over
+    // the peak's ± 15 µs from low to high, its numbers in the legend.
+    let band = incident_peak_band(out, &stresses);
     let gauge_title = format!("{title}: gauge signals");
     let gauge_axes = Axes {
         title: &gauge_title,
@@ -719,7 +722,16 @@ fn plot_test<'a>(
         x_scale: 1e6,
         y_scale: 1e-6,
     };
-    let mut panels = vec![(gauge_axes, gauge_curves(out, &stresses))];
+    let mut gauge_panel = gauge_curves(out, &stresses);
+    if let Some((x, y, [lo, hi])) = &band {
+        let label = format!(
+            "incident peak, 90 % band {:.1}-{:.1} MPa",
+            lo * 1e-6,
+            hi * 1e-6
+        );
+        gauge_panel.push(curve(&label, x, y));
+    }
+    let mut panels = vec![(gauge_axes, gauge_panel)];
     panels.extend(specimen);
     // Positions along the apparatus with the specimen at 0: striker and incident bar to the left.
     let (li, ls) = (apparatus.incident.length_m, apparatus.striker.length_m);
@@ -746,6 +758,28 @@ fn plot_test<'a>(
         })
         .collect();
     test_figure(path, force, &panels, &fields)
+}
+
+/// The box a run's incident peak band draws on the gauge panel: (times, stresses) of its outline,
+/// ± 15 µs about the incident gauge's peak from the band's low to its high, and the band; None
+/// without a band or an incident gauge.
+#[allow(clippy::type_complexity)]
+fn incident_peak_band(
+    out: &RunOutput,
+    stresses: &[Vec<f64>],
+) -> Option<(Vec<f64>, Vec<f64>, [f64; 2])> {
+    let band = out
+        .summary
+        .iter()
+        .find(|i| i.key == "incident_peak_stress")?
+        .band_90?;
+    let k = out.gauges.iter().position(|g| g.name == "incident")?;
+    let t = out.time_s.as_deref()?;
+    let s = &stresses[k];
+    let peak = (0..s.len().min(t.len())).max_by(|&a, &b| s[a].total_cmp(&s[b]))?;
+    let (t0, t1) = (t[peak] - 15e-6, t[peak] + 15e-6);
+    let [lo, hi] = band;
+    Some((vec![t0, t1, t1, t0, t0], vec![lo, lo, hi, hi, lo], band))
 }
 
 /// Force against sphere approach: the true contact force and, when the run reduced its gauges,

@@ -37,7 +37,7 @@ fn one_d<'a>(path: String, data: &'a [f64], units: &'a str) -> Dataset<'a> {
 /// The numeric datasets [`crate::io::write_hdf5`] writes for `out`, in the order written:
 /// `contact/*`, `chain/*`, `drive/{time,force}`, `time`, `gauges/<name>/{strain,voltage}`,
 /// `bars/<name>/{x,time,snapshots}`,
-/// `reduction/*`, `energy/*`, `summary/<key>` (scalars).
+/// `reduction/*`, `energy/*`, `summary/<key>` (scalars), `summary/bands/<key>` ([low, high]).
 pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
     let mut v = Vec::new();
     if let Some(contact) = &out.contact {
@@ -102,6 +102,16 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
             data: Cow::Owned(vec![it.value]),
             units: Cow::Borrowed(it.unit),
         });
+    }
+    for it in &out.summary {
+        if let Some(band) = it.band_90 {
+            v.push(Dataset {
+                path: format!("summary/bands/{}", it.key),
+                shape: vec![2],
+                data: Cow::Owned(band.to_vec()),
+                units: Cow::Borrowed(it.unit),
+            });
+        }
     }
     v
 }

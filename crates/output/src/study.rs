@@ -9,7 +9,8 @@
 //! inputs that are names) with the attribute `order` (the keys, one per line);
 //! `/summary/inputs_as_written/<key>` (the values as the user wrote them, `7psi`, `0.3mm`); and
 //! `/runs/<index>` groups whose attributes are that run's inputs (SI numbers, or strings) and
-//! results (numbers).
+//! results (numbers); `/summary/warnings` (strings, one per run: its warnings, one per line,
+//! empty for none) and the same as each `/runs/<index>` attribute `warnings`.
 
 use crate::atomic::write_atomically;
 use crate::h5::{h5err, string_attr, vlu, write_dataset};
@@ -94,6 +95,9 @@ pub struct StudyTable {
     pub inputs: Vec<InputColumn>,
     /// The results, in order.
     pub results: Vec<ResultColumn>,
+    /// Each run's warnings (out of the model's calibrated range, …), one per line; empty for
+    /// none. An empty vector: none recorded (a file of an older shpb).
+    pub warnings: Vec<String>,
 }
 
 impl StudyTable {
@@ -130,6 +134,14 @@ impl StudyTable {
                     .find(|c| c.values.len() != n)
                     .map(|c| c.name.as_str())
             })
+            .or_else(|| {
+                (!self.warnings.is_empty() && self.warnings.len() != n).then_some("warnings")
+            })
+    }
+
+    /// The warnings of row `row` (none when the table records none).
+    pub fn warnings_of(&self, row: usize) -> &str {
+        self.warnings.get(row).map_or("", String::as_str)
     }
 }
 
@@ -179,6 +191,13 @@ pub fn write_study_hdf5(path: &Path, force: bool, table: &StudyTable) -> Result<
                 }
             }
         }
+        let warnings: Vec<VarLenUnicode> = (0..table.len())
+            .map(|i| vlu(table.warnings_of(i)))
+            .collect();
+        s.new_dataset_builder()
+            .with_data(&warnings)
+            .create("warnings")
+            .map_err(h5err(path))?;
         string_attr(&inputs, "order", &table.keys().join("\n"), path)?;
         string_attr(&written, "order", &table.keys().join("\n"), path)?;
         let runs = f.create_group("runs").map_err(h5err(path))?;
@@ -202,6 +221,7 @@ pub fn write_study_hdf5(path: &Path, force: bool, table: &StudyTable) -> Result<
                     .and_then(|at| at.write_scalar(&c.values[row]))
                     .map_err(h5err(path))?;
             }
+            string_attr(&g, "warnings", table.warnings_of(row), path)?;
         }
         f.close().map_err(h5err(path))
     })
@@ -293,7 +313,7 @@ pub fn read_study_hdf5(path: &Path) -> Result<StudyTable> {
         .map_err(|e| bad("summary", e.to_string()))?;
     let results = names
         .iter()
-        .filter(|n| !["run", "inputs", "inputs_as_written"].contains(&n.as_str()))
+        .filter(|n| !["run", "inputs", "inputs_as_written", "warnings"].contains(&n.as_str()))
         .map(|name| {
             let units = s
                 .dataset(name)
@@ -337,6 +357,14 @@ pub fn read_study_hdf5(path: &Path) -> Result<StudyTable> {
             Ok(InputColumn { key, values, si })
         })
         .collect::<Result<Vec<_>>>()?;
+    // Files written before the warnings were kept have none.
+    let warnings = match s.dataset("warnings") {
+        Ok(d) => d
+            .read_raw::<VarLenUnicode>()
+            .map(|v| v.iter().map(|x| x.as_str().to_string()).collect())
+            .map_err(|e| bad("summary/warnings", e.to_string()))?,
+        Err(_) => Vec::new(),
+    };
     let table = StudyTable {
         shpb_version,
         scene,
@@ -345,6 +373,7 @@ pub fn read_study_hdf5(path: &Path) -> Result<StudyTable> {
         run,
         inputs,
         results,
+        warnings,
     };
     if table.ragged_column().is_some() {
         return Err(bad("summary", "columns of different lengths".into()));
@@ -405,6 +434,10 @@ mod tests {
                     values: vec![0.1, f64::NAN],
                 },
             ],
+            warnings: vec![
+                String::new(),
+                "gun pressure 17.5 psi is outside 10-15 psi\nsecond".into(),
+            ],
         }
     }
 
@@ -429,6 +462,7 @@ mod tests {
             assert_eq!(b.values[1].is_nan(), c.values[1].is_nan());
         }
         assert_eq!(back.results.len(), t.results.len());
+        assert_eq!(back.warnings, t.warnings, "each run's warnings kept");
         // No clobbering without `force`.
         assert!(write_study_hdf5(&path, false, &t).is_err());
         write_study_hdf5(&path, true, &t).unwrap();

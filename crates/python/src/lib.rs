@@ -275,6 +275,36 @@ impl RunData {
         }
     }
 
+    /// The 90 % bands of the summary (docs/physics.md §10.6): (key, value, units, low, high) in
+    /// the order of the summary; a loaded file's from its `summary/bands/<key>`.
+    fn bands(&self) -> Vec<(String, f64, String, f64, f64)> {
+        match &self.source {
+            Source::Simulated { out, .. } => out
+                .summary
+                .iter()
+                .filter_map(|i| {
+                    i.band_90
+                        .map(|[lo, hi]| (i.key.clone(), i.value, i.unit.to_string(), lo, hi))
+                })
+                .collect(),
+            Source::Reduced { .. } => Vec::new(),
+            Source::Loaded { file, .. } => file
+                .summary
+                .iter()
+                .filter_map(|(k, v, u)| {
+                    let band = file
+                        .datasets
+                        .iter()
+                        .find(|d| d.path == format!("summary/bands/{k}"))?;
+                    match band.data.as_ref() {
+                        [lo, hi] => Some((k.clone(), *v, u.clone(), *lo, *hi)),
+                        _ => None,
+                    }
+                })
+                .collect(),
+        }
+    }
+
     /// Every numeric dataset: (path, shape, units), in path order.
     fn dataset_info(&self) -> Vec<(String, Vec<usize>, String)> {
         self.datasets()
@@ -389,13 +419,14 @@ impl RunData {
 
 /// Runs a scene (a scene file, a run file to rerun, or a dict) as `shpb run` does.
 #[pyfunction]
-#[pyo3(signature = (scene, fidelity = None, set = None, command_line = String::new()))]
+#[pyo3(signature = (scene, fidelity = None, set = None, command_line = String::new(), bands = true))]
 fn run(
     py: Python<'_>,
     scene: &Bound<'_, PyAny>,
     fidelity: Option<&str>,
     set: Option<&Bound<'_, PyDict>>,
     command_line: String,
+    bands: bool,
 ) -> PyResult<RunData> {
     let fidelity = self::fidelity(fidelity)?;
     let overrides = overrides(set)?;
@@ -419,7 +450,8 @@ fn run(
         };
         let (params, provenance) = api::load_scene(scene, fidelity, &overrides, command_line)?;
         // Every 1 % of a long run: a pending Ctrl-C (SIGINT) stops it with KeyboardInterrupt.
-        let out = api::run_scene(&params, &mut |_| {
+        // The summary's 90 % bands unless `bands=False` (docs/physics.md §10.6).
+        let out = api::run_scene_with_bands(&params, &provenance, bands, &mut |_| {
             Python::with_gil(|py| py.check_signals().is_ok())
         })?;
         Ok((params, out, provenance))
@@ -589,12 +621,14 @@ fn reduce(
 }
 
 /// A sweep's table: the swept keys, each row's values as written, the SI value and units of each
-/// input column (None when not numeric) and the summary columns (name, units, values).
+/// input column (None when not numeric), the summary columns (name, units, values) and each
+/// row's warnings.
 type SweepTable = (
     Vec<String>,
     Vec<Vec<String>>,
     Vec<Option<(String, Vec<f64>)>>,
     Vec<(String, String, Vec<f64>)>,
+    Vec<Vec<String>>,
 );
 
 /// The rows of a table as Python takes them ([`SweepTable`]).
@@ -627,7 +661,8 @@ fn table_columns(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> Swe
             )
         })
         .collect();
-    (keys.to_vec(), labels, inputs, columns)
+    let warnings = rows.iter().map(|r| r.warnings.clone()).collect();
+    (keys.to_vec(), labels, inputs, columns, warnings)
 }
 
 /// Runs `scene` over the product of the `--set` specifications `set` on `jobs` threads
@@ -671,20 +706,24 @@ fn sweep_table(keys: Vec<String>, rows: StudyRows) -> PyResult<SweepTable> {
 /// Rows as they travel between processes ([`StudyRows`]).
 fn travelling(rows: &[shpb_study::sweep::RunSummary]) -> StudyRows {
     rows.iter()
-        .map(|r| (r.index, r.inputs.clone(), r.values()))
+        .map(|r| (r.index, r.inputs.clone(), r.values(), r.warnings.clone()))
         .collect()
 }
 
 /// Rows back from their travelling form.
 fn arrived(rows: StudyRows) -> Vec<shpb_study::sweep::RunSummary> {
     rows.into_iter()
-        .map(|(index, inputs, v)| shpb_study::sweep::RunSummary::from_values(index, inputs, v))
+        .map(|(index, inputs, v, warnings)| {
+            let mut row = shpb_study::sweep::RunSummary::from_values(index, inputs, v);
+            row.warnings = warnings;
+            row
+        })
         .collect()
 }
 
 /// Runs of a sweep or a study as they travel between processes: (index, inputs as written, the
-/// summary values in the order of `SUMMARY_COLUMNS`).
-type StudyRows = Vec<(usize, Vec<String>, [f64; 5])>;
+/// summary values in the order of `SUMMARY_COLUMNS`, the run's warnings).
+type StudyRows = Vec<(usize, Vec<String>, [f64; 5], Vec<String>)>;
 
 /// The plan of a study (`shpb study --samples --seed [--no-gun-scatter] [--fidelity]`).
 fn study_plan(

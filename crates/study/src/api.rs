@@ -249,6 +249,23 @@ pub fn run_scene(params: &Params, progress: &mut dyn FnMut(f64) -> bool) -> Resu
     Ok(out)
 }
 
+/// [`run_scene`], then, with `bands` and a set-up that states its uncertainty (or a gun scatter
+/// the scene uses), the 90 % bands of the summary ([`crate::band::predict`], docs/physics.md
+/// §10.6) written into its items' `band_90`: what `shpb run` (unless `--no-bands`) and
+/// `shpb.run` do. `provenance` is what [`load_scene`] returned with `params`.
+pub fn run_scene_with_bands(
+    params: &Params,
+    provenance: &Provenance,
+    bands: bool,
+    progress: &mut dyn FnMut(f64) -> bool,
+) -> Result<RunOutput> {
+    let mut out = run_scene(params, progress)?;
+    if bands && let Some(p) = crate::band::predict(params, &out, provenance) {
+        crate::band::apply(&mut out, &p);
+    }
+    Ok(out)
+}
+
 /// A reduction of `shpb reduce` with what it was made from.
 #[derive(Debug, Clone)]
 pub struct Reduced {

@@ -777,6 +777,7 @@ mod tests {
             peak_strain_rate_per_s: f64::NAN,
             equilibrium_ratio_at_peak: ratio,
             time_to_equilibrium_s: f64::NAN,
+            warnings: Vec::new(),
         }
     }
 

@@ -78,6 +78,7 @@ impl SweepFile {
                 peak_strain_rate_per_s: cols[2][i],
                 equilibrium_ratio_at_peak: cols[3][i],
                 time_to_equilibrium_s: cols[4][i],
+                warnings: table.warnings_of(i).lines().map(str::to_string).collect(),
             })
             .collect();
         Ok(SweepFile {
@@ -118,6 +119,7 @@ pub fn sweep_table(
                 values: rows.iter().map(|r| r.values()[k]).collect(),
             })
             .collect(),
+        warnings: rows.iter().map(|r| r.warnings.join("\n")).collect(),
     }
 }
 
@@ -281,6 +283,7 @@ mod tests {
             peak_strain_rate_per_s: 500.0,
             equilibrium_ratio_at_peak: f64::NAN,
             time_to_equilibrium_s: 3.5e-5,
+            warnings: Vec::new(),
         }
     }
 
@@ -361,6 +364,7 @@ mod merge_tests {
                 peak_strain_rate_per_s: f64::NAN,
                 equilibrium_ratio_at_peak: f64::NAN,
                 time_to_equilibrium_s: f64::NAN,
+                warnings: Vec::new(),
             })
             .collect();
         let mut sweep = set.clone();

@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod api;
+pub mod band;
 pub mod bench;
 pub mod calibrate;
 pub mod convergence;

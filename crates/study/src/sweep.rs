@@ -257,6 +257,56 @@ pub struct RunSummary {
     /// First reduced time at which the equilibrium ratio is ≤ 0.05 with the back force ≥ 10 % of
     /// its peak, s (NaN if never).
     pub time_to_equilibrium_s: f64,
+    /// The run's warnings, the scene's first, as `shpb run` prints them (a gun pressure outside
+    /// its calibration, a shaper extrapolated, …).
+    pub warnings: Vec<String>,
+}
+
+/// The separator of a row's warnings in one CSV cell (`shpb sweep --csv`, `shpb design`).
+pub const WARNINGS_SEPARATOR: &str = " | ";
+
+/// A row's warnings as one CSV cell: joined by [`WARNINGS_SEPARATOR`], double-quoted (RFC 4180,
+/// quotes doubled) when it holds a comma or a quote; empty for none.
+pub fn warnings_cell(warnings: &[String]) -> String {
+    let text = warnings
+        .iter()
+        .map(|w| w.replace(['\n', '\r'], " "))
+        .collect::<Vec<_>>()
+        .join(WARNINGS_SEPARATOR);
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text
+    }
+}
+
+/// The cells of one CSV line, a double-quoted cell (RFC 4180, `""` for a quote) read as one.
+pub fn split_csv_line(line: &str) -> Vec<String> {
+    let mut cells = vec![String::new()];
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        let cell = cells.last_mut().expect("one cell at least");
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                chars.next();
+                cell.push('"');
+            }
+            ('"', true) => quoted = false,
+            ('"', false) if cell.is_empty() => quoted = true,
+            (',', false) => cells.push(String::new()),
+            (c, _) => cell.push(c),
+        }
+    }
+    cells
+}
+
+/// The warnings of a CSV cell written by [`warnings_cell`] (after [`split_csv_line`]).
+pub fn warnings_of_cell(cell: &str) -> Vec<String> {
+    if cell.is_empty() {
+        return Vec::new();
+    }
+    cell.split(WARNINGS_SEPARATOR).map(str::to_string).collect()
 }
 
 /// Summary columns with units.
@@ -306,6 +356,7 @@ impl RunSummary {
             peak_strain_rate_per_s: v[2],
             equilibrium_ratio_at_peak: v[3],
             time_to_equilibrium_s: v[4],
+            warnings: Vec::new(),
         }
     }
 
@@ -355,6 +406,7 @@ pub fn summarise(index: usize, inputs: Vec<String>, out: &RunOutput) -> RunSumma
         peak_strain_rate_per_s: rate,
         equilibrium_ratio_at_peak: eq,
         time_to_equilibrium_s: t_eq,
+        warnings: out.warnings.clone(),
     }
 }
 
@@ -398,7 +450,9 @@ pub fn run_points(
             .par_iter()
             .map(|p| {
                 let params = Params::from_file_overridden(scene, &overrides(axes, p))?;
-                let out = params.run()?;
+                // The scene's warnings first, as `shpb run` prints them (api::run_scene).
+                let mut out = params.run()?;
+                out.warnings.splice(0..0, params.warnings());
                 let inputs = axes
                     .iter()
                     .zip(&p.coords)
@@ -519,6 +573,7 @@ pub fn summary_csv_keys(keys: &[String], rows: &[RunSummary]) -> String {
             .iter()
             .map(|(n, u)| shpb_output::io::csv_name(n, u)),
     );
+    head.push("warnings".into());
     let mut text = head.join(",");
     text.push('\n');
     for (i, r) in rows.iter().enumerate() {
@@ -528,6 +583,7 @@ pub fn summary_csv_keys(keys: &[String], rows: &[RunSummary]) -> String {
             None => c.values[i].clone(),
         }));
         cells.extend(r.values().iter().map(|v| format!("{v:e}")));
+        cells.push(warnings_cell(&r.warnings));
         text.push_str(&cells.join(","));
         text.push('\n');
     }
@@ -783,25 +839,25 @@ fn row_line(r: &RunSummary) -> String {
     let mut cells = vec![r.index.to_string()];
     cells.extend(r.inputs.iter().cloned());
     cells.extend(r.values().iter().map(|v| format!("{v:e}")));
+    cells.push(warnings_cell(&r.warnings));
     cells.join(",") + "\n"
 }
 
 fn parse_row(line: &str, n_inputs: usize) -> Option<RunSummary> {
-    let cells: Vec<&str> = line.split(',').collect();
-    if cells.len() != 1 + n_inputs + SUMMARY_COLUMNS.len() {
+    let cells = split_csv_line(line);
+    if cells.len() != 2 + n_inputs + SUMMARY_COLUMNS.len() {
         return None;
     }
+    let (cells, warnings) = cells.split_at(cells.len() - 1);
     let index = cells[0].parse().ok()?;
     let inputs = cells[1..=n_inputs].iter().map(|c| c.to_string()).collect();
     let v: Vec<f64> = cells[1 + n_inputs..]
         .iter()
         .map(|c| c.parse().ok())
         .collect::<Option<_>>()?;
-    Some(RunSummary::from_values(
-        index,
-        inputs,
-        [v[0], v[1], v[2], v[3], v[4]],
-    ))
+    let mut row = RunSummary::from_values(index, inputs, [v[0], v[1], v[2], v[3], v[4]]);
+    row.warnings = warnings_of_cell(&warnings[0]);
+    Some(row)
 }
 
 /// Whether run `index` belongs to the shard of `stamp`.
@@ -973,6 +1029,23 @@ mod tests {
     }
 
     #[test]
+    fn a_row_s_warnings_survive_the_checkpoint_line() {
+        // Warnings hold commas and quotes: one quoted cell (RFC 4180), read back as written.
+        let mut r = RunSummary::from_values(3, vec!["7psi".into()], [1.0, 2.0, 3.0, 4.0, 5.0]);
+        r.warnings = vec![
+            "gun pressure 7 psi is outside 10 to 15 psi, the pressures".into(),
+            "a \"quoted\" word".into(),
+        ];
+        let line = row_line(&r);
+        let back = parse_row(line.trim_end(), 1).unwrap();
+        assert_eq!(back, r);
+        let none = RunSummary::from_values(4, vec!["8psi".into()], [1.0; 5]);
+        assert!(row_line(&none).ends_with(",\n"));
+        assert_eq!(parse_row(row_line(&none).trim_end(), 1).unwrap(), none);
+        assert_eq!(split_csv_line("a,\"b, c\",\"\""), ["a", "b, c", ""]);
+    }
+
+    #[test]
     fn a_key_set_twice_is_an_error_naming_it() {
         for set in [
             &["pressure=7psi,8psi", "pressure=9psi"][..],
@@ -1034,6 +1107,7 @@ mod tests {
             peak_strain_rate_per_s: 3.0,
             equilibrium_ratio_at_peak: 4.0,
             time_to_equilibrium_s: 5.0,
+            warnings: Vec::new(),
         };
         let keys = specs(&["pressure", "shaper.thickness_m", "law"]);
         let text = summary_csv_keys(
@@ -1047,7 +1121,7 @@ mod tests {
         assert_eq!(
             lines.next().unwrap(),
             "run,pressure_Pa,shaper.thickness_m,law,peak_force_N,displacement_at_peak_m,\
-             peak_strain_rate_per_s,equilibrium_ratio_at_peak_1,time_to_equilibrium_s"
+             peak_strain_rate_per_s,equilibrium_ratio_at_peak_1,time_to_equilibrium_s,warnings"
         );
         let cells: Vec<&str> = lines.next().unwrap().split(',').collect();
         let pa: f64 = cells[1].parse().unwrap();
@@ -1164,6 +1238,7 @@ mod tests {
             peak_strain_rate_per_s: f64::NAN,
             equilibrium_ratio_at_peak: f64::NAN,
             time_to_equilibrium_s: f64::NAN,
+            warnings: Vec::new(),
         }
     }
 

@@ -575,7 +575,9 @@ pub fn study_shard_rows(
             .into_par_iter()
             .map(|i| {
                 let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
-                let out = params.run()?;
+                // Every warning of the run kept in its row, the scene's first.
+                let mut out = params.run()?;
+                out.warnings.splice(0..0, params.warnings());
                 let row = summarise(i, samples.labels[i].clone(), &out);
                 let traces = if keep_traces && i < MAX_TRACED_SAMPLES {
                     RunTraces {

@@ -219,6 +219,7 @@ fn table(
     let mut header = vec!["run".to_string(), "preset".to_string()];
     header.extend(varies.iter().map(|v| v.key.clone()));
     header.extend(columns.iter().map(|&q| column_name(q)));
+    header.push("warnings".into());
     t.push_str(&header.join(","));
     t.push('\n');
     for (i, r) in d.runs.iter().enumerate() {
@@ -229,6 +230,8 @@ fn table(
                 .iter()
                 .map(|&q| significant(quantity_of(&r.summary, q), 6)),
         );
+        // Every warning of the run (out of the gun's or shaper's calibration, …).
+        row.push(shpb_study::sweep::warnings_cell(&r.summary.warnings));
         t.push_str(&row.join(","));
         t.push('\n');
     }
@@ -350,6 +353,7 @@ fn json(
                 "preset": r.fidelity.name(),
                 "inputs": inputs(&r.inputs),
                 "results": results(&r.summary),
+                "warnings": r.summary.warnings,
             })
         })
         .collect();

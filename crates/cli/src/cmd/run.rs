@@ -12,9 +12,11 @@ use shpb_output::writer::{Csv, Hdf5, Png, Writer};
 use std::path::{Path, PathBuf};
 
 /// `shpb run SCENE [-o OUT.h5] [--csv OUT.csv] [--plot OUT.png] [--force] [--fidelity F]
-/// [--set KEY=VALUE …]`;
+/// [--set KEY=VALUE …] [--no-bands]`;
 /// SCENE may be a run file (`.h5` written by `shpb run -o`): the test is run again from the
-/// scene and input files stored in its `/provenance`, not from the disk.
+/// scene and input files stored in its `/provenance`, not from the disk. `bands`: the summary's
+/// 90 % bands (docs/physics.md §10.6; false with `--no-bands`).
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     scene: &Path,
     output: Option<&Path>,
@@ -23,6 +25,7 @@ pub fn run(
     force: bool,
     fidelity: Option<Fidelity>,
     set: &[String],
+    bands: bool,
 ) -> Result<()> {
     let overrides = overrides(set)?;
     let outputs = [
@@ -53,7 +56,7 @@ pub fn run(
     }
     check_disk(&[(output, "--output")], params.estimate().output_bytes)?;
     let mut progress = ProgressLine::new(&params.source);
-    let out = shpb_study::api::run_scene(&params, &mut |f| {
+    let out = shpb_study::api::run_scene_with_bands(&params, &provenance, bands, &mut |f| {
         progress.update(f);
         true
     })?;
@@ -154,10 +157,17 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
         ),
     };
     for it in &out.summary {
-        text.push_str(&format!(
-            "  {:<40} {:>14.6e} {}\n",
-            it.key, it.value, it.unit
-        ));
+        match it.band_90 {
+            None => text.push_str(&format!(
+                "  {:<40} {:>14.6e} {}\n",
+                it.key, it.value, it.unit
+            )),
+            // docs/physics.md §10.6: the 90 % band the set-up's uncertainty gives the value.
+            Some([low, high]) => text.push_str(&format!(
+                "  {:<40} {:>14.6e} [{low:.6e}, {high:.6e}] {}\n",
+                it.key, it.value, it.unit
+            )),
+        }
     }
     // True and reduced over the same window (the first loading pulse), so that a long run's
     // later impacts are not compared with the first pulse's reduction.
@@ -185,10 +195,11 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             .summary
             .iter()
             .map(|it| {
-                (
-                    it.key.clone(),
-                    serde_json::json!({"value": finite(it.value), "unit": it.unit}),
-                )
+                let mut v = serde_json::json!({"value": finite(it.value), "unit": it.unit});
+                if let Some([low, high]) = it.band_90 {
+                    v["band_90"] = serde_json::json!([finite(low), finite(high)]);
+                }
+                (it.key.clone(), v)
             })
             .collect();
         serde_json::json!({

@@ -300,6 +300,7 @@ fn finished_rows(
             peak_strain_rate_per_s: f64::NAN,
             equilibrium_ratio_at_peak: f64::NAN,
             time_to_equilibrium_s: f64::NAN,
+            warnings: Vec::new(),
         })
         .collect();
     let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
@@ -317,8 +318,8 @@ fn finished_rows(
     }
     let inputs = 1 + keys.len();
     for (i, (line, want)) in text.lines().zip(expected.lines()).enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        let want: Vec<&str> = want.split(',').collect();
+        let cells = shpb_study::sweep::split_csv_line(line);
+        let want = shpb_study::sweep::split_csv_line(want);
         let same = if i == 0 {
             cells == want
         } else {
@@ -332,7 +333,9 @@ fn finished_rows(
         }
         if i > 0 {
             let r = &mut rows[i - 1];
-            let v: Vec<f64> = cells[inputs..]
+            let (values, warnings) = cells[inputs..].split_at(cells.len() - inputs - 1);
+            r.warnings = shpb_study::sweep::warnings_of_cell(&warnings[0]);
+            let v: Vec<f64> = values
                 .iter()
                 .map(|c| c.parse().unwrap_or(f64::NAN))
                 .collect();
@@ -437,7 +440,12 @@ fn sweep_json(keys: &[String], rows: &[shpb_study::sweep::RunSummary]) -> serde_
                         )
                     })
                     .collect();
-            serde_json::json!({"run": r.index, "inputs": inputs, "results": results})
+            serde_json::json!({
+                "run": r.index,
+                "inputs": inputs,
+                "results": results,
+                "warnings": r.warnings,
+            })
         })
         .collect();
     serde_json::json!({ "runs": runs })

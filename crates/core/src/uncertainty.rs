@@ -1,0 +1,100 @@
+//! What a set-up's calibrated constants are uncertain by and the shot-to-shot scatter of the
+//! outputs its calibration shots show ([`Uncertainty`], docs/physics.md §10.6): plain validated
+//! numbers (1-sigma, normal, independent), which `shpb-input` reads from a set-up's
+//! `[uncertainty]` table and the study layer carries into a run's 90 % bands.
+
+/// One uncertain constant of the set-up: the set-up key it is written under, its value and its
+/// standard deviation in the key's own SI unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UncertainInput {
+    /// The dotted set-up key (`gun.k_m2_per_s2_per_pa`).
+    pub key: String,
+    /// The key's value in the set-up, SI.
+    pub value: f64,
+    /// 1-sigma, in the key's SI unit (> 0).
+    pub sd: f64,
+    /// The 1-sigma as written, relative to the value, when the set-up gave it so.
+    pub relative_sd: Option<f64>,
+}
+
+/// The outputs whose shot-to-shot scatter a calibration may state, with the run summary key each
+/// is added to and whether the scatter is relative to the value (else absolute, in the output's
+/// SI unit).
+pub const SCATTER_OUTPUTS: [(&str, &str, bool); 4] = [
+    ("incident_peak_stress", "incident_peak_stress", true),
+    ("incident_energy", "incident_energy", true),
+    ("reflected_delay_s", "reflected_delay", false),
+    ("transmitted_delay_s", "transmitted_delay", false),
+];
+
+/// The shot-to-shot scatter of one output beyond the model (1-sigma).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputScatter {
+    /// The run summary key it applies to (`incident_peak_stress`, `reflected_delay`).
+    pub output: String,
+    /// 1-sigma: a fraction of the value when `relative`, else in the output's SI unit (> 0).
+    pub sd: f64,
+    /// Whether `sd` is relative to the value.
+    pub relative: bool,
+}
+
+impl OutputScatter {
+    /// The absolute 1-sigma at output value `value`.
+    pub fn sd_at(&self, value: f64) -> f64 {
+        if self.relative {
+            self.sd * value.abs()
+        } else {
+            self.sd
+        }
+    }
+}
+
+/// A set-up's `[uncertainty]`: what the calibration was fitted on, the uncertain constants and
+/// the outputs' shot-to-shot scatter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Uncertainty {
+    /// What the constants were fitted on (free text).
+    pub fitted_on: String,
+    /// Number of calibration shots (≥ 1).
+    pub shots: u32,
+    /// The uncertain constants, in the order written.
+    pub inputs: Vec<UncertainInput>,
+    /// The outputs' shot-to-shot scatter, in the order written.
+    pub scatter: Vec<OutputScatter>,
+}
+
+impl Uncertainty {
+    /// The scatter stated for run summary key `output`, if any.
+    pub fn scatter_of(&self, output: &str) -> Option<&OutputScatter> {
+        self.scatter.iter().find(|s| s.output == output)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scatter_is_relative_or_absolute() {
+        let rel = OutputScatter {
+            output: "incident_peak_stress".into(),
+            sd: 0.02,
+            relative: true,
+        };
+        assert!((rel.sd_at(-100.0) - 2.0).abs() < 1e-12);
+        let abs = OutputScatter {
+            output: "reflected_delay".into(),
+            sd: 2e-6,
+            relative: false,
+        };
+        assert_eq!(abs.sd_at(5.0), 2e-6);
+        let u = Uncertainty {
+            fitted_on: "x".into(),
+            shots: 1,
+            inputs: vec![],
+            scatter: vec![rel.clone(), abs],
+        };
+        assert_eq!(u.scatter_of("incident_peak_stress"), Some(&rel));
+        assert_eq!(u.scatter_of("incident_energy"), None);
+    }
+}
