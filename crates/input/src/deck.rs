@@ -315,6 +315,8 @@ impl Deck {
                 channels: vec![channel("incident", &inc), channel("transmission", &tra)],
             },
             inserts: Inserts::default(),
+            // A deck states no uncertainty of its constants.
+            uncertainty: None,
         };
         let specimen = CylinderGeometry {
             length_m: l.number("Initial Sample Length (mm)", "mm", 0.0, 1000.0, false)? * 1e-3,
