@@ -211,8 +211,8 @@ pub struct Arrivals {
     /// Arrival of the incident bar's far-end reflection (the reflected pulse come back from the
     /// impact end as compression, ideally 2 L_I/c0 after the incident foot) after the incident
     /// foot, s: the reflected foot's delay plus the time from the reflected pulse's half-peak
-    /// rising crossing to the echo's; None when the record does not show an echo of at least
-    /// 10 % of the incident peak within half to twice 2 L_I/c0.
+    /// rising crossing to the echo's; None without a reflected pulse or when the record does not
+    /// show an echo of at least 10 % of the incident peak within (L_I − d_I)/c0 of 2 L_I/c0.
     pub incident_echo_delay_s: Option<f64>,
 }
 
@@ -249,13 +249,14 @@ pub fn measured_arrivals(
     let geometric_t = setup.incident_gauge_m / c_i
         + setup.transmission_gauge_m / c_t
         + options.specimen_transit_s;
+    let reflected = (peak > 0.0)
+        .then(|| foot(&strains.incident, 1.0, geometric_r, 0.1 * peak))
+        .flatten();
     Ok(Arrivals {
         dt_s: dt,
         incident_foot_s: incident_start_s,
         incident_peak_strain: peak,
-        reflected_delay_s: (peak > 0.0)
-            .then(|| foot(&strains.incident, 1.0, geometric_r, 0.1 * peak))
-            .flatten(),
+        reflected_delay_s: reflected,
         transmitted_delay_s: foot(
             &strains.transmission,
             -1.0,
@@ -264,23 +265,28 @@ pub fn measured_arrivals(
         ),
         // The echo rides on the tail of the reflected pulse, whose 2 % level it may not leave:
         // it is timed against the reflected pulse, itself inverted, by their half-peak rising
-        // crossings, and the reflected foot's delay added.
-        incident_echo_delay_s: match bi.length_m {
-            Some(l) if peak > 0.0 => {
-                let half = |sign: f64, geometric_s: f64| {
-                    align::foot_delay_s(
+        // crossings, and the reflected foot's delay added. It is searched within half the
+        // reflected pulse's path to the impact end, 2 (L_I − d_I)/c0, around where the set-up
+        // puts it (so within ±25 % of the set-up's c0).
+        incident_echo_delay_s: match (bi.length_m, reflected) {
+            (Some(l), Some(r)) => {
+                let geometric_e = 2.0 * l / c_i;
+                let w = 0.5 * (geometric_e - geometric_r).max(0.0);
+                let half = |sign: f64, within_s: (f64, f64)| {
+                    align::foot_delay_between_s(
                         &strains.incident,
                         sign,
                         dt,
                         s_i,
-                        geometric_s,
+                        within_s,
                         0.1 * peak,
                         0.5,
                     )
                 };
-                let reflected = foot(&strains.incident, 1.0, geometric_r, 0.1 * peak);
-                match (reflected, half(1.0, geometric_r), half(-1.0, 2.0 * l / c_i)) {
-                    (Some(r), Some(r50), Some(e50)) if e50 > r50 => Some(r + e50 - r50),
+                let r50 = half(1.0, (0.5 * geometric_r, 2.0 * geometric_r));
+                let e50 = half(-1.0, (geometric_e - w, geometric_e + w));
+                match (r50, e50) {
+                    (Some(r50), Some(e50)) if e50 > r50 => Some(r + e50 - r50),
                     _ => None,
                 }
             }

@@ -46,8 +46,8 @@ pub fn calibrate(shots: &Path, bars: &Path, output: &Path, force: bool) -> Resul
              striker_velocity_m_s)",
         ));
     }
-    let manifest = ShotManifest::from_file(shots)?;
     let (base_name, base_text, base_gauges) = setup_file::read_base(bars)?;
+    let manifest = ShotManifest::from_file(shots)?;
     if base_gauges.is_some() {
         check_output_path(&gauges_out, force, "-o", &["toml"])?;
     }

@@ -74,8 +74,29 @@ pub(crate) fn foot_delay_s(
     least: f64,
     fraction: f64,
 ) -> Option<f64> {
-    let from = (s_i + 0.5 * geometric_s / dt).max(0.0) as usize;
-    let to = ((s_i + 2.0 * geometric_s / dt) as usize).min(eps.len());
+    foot_delay_between_s(
+        eps,
+        sign,
+        dt,
+        s_i,
+        (0.5 * geometric_s, 2.0 * geometric_s),
+        least,
+        fraction,
+    )
+}
+
+/// [`foot_delay_s`] searched between `within_s.0` and `within_s.1` after the incident foot.
+pub(crate) fn foot_delay_between_s(
+    eps: &[f64],
+    sign: f64,
+    dt: f64,
+    s_i: f64,
+    within_s: (f64, f64),
+    least: f64,
+    fraction: f64,
+) -> Option<f64> {
+    let from = (s_i + within_s.0 / dt).max(0.0) as usize;
+    let to = ((s_i + within_s.1 / dt).max(0.0) as usize).min(eps.len());
     if from + 2 >= to {
         return None;
     }

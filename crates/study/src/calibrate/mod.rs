@@ -17,6 +17,7 @@
 
 pub mod arrivals;
 pub mod gun;
+pub mod optimise;
 pub mod setup_file;
 pub mod shaper;
 pub mod velocity_factor;

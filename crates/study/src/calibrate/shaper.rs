@@ -22,15 +22,12 @@
 //!   bars/authors.toml states it.
 
 use super::{Calibrator, Data, Fitted, SdFrom, ShotData, incident_pulse, pulse_energy_j};
-use argmin::core::{CostFunction, Executor, State};
-use argmin::solver::neldermead::NelderMead;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::{PulseMetrics, pulse_metrics};
 use shpb_core::shaper::{PulseShaper, ShaperModel};
 use shpb_input::{Error, Result};
-use std::sync::Mutex;
 
 /// The shaper calibration (registered in [`super::CALIBRATIONS`]).
 pub struct ShaperFit;
@@ -41,8 +38,8 @@ pub const TOLERANCES: [f64; 4] = [0.15, 0.20, 0.20, 0.20];
 pub const CELL_M: f64 = 1e-3;
 /// Gauge grid of the calibration runs (a `pulse` scene's default), m.
 pub const GAUGE_LENGTH_M: f64 = 2e-3;
-/// Nelder–Mead iterations per round.
-const ITERATIONS_PER_ROUND: u64 = 250;
+/// Nelder–Mead evaluations per round.
+const EVALS_PER_ROUND: usize = 400;
 /// Relative step of the central differences of the Jacobian, in log space.
 const JACOBIAN_STEP: f64 = 0.01;
 /// Penalty of a point outside the bounds.
@@ -95,8 +92,6 @@ pub struct Problem<'a> {
     pub measured: Vec<Measured>,
     /// The velocities.
     pub velocities: Velocities,
-    /// Cost evaluations so far, and the best (cost, point).
-    evals: Mutex<(usize, f64, Vec<f64>)>,
 }
 
 /// (k, p_loss) of the line v² = k (p − p_loss) through (p1, v1) and (p2, v2); None unless it
@@ -142,7 +137,6 @@ impl<'a> Problem<'a> {
             apparatus: a,
             measured,
             velocities,
-            evals: Mutex::new((0, f64::INFINITY, vec![])),
         }
     }
 
@@ -235,36 +229,9 @@ impl<'a> Problem<'a> {
     }
 
     /// Residuals of point `x`; None outside the bounds or without a complete pulse.
-    fn residuals_at(&self, x: &[f64]) -> Option<Vec<f64>> {
+    pub fn residuals_at(&self, x: &[f64]) -> Option<Vec<f64>> {
         let p = self.unpack(x)?;
         self.residuals(&self.simulate(&p))
-    }
-
-    /// Evaluations so far.
-    pub fn evaluations(&self) -> usize {
-        self.evals.lock().map(|e| e.0).unwrap_or(0)
-    }
-}
-
-/// The problem as argmin's cost function: Σ r², [`OUTSIDE`] beyond the bounds.
-struct Cost<'p, 'a>(&'p Problem<'a>);
-
-impl CostFunction for Cost<'_, '_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-
-    fn cost(&self, x: &Vec<f64>) -> std::result::Result<f64, argmin::core::Error> {
-        let c = self
-            .0
-            .residuals_at(x)
-            .map_or(OUTSIDE, |r| r.iter().map(|v| v * v).sum());
-        if let Ok(mut e) = self.0.evals.lock() {
-            e.0 += 1;
-            if c < e.1 {
-                (e.1, e.2) = (c, x.clone());
-            }
-        }
-        Ok(c)
     }
 }
 
@@ -283,61 +250,35 @@ pub struct FitResult {
     pub evaluations: usize,
 }
 
-/// Minimises the problem from `x0` with argmin's Nelder–Mead (restarts with a smaller simplex
-/// until a round stops improving), then the covariance at the optimum.
+/// Minimises the problem from `x0` with argmin's Nelder–Mead ([`super::optimise::nelder_mead`];
+/// restarts with a smaller simplex until a round stops improving), then the covariance at the
+/// optimum.
 pub fn minimise(
     problem: &Problem,
     x0: Vec<f64>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<FitResult> {
-    let fail = |e: argmin::core::Error| Error::Input {
-        file: problem.apparatus.source.clone(),
-        key: "shaper".into(),
-        problem: format!("the optimiser failed: {e}"),
-        allowed: "a shaper fit that converges".into(),
+    let mut f = |x: &[f64]| {
+        problem
+            .residuals_at(x)
+            .map_or(OUTSIDE, |r| r.iter().map(|v| v * v).sum())
     };
-    let mut x = x0;
-    let mut last = f64::INFINITY;
+    let (mut x, mut objective, mut evaluations) = (x0, f64::INFINITY, 0);
     for round in 0..4 {
-        let step = if round == 0 { 0.15 } else { 0.05 };
-        let mut simplex = vec![x.clone()];
-        for i in 0..x.len() {
-            let mut p = x.clone();
-            p[i] += step;
-            simplex.push(p);
-        }
-        let solver = NelderMead::new(simplex)
-            .with_sd_tolerance(1e-6)
-            .map_err(fail)?;
-        let res = Executor::new(Cost(problem), solver)
-            .configure(|s| s.max_iters(ITERATIONS_PER_ROUND))
-            .run()
-            .map_err(fail)?;
-        let best = res.state().get_best_cost();
-        x = res
-            .state()
-            .get_best_param()
-            .cloned()
-            .unwrap_or_else(|| x.clone());
+        let step = vec![if round == 0 { 0.15 } else { 0.05 }; x.len()];
+        let (xb, fb, n) = super::optimise::nelder_mead(&mut f, &x, &step, EVALS_PER_ROUND, 1e-6);
+        evaluations += n;
         progress(&format!(
-            "shaper: round {round}, objective {best:.4}, {} evaluations so far",
-            problem.evaluations()
+            "shaper: round {round}, objective {fb:.4}, {evaluations} evaluations so far"
         ));
-        if last - best < 1e-4 * last.max(1e-12) {
+        let improved = objective - fb >= 1e-4 * objective.max(1e-12);
+        if fb < objective {
+            (x, objective) = (xb, fb);
+        }
+        if !improved {
             break;
         }
-        last = best;
     }
-    // The best point any evaluation saw (Nelder–Mead's best vertex is among them).
-    let (objective, x) = {
-        let e = problem.evals.lock().map_err(|_| Error::Input {
-            file: problem.apparatus.source.clone(),
-            key: "shaper".into(),
-            problem: "a simulation thread panicked".into(),
-            allowed: "a fit whose simulations run".into(),
-        })?;
-        (e.1, e.2.clone())
-    };
     let point = problem.unpack(&x).ok_or_else(|| Error::Input {
         file: problem.apparatus.source.clone(),
         key: "shaper".into(),
@@ -351,7 +292,7 @@ pub fn minimise(
         point,
         objective,
         covariance,
-        evaluations: problem.evaluations(),
+        evaluations,
     })
 }
 
