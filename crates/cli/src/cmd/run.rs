@@ -169,6 +169,24 @@ fn print_summary(params: &Params, out: &RunOutput) -> Result<()> {
             )),
         }
     }
+    // What the bands stand for (docs/physics.md §10.6).
+    if out.summary.iter().any(|i| i.band_90.is_some()) {
+        let inputs = shpb_study::band::inputs(params);
+        let scatter = shpb_study::band::uncertainty(params).map_or(0, |u| u.scatter.len());
+        text.push_str(&format!(
+            "bands: 90 %, first-order propagation of {}{} (docs/physics.md §10.6)\n",
+            inputs
+                .iter()
+                .map(|i| format!("{} (sd {:.3e})", i.key, i.sd))
+                .collect::<Vec<_>>()
+                .join(", "),
+            if scatter > 0 {
+                " and the set-up's output scatter"
+            } else {
+                ""
+            }
+        ));
+    }
     // True and reduced over the same window (the first loading pulse), so that a long run's
     // later impacts are not compared with the first pulse's reduction.
     let comparison = out.peak_comparison().map(|p| {
