@@ -1210,3 +1210,64 @@ fn report(
     );
     r
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fit_cache_reads_back_every_constant_exactly() {
+        // The predictions must use the very numbers the calibrations found: values that do not
+        // print exactly in few digits, a constant without a 1-sigma, a quoted fitted_on.
+        let fitted = |key: &str, value: f64, sd: Option<f64>, uncertain: bool| Fitted {
+            key: key.into(),
+            value,
+            unit: "m^2/s^2/Pa",
+            sd,
+            sd_from: SdFrom::Covariance,
+            fitted_on: "the line \"through\" v1, v2".into(),
+            uncertain,
+        };
+        let fit = FoldFit {
+            variant: VARIANTS[1].0.into(),
+            held_out: 7,
+            seconds: 12.345_678_901,
+            calibration: Calibration {
+                fitted_on: "samples 1-8 without sample 7".into(),
+                shots: 7,
+                constants: vec![
+                    fitted(
+                        "gun.k_m2_per_s2_per_pa",
+                        7.163e-4 / 3.0,
+                        Some(1e-5 / 7.0),
+                        true,
+                    ),
+                    fitted(
+                        "gun.calibrated_min_pressure_pa",
+                        68_947.572_931_7,
+                        None,
+                        false,
+                    ),
+                ],
+                scatter: vec![
+                    ("incident_peak_stress", 0.1 / 3.0),
+                    ("reflected_delay_s", 3.7e-7),
+                ],
+                ran: Vec::new(),
+            },
+        };
+        let path = std::env::temp_dir().join(format!("shot_loo_cache_{}.toml", std::process::id()));
+        std::fs::write(&path, cache_text(std::slice::from_ref(&fit))).unwrap();
+        let back = read_cache(&path);
+        let _ = std::fs::remove_file(&path);
+        let back = back.unwrap();
+        assert_eq!(back.len(), 1);
+        let b = &back[0];
+        assert_eq!((b.variant.as_str(), b.held_out), (VARIANTS[1].0, 7));
+        assert_eq!(b.seconds, fit.seconds);
+        assert_eq!(b.calibration.constants, fit.calibration.constants);
+        assert_eq!(b.calibration.scatter, fit.calibration.scatter);
+        assert_eq!(b.calibration.fitted_on, fit.calibration.fitted_on);
+        assert_eq!(b.calibration.shots, 7);
+    }
+}
