@@ -27,6 +27,7 @@ use shpb_study::band::{self, Band, Prediction, VELOCITY_SCATTER, Z_90};
 use shpb_study::calibrate::{
     self, Calibration, Data, Fitted, SdFrom, ShotData, incident_pulse, pulse_energy_j, setup_file,
 };
+use shpb_validate::figure::{Figure, Legend, Panel, Series, Style, draw};
 use shpb_validate::gauge_records::SAMPLES;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -38,6 +39,8 @@ const CACHE: &str = "validation/pulse/shot_loo_fits.toml";
 const MANIFEST: &str = "validation/pulse/shots-2013-05-22.toml";
 /// The report.
 const REPORT: &str = "validation/pulse/LOO.md";
+/// Its figure.
+const FIGURE: &str = "validation/pulse/loo.png";
 /// Acceptance of issue 41: incident-peak band half-width at most this fraction of the value.
 const PEAK_HALF_WIDTH_MAX: f64 = 0.20;
 /// Acceptance of issue 41: delay band half-width at most this, s.
@@ -477,6 +480,7 @@ fn main() {
     let _ = std::fs::remove_dir_all(&dir);
 
     let md = report(&all.base, &fits, &results, from_cache, fit_seconds, start);
+    draw(&root.join(FIGURE), true, &figure(&results)).expect("write the figure");
     let path = root.join(REPORT);
     std::fs::write(&path, md).expect("write the report");
     println!("wrote {}", path.display());
@@ -501,7 +505,7 @@ fn variant_section(r: &mut String, fits: &[FoldFit], results: &[FoldResult]) -> 
     // Per-fold table.
     let _ = writeln!(
         r,
-        "## Folds\n\nEach cell: predicted [90 % band] / measured, ✓ inside, ✗ outside.\n"
+        "### Folds\n\nEach cell: predicted [90 % band] / measured, ✓ inside, ✗ outside.\n"
     );
     let _ = writeln!(
         r,
@@ -560,7 +564,7 @@ fn variant_section(r: &mut String, fits: &[FoldFit], results: &[FoldResult]) -> 
     // Half-widths and what sets them.
     let _ = writeln!(
         r,
-        "## Band half-widths and what sets them\n\n\
+        "### Band half-widths and what sets them\n\n\
          Half-width = {Z_90:.3} σ. Shares are fractions of σ²: the calibrated constants' 1-sigma \
          (`gun.k_m2_per_s2_per_pa`, `gun.loss_pressure_pa`, `shaper.diameter_m`, \
          `shaper.thickness_m`, `shaper.youngs_modulus_pa`, each moved alone), the gun's \
@@ -695,7 +699,7 @@ fn variant_section(r: &mut String, fits: &[FoldFit], results: &[FoldResult]) -> 
     }
 
     // The model's bias.
-    let _ = writeln!(r, "\n## The model's bias across the eight shots\n");
+    let _ = writeln!(r, "\n### The model's bias across the eight shots\n");
     let _ = writeln!(
         r,
         "Predicted nominal − measured, per held-out shot, and its mean ± sd over the folds:\n"
@@ -749,7 +753,7 @@ fn variant_section(r: &mut String, fits: &[FoldFit], results: &[FoldResult]) -> 
     // Calibrations.
     let _ = writeln!(
         r,
-        "\n## The eight calibrations\n\nConstants with their 1-sigma (relative) and the \
+        "\n### The eight calibrations\n\nConstants with their 1-sigma (relative) and the \
          `[uncertainty.scatter]` each fold's set-up states:\n"
     );
     let keys = [
@@ -890,6 +894,65 @@ fn jackknife_section(
     (out, rows)
 }
 
+/// The figure: for each quantity, where each held-out record falls in its band,
+/// (measured − predicted)/half-width (inside: between −1 and 1), for both calibrations.
+fn figure(results: &[FoldResult]) -> Figure {
+    let names = [
+        "incident peak stress",
+        "incident pulse energy",
+        "reflected delay",
+        "transmitted delay",
+    ];
+    let panels = names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let mut series = Vec::new();
+            for (v, (variant, _)) in VARIANTS.iter().enumerate() {
+                let (x, y): (Vec<f64>, Vec<f64>) = results
+                    .iter()
+                    .filter(|f| f.variant == *variant)
+                    .filter_map(|f| {
+                        let b = f.bands[j].as_ref()?;
+                        let half = Z_90 * b.sd;
+                        Some((f.held_out as f64, (f.measured[j]? - b.value) / half))
+                    })
+                    .unzip();
+                series.push(Series::new(
+                    format!("calibration {variant}"),
+                    x,
+                    y,
+                    Style::Points(if v == 0 { 0 } else { 3 }),
+                ));
+            }
+            for edge in [-1.0, 1.0] {
+                series.push(Series::new(
+                    if edge < 0.0 { "90 % band edges" } else { "" },
+                    vec![0.5, 8.5],
+                    vec![edge, edge],
+                    Style::Dashed(2),
+                ));
+            }
+            Panel {
+                title: (*name).into(),
+                x_label: "held-out sample".into(),
+                y_label: "(measured − predicted) / band half-width".into(),
+                x_scale: 1.0,
+                y_scale: 1.0,
+                series,
+            }
+        })
+        .collect();
+    Figure {
+        legend: Legend::LowerRight,
+        caption: "Where each held-out record falls in its predicted 90 % band: \
+                  (measured − predicted) / half-width, inside between the dashed lines."
+            .into(),
+        columns: 2,
+        panels,
+    }
+}
+
 /// Whether `m` lies in the band `b`.
 fn inside(b: &Option<Band>, m: Option<f64>) -> Option<bool> {
     let (b, m) = (b.as_ref()?, m?);
@@ -933,6 +996,13 @@ fn report(
          after the incident foot at the gauges), the rule the run's `reflected_delay` and \
          `transmitted_delay` use.\n"
     );
+    let _ = writeln!(
+        r,
+        "![Where each held-out record falls in its band](loo.png)\n\n*Where each held-out \
+         record falls in its predicted 90 % band, (measured − predicted) / half-width: inside \
+         between the dashed lines at ±1; red: the manifest's calibration, blue: with the arrival \
+         calibration.*\n"
+    );
     let mut summaries = Vec::new();
     for (name, only) in VARIANTS {
         let fv: Vec<FoldFit> = fits.iter().filter(|f| f.variant == name).cloned().collect();
@@ -943,7 +1013,7 @@ fn report(
             .collect();
         let _ = writeln!(
             r,
-            "# Calibration `{}` (`calibrate = {:?}`){}\n",
+            "## Calibration `{}` (`calibrate = {:?}`){}\n",
             name,
             only,
             if name == VARIANTS[0].0 {
