@@ -13,7 +13,9 @@
 //!   shaper's three; otherwise also the striker velocities at the lowest and highest pressure,
 //!   which fix the gun line v² = k (p − p_loss) through them (0 ≤ p_loss < the lowest pressure).
 //! - **Optimiser.** Nelder–Mead (argmin), restarted from the best point with a smaller simplex
-//!   until a round improves the objective by less than 10⁻⁴ of it.
+//!   until a round improves the objective by less than 10⁻⁴ of it; a gun-line fit first frees one
+//!   velocity per pressure (stage 1) and starts the tied fit (stage 2) from it, as the report
+//!   generator always did.
 //! - **1-sigma.** The least-squares covariance s² (JᵀJ)⁻¹ of the parameters, J the Jacobian of
 //!   the residuals by central differences (±1 % in log space) at the optimum, s² = Σ r²/(n − p);
 //!   k's and p_loss's from the two velocities' by the delta method.
@@ -74,6 +76,9 @@ pub struct Simulated {
 pub enum Velocities {
     /// Known per group (measured, or from a gun line fitted before), m/s.
     Known(Vec<f64>),
+    /// One free velocity per group (stage 1 of a gun-line fit: the shaper found without the gun
+    /// law, from which stage 2 starts).
+    Free(usize),
     /// Tied to a gun line through free velocities at the lowest and highest of these pressures
     /// (sorted, Pa); p_loss below `loss_below_pa`.
     GunLine {
@@ -144,6 +149,7 @@ impl<'a> Problem<'a> {
     fn velocity_parameters(&self) -> usize {
         match self.velocities {
             Velocities::Known(_) => 0,
+            Velocities::Free(n) => n,
             Velocities::GunLine { .. } => 2,
         }
     }
@@ -163,6 +169,7 @@ impl<'a> Problem<'a> {
         let nv = self.velocity_parameters();
         let v = match &self.velocities {
             Velocities::Known(v) => v.clone(),
+            Velocities::Free(n) => x[..*n].iter().map(|y| y.exp()).collect(),
             Velocities::GunLine {
                 pressures_pa,
                 loss_below_pa,
@@ -192,14 +199,22 @@ impl<'a> Problem<'a> {
         Some((v, s))
     }
 
-    /// The starting point (log space) of the base set-up's shaper and `velocities`.
-    pub fn pack(&self, start_v: (f64, f64)) -> Vec<f64> {
-        let s = self.apparatus.shaper.expect("a shaper");
-        let mut x = match self.velocities {
+    /// The point (log space) of `shaper` and the velocities `v` per group (a gun line: through
+    /// the first and last).
+    pub fn pack(&self, v: &[f64], shaper: &PulseShaper) -> Vec<f64> {
+        let mut x: Vec<f64> = match self.velocities {
             Velocities::Known(_) => vec![],
-            Velocities::GunLine { .. } => vec![start_v.0.ln(), start_v.1.ln()],
+            Velocities::Free(_) => v.iter().map(|v| v.ln()).collect(),
+            Velocities::GunLine { .. } => vec![v[0].ln(), v[v.len() - 1].ln()],
         };
-        x.extend([s.diameter_m, s.thickness_m, s.youngs_modulus_pa].map(f64::ln));
+        x.extend(
+            [
+                shaper.diameter_m,
+                shaper.thickness_m,
+                shaper.youngs_modulus_pa,
+            ]
+            .map(f64::ln),
+        );
         x
     }
 
@@ -256,6 +271,7 @@ pub struct FitResult {
 pub fn minimise(
     problem: &Problem,
     x0: Vec<f64>,
+    with_covariance: bool,
     progress: &mut dyn FnMut(&str),
 ) -> Result<FitResult> {
     let mut f = |x: &[f64]| {
@@ -285,8 +301,12 @@ pub fn minimise(
         problem: "no point inside the bounds gives complete simulated pulses".into(),
         allowed: "a base shaper and gun that give an incident pulse at the shots' pressures".into(),
     })?;
-    progress("shaper: Jacobian at the optimum");
-    let covariance = covariance(problem, &x, objective);
+    let covariance = if with_covariance {
+        progress("shaper: Jacobian at the optimum");
+        covariance(problem, &x, objective)
+    } else {
+        None
+    };
     Ok(FitResult {
         x,
         point,
@@ -429,14 +449,28 @@ impl Calibrator for ShaperFit {
             groups(data, earlier_gun(earlier)).expect("skip_reason checked the shots");
         let measured = measure(a, &shots, &group)?;
         let problem = Problem::new(a, measured, velocities.clone());
-        let start_v = match &velocities {
+        let base_shaper = a.shaper.expect("skip_reason checked the shaper");
+        let x0 = match &velocities {
             Velocities::GunLine { pressures_pa, .. } => {
-                let v = |p: f64| a.striker_velocity_m_s(p).unwrap_or(5.0);
-                (v(pressures_pa[0]), v(*pressures_pa.last().unwrap_or(&0.0)))
+                // Stage 1: one velocity per pressure (from the base gun's), then stage 2 from
+                // its velocities and shaper, tied to the gun line (validation/pulse/REPORT.md).
+                let v0: Vec<f64> = pressures_pa
+                    .iter()
+                    .map(|&p| a.striker_velocity_m_s(p).unwrap_or(5.0))
+                    .collect();
+                let free = Problem::new(
+                    a,
+                    problem.measured.clone(),
+                    Velocities::Free(pressures_pa.len()),
+                );
+                progress("shaper: stage 1, one free velocity per pressure");
+                let r1 = minimise(&free, free.pack(&v0, &base_shaper), false, progress)?;
+                progress("shaper: stage 2, the velocities on the gun line");
+                problem.pack(&r1.point.0, &r1.point.1)
             }
-            Velocities::Known(_) => (0.0, 0.0),
+            _ => problem.pack(&[], &base_shaper),
         };
-        let r = minimise(&problem, problem.pack(start_v), progress)?;
+        let r = minimise(&problem, x0, true, progress)?;
         let (v, s) = &r.point;
         let labels = data.on(shots.iter().copied());
         let n_res = 4 * problem.measured.len();

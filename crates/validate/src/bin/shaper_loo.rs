@@ -20,8 +20,6 @@
 
 #[path = "common/mod.rs"]
 mod common;
-#[path = "calibrate_pulse/nelder_mead.rs"]
-mod nelder_mead;
 
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
@@ -302,7 +300,13 @@ fn fit(a: &Apparatus, fam: Family, records: &[Record], train: &[usize], start_v:
         let mut reached = f64::INFINITY;
         for round in 0..4 {
             let step = vec![if round == 0 { 0.2 } else { 0.05 }; x.len()];
-            let (xb, fb, n) = nelder_mead::nelder_mead(&mut f, &x, &step, EVALS_PER_ROUND, 1e-7);
+            let (xb, fb, n) = shpb_study::calibrate::optimise::nelder_mead(
+                &mut f,
+                &x,
+                &step,
+                EVALS_PER_ROUND,
+                1e-7,
+            );
             eprintln!(
                 "{} train {:?}: round {round}, objective {fb:.4}, {n} evaluations",
                 fam.name(),
@@ -718,7 +722,7 @@ fn section(
          velocities, the shaper's free constants (three, or the exponential law's one); objective Σ (error/target)² of incident peak, rise \
          10–90 %, duration at 10 % and pulse energy, targets 5 / 10 / 10 / 5 %), then predicts the held-out \
          pressure with the gun line extrapolated (10, 15 psi) or interpolated (12.5 psi). Errors are \
-         (predicted − measured)/measured on each held-out record; bold: outside the issue-18 target. Nelder–Mead \
+         (predicted − measured)/measured on each held-out record; bold: outside the issue-18 target. argmin's Nelder–Mead (`shpb_study::calibrate::optimise`) \
          in log space, ≤ 4 rounds of {EVALS_PER_ROUND} evaluations, 1 mm cells, no dispersion, as `calibrate_pulse`. \
          {provenance}.\n\n\
          Models: **frew**, the shipped Frew–Forrestal–Chen disc with an effective modulus (free: diameter, \
