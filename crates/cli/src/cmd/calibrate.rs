@@ -173,17 +173,9 @@ fn paired_factor(c: &mut Calibration, volts: &Path, strains: &Path) -> Result<()
     Ok(())
 }
 
-/// Warns when the written set-up (without its `[uncertainty]` table, which another part of
-/// shpb reads) would not load as a set-up: a calibrated value out of its key's range.
+/// Warns when the written set-up would not load as a set-up (a calibrated value out of its key's
+/// range, or an uncertainty its key cannot carry).
 fn check_loads(texts: &setup_file::SetupTexts, gauges_name: &str) {
-    let setup = texts
-        .setup
-        .split("\n[uncertainty]\n")
-        .next()
-        .unwrap_or(&texts.setup);
-    let setup = setup
-        .strip_suffix("# calibration shots show; written by `shpb calibrate` (1-sigma, normal, independent).\n")
-        .unwrap_or(setup);
     let gauges = |g: &str| -> Result<GaugeSetup> {
         match &texts.gauges {
             Some(t) if g == gauges_name => GaugeSetup::from_toml(t, g),
@@ -195,10 +187,8 @@ fn check_loads(texts: &setup_file::SetupTexts, gauges_name: &str) {
             }),
         }
     };
-    if let Err(e) = Apparatus::from_toml(setup, "calibrated set-up", &gauges) {
-        warn(&format!(
-            "the calibrated set-up does not load in this build of shpb: {e}"
-        ));
+    if let Err(e) = Apparatus::from_toml(&texts.setup, "calibrated set-up", &gauges) {
+        warn(&format!("the calibrated set-up does not load: {e}"));
     }
 }
 

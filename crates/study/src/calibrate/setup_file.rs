@@ -186,7 +186,7 @@ pub fn rewrite(
     if !text.ends_with('\n') {
         text.push('\n');
     }
-    text.push_str(&uncertainty_table(c));
+    text.push_str(&uncertainty_table(c, gauges.is_none()));
     Ok(SetupTexts {
         setup: text,
         gauges: gdoc.map(|g| g.to_string()),
@@ -272,7 +272,10 @@ fn set_gauge(g: &mut DocumentMut, channel: &str, key: &str, f: &Fitted, file: &s
 
 /// The `[uncertainty]` table (interfaces §2): fitted_on, shots, the relative or absolute 1-sigma
 /// of each uncertain constant (p_loss absolute, the others relative), the scatter.
-pub fn uncertainty_table(c: &Calibration) -> String {
+///
+/// A gauge channel's constant (`gauges.<channel>.<key>`) can be uncertain only when the channels
+/// are inline (`channels_inline`); with a separate gauge file its 1-sigma is written as a comment.
+pub fn uncertainty_table(c: &Calibration, channels_inline: bool) -> String {
     let mut t = String::from(
         "\n# What the calibrated constants are uncertain by, and the shot-to-shot scatter the\n\
          # calibration shots show; written by `shpb calibrate` (1-sigma, normal, independent).\n\
@@ -294,6 +297,9 @@ pub fn uncertainty_table(c: &Calibration) -> String {
     if !rel.is_empty() {
         t.push_str("[uncertainty.relative_sd]\n");
         for f in rel {
+            if !channels_inline && f.key.starts_with("gauges.") {
+                t.push_str("# the gauge channels are in their own file, which [uncertainty] cannot reach:\n# ");
+            }
             t.push_str(&format!(
                 "\"{}\" = {:.3e}   # {}\n",
                 f.key,
