@@ -14,16 +14,8 @@ use std::path::Path;
 /// One pound per square inch, Pa.
 const PSI_PA: f64 = shpb::units::PSI_PA;
 
-/// The banded values (`shpb_study::band::BANDED`).
-const BANDED: [&str; 7] = [
-    "incident_peak_stress",
-    "incident_energy",
-    "reflected_delay",
-    "transmitted_delay",
-    "reduced_peak_back_force",
-    "reduced_displacement_at_peak_force",
-    "reduced_equilibrium_ratio_at_peak",
-];
+/// The banded values.
+use shpb::band::BANDED;
 
 fn json(out: &std::process::Output) -> serde_json::Value {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(out));
