@@ -300,15 +300,15 @@ pub fn pooled_sd(values: &[(Option<u64>, f64)], relative: bool) -> Option<f64> {
     (df > 0).then(|| (ss / df as f64).sqrt())
 }
 
-/// Energy an incident pulse carries past the gauge, A/(ρ c0) ∫σ² dt, J (docs/physics.md §6.4).
+/// Energy a stress pulse carries past a gauge in one direction, A/(ρ c0) ∫σ² dt, J
+/// (docs/physics.md §6.4), on samples evenly spaced by their mean step (0 for fewer than two).
 pub fn pulse_energy_j(a: &Apparatus, time_s: &[f64], stress_pa: &[f64]) -> f64 {
-    let m = &a.material;
-    let z = m.density_kg_m3 * m.wave_speed_m_s();
-    let dt = if time_s.len() > 1 {
-        time_s[1] - time_s[0]
-    } else {
-        0.0
-    };
+    let n = time_s.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
+    let dt = (time_s[n - 1] - time_s[0]) / (n - 1) as f64;
     a.incident.area_m2() / z * stress_pa.iter().map(|s| s * s).sum::<f64>() * dt
 }
 

@@ -28,6 +28,7 @@ use shpb_core::numeric::min_max;
 use shpb_core::shaper::{CrushedDisc, ExponentialSpring, PulseShaper, ShaperModel};
 use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
+use shpb_study::calibrate::pulse_energy_j;
 use shpb_validate::gauge_records::{
     GaugeStresses, INCIDENT_WINDOW_S, SAMPLES, SAMPLES_2013_06_06, Sample, incident_pulse,
     virtual_test,
@@ -51,13 +52,6 @@ struct Record {
     psi: f64,
     metrics: PulseMetrics,
     energy_j: f64,
-}
-
-/// Energy a bar stress pulse carries, A/(ρ c0) ∫σ² dt, J.
-fn pulse_energy_j(a: &Apparatus, t: &[f64], y: &[f64]) -> f64 {
-    let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    a.incident.area_m2() / z * y.iter().map(|s| s * s).sum::<f64>() * dt
 }
 
 fn read_records(a: &Apparatus) -> Vec<Record> {

@@ -17,6 +17,7 @@ use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::pulse_metrics;
 use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
+use shpb_study::calibrate::pulse_energy_j;
 use shpb_study::uq::{Source, StudyInput, draw, mean_sd};
 use shpb_validate::gauge_records::{INCIDENT_WINDOW_S, SAMPLES, incident_pulse};
 use std::fmt::Write as _;
@@ -36,13 +37,6 @@ const CHI2_5: (f64, f64) = (1.145_476, 11.070_498);
 
 /// One simulated shot: striker velocity (m/s), incident pulse energy (J) and peak (Pa).
 type Shot = (f64, f64, f64);
-
-/// Energy a bar stress pulse carries, A/(ρ c0) ∫σ² dt, J (as validation/pulse/REPORT.md).
-fn pulse_energy_j(a: &Apparatus, t: &[f64], y: &[f64]) -> f64 {
-    let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    a.incident.area_m2() / z * y.iter().map(|s| s * s).sum::<f64>() * dt
-}
 
 /// Pooled relative standard deviation of groups of values (each value over its group's mean;
 /// N − G degrees of freedom): (s, degrees of freedom).

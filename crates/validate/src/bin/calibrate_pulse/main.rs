@@ -33,6 +33,7 @@ use shpb_input::prelude::*;
 use shpb_input::units::PSI_PA;
 use shpb_output::plot::{Axes, Curve, xy_plot};
 use shpb_study::calibrate::optimise::nelder_mead;
+use shpb_study::calibrate::pulse_energy_j;
 use shpb_validate::gauge_records::{
     BASELINE_SAMPLES, INCIDENT_WINDOW_S as WINDOW_S, SAMPLES, incident_pulse,
 };
@@ -748,13 +749,6 @@ fn plateau_and_fall(t: &[f64], y: &[f64]) -> (f64, f64) {
         (Some(r), Some(f90), Some(f10)) => (f90 - r, f10 - f90),
         _ => (f64::NAN, f64::NAN),
     }
-}
-
-/// Energy a stress history carries past a gauge in one direction, A/(ρ c0) ∫ σ² dt, J.
-fn pulse_energy_j(a: &Apparatus, t: &[f64], y: &[f64]) -> f64 {
-    let z = a.material.density_kg_m3 * a.material.wave_speed_m_s();
-    let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
-    a.incident.area_m2() / z * y.iter().map(|s| s * s).sum::<f64>() * dt
 }
 
 /// Aligned traces for a plot: times relative to the 10 % rise, −20 to 240 µs.
