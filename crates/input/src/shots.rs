@@ -13,6 +13,9 @@
 //! bars_together = false              # optional: no specimen, the bars pressed together
 //! label = "sample 1"                 # optional: the shot's name in messages and tables
 //! layout = "other.toml"              # optional: this shot's layout
+//! scene = "shot1-test.toml"          # optional: the shot's virtual test (its specimen, its
+//!                                    # pressure); when shots name one, `shpb calibrate` states
+//!                                    # the shots' scatter about the calibrated model
 //! ```
 
 use crate::error::{Error, Result, Validator};
@@ -36,6 +39,8 @@ pub struct Shot {
     pub bars_together: bool,
     /// How the record reads when it is not the authors' CSV.
     pub layout: Option<RecordLayout>,
+    /// The shot's virtual test (a scene file with bars, resolved relative to the manifest).
+    pub scene: Option<PathBuf>,
 }
 
 /// A manifest of calibration shots.
@@ -71,6 +76,7 @@ struct RawShot {
     #[serde(default)]
     bars_together: bool,
     layout: Option<String>,
+    scene: Option<String>,
 }
 
 /// Largest striker velocity a shot may state, m/s (a gas-gun SHPB stays far below).
@@ -143,6 +149,21 @@ impl ShotManifest {
                 Some(name) => Some(read_layout(&t.key("layout"), name)?),
                 None => common_layout.clone(),
             };
+            let scene = match &s.scene {
+                Some(name) => {
+                    let p = dir.join(name);
+                    if !crate::files::is_file(&p) {
+                        return Err(t.error(
+                            "scene",
+                            format!("cannot read {}: no such file", p.display()),
+                            "the shot's virtual test, a scene .toml with bars (relative to the \
+                             manifest)",
+                        ));
+                    }
+                    Some(p)
+                }
+                None => None,
+            };
             let label = s.label.clone().unwrap_or_else(|| {
                 Path::new(&s.file)
                     .file_name()
@@ -155,6 +176,7 @@ impl ShotManifest {
                 velocity_m_s,
                 bars_together: s.bars_together,
                 layout,
+                scene,
             });
         }
         let fitted_on = raw.fitted_on.unwrap_or_else(|| {

@@ -11,6 +11,8 @@
 //! "gun.k_m2_per_s2_per_pa" = 0.045
 //! [uncertainty.sd]                # 1-sigma in the key's own SI unit (> 0)
 //! "gun.loss_pressure_pa" = 3.0e3
+//! [uncertainty.correlation."gun.k_m2_per_s2_per_pa"]   # r of pairs one fit gave together
+//! "gun.loss_pressure_pa" = 0.93   # each pair once, both keys above; unlisted: independent
 //! [uncertainty.scatter]           # shot-to-shot scatter of outputs, 1-sigma
 //! incident_peak_stress = 0.02     # relative
 //! reflected_delay_s = 2.0e-6      # absolute, s
@@ -18,7 +20,10 @@
 
 use crate::error::{Error, Result, Validator};
 use shpb_core::apparatus::Apparatus;
-use shpb_core::uncertainty::{OutputScatter, SCATTER_OUTPUTS, UncertainInput, Uncertainty};
+use shpb_core::uncertainty::{
+    Correlation, OutputScatter, SCATTER_OUTPUTS, UncertainInput, Uncertainty,
+    is_positive_semidefinite,
+};
 
 /// Set-up keys that state a range or a scatter rather than a constant of the test: not
 /// uncertain inputs (the gun's `velocity_scatter` is itself the striker's shot-to-shot scatter).
@@ -166,11 +171,20 @@ pub fn read(
         ));
     };
     for key in t.keys() {
-        if !["fitted_on", "shots", "relative_sd", "sd", "scatter"].contains(&key.as_str()) {
+        if ![
+            "fitted_on",
+            "shots",
+            "relative_sd",
+            "sd",
+            "correlation",
+            "scatter",
+        ]
+        .contains(&key.as_str())
+        {
             return Err(v.error(
                 key,
                 "unknown key",
-                "fitted_on, shots, relative_sd, sd, scatter",
+                "fitted_on, shots, relative_sd, sd, correlation, scatter",
             ));
         }
     }
@@ -282,6 +296,7 @@ pub fn read(
             });
         }
     }
+    let correlations = correlations(&v, t.get("correlation"), &inputs)?;
     let sv = v.table("scatter");
     let names = SCATTER_OUTPUTS
         .iter()
@@ -311,8 +326,102 @@ pub fn read(
         fitted_on,
         shots,
         inputs,
+        correlations,
         scatter,
     })
+}
+
+/// The `[uncertainty.correlation]` table `value` (`[uncertainty.correlation."A"] "B" = r`): each
+/// pair of two different keys of `inputs`, once, r in [−1, 1], the whole matrix positive
+/// semi-definite (else no normal distribution has it).
+fn correlations(
+    v: &Validator,
+    value: Option<&toml::Value>,
+    inputs: &[UncertainInput],
+) -> Result<Vec<Correlation>> {
+    let Some(value) = value else {
+        return Ok(Vec::new());
+    };
+    let cv = v.table("correlation");
+    let keys = || {
+        format!(
+            "a key of [uncertainty.relative_sd] or [uncertainty.sd]: {}",
+            inputs
+                .iter()
+                .map(|i| i.key.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    let Some(t) = value.as_table() else {
+        return Err(v.error(
+            "correlation",
+            "not a table",
+            "[uncertainty.correlation.\"KEY\"] tables of \"OTHER KEY\" = r",
+        ));
+    };
+    let mut out: Vec<Correlation> = Vec::new();
+    for (a, row) in t {
+        if !inputs.iter().any(|i| &i.key == a) {
+            return Err(cv.error(a, "not an uncertain constant", keys()));
+        }
+        let Some(row) = row.as_table() else {
+            return Err(cv.error(a, "not a table", "a table of \"OTHER KEY\" = r"));
+        };
+        let rv = cv.table(a);
+        for (b, r) in row {
+            if !inputs.iter().any(|i| &i.key == b) || a == b {
+                return Err(rv.error(b, "not another uncertain constant", keys()));
+            }
+            let allowed = "a correlation coefficient, -1 to 1";
+            let r = match r {
+                toml::Value::Float(x) => *x,
+                toml::Value::Integer(i) => *i as f64,
+                other => {
+                    return Err(rv.error(
+                        b,
+                        format!("{} is not a number", other.type_str()),
+                        allowed,
+                    ));
+                }
+            };
+            if !(-1.0..=1.0).contains(&r) {
+                return Err(rv.error(b, format!("{r} is out of range"), allowed));
+            }
+            if out
+                .iter()
+                .any(|c| (c.a == *a && c.b == *b) || (c.a == *b && c.b == *a))
+            {
+                return Err(rv.error(b, "the pair is given twice", "each pair once"));
+            }
+            out.push(Correlation {
+                a: a.clone(),
+                b: b.clone(),
+                r,
+            });
+        }
+    }
+    let n = inputs.len();
+    let mut m = vec![0.0; n * n];
+    for (i, x) in inputs.iter().enumerate() {
+        for (j, y) in inputs.iter().enumerate() {
+            m[i * n + j] = if i == j {
+                1.0
+            } else {
+                out.iter()
+                    .find(|c| (c.a == x.key && c.b == y.key) || (c.a == y.key && c.b == x.key))
+                    .map_or(0.0, |c| c.r)
+            };
+        }
+    }
+    if !is_positive_semidefinite(&m, n) {
+        return Err(v.error(
+            "correlation",
+            "the correlations cannot hold together (the matrix is not positive semi-definite)",
+            "the correlations of one covariance matrix, as `shpb calibrate` writes them",
+        ));
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -352,6 +461,27 @@ mod tests {
             .unwrap();
         assert_eq!((p.value, p.sd, p.relative_sd), (21.76e3, 3.0e3, None));
         assert!(u.scatter.is_empty());
+        assert_eq!(
+            u.correlation("gun.k_m2_per_s2_per_pa", "gun.loss_pressure_pa"),
+            0.0
+        );
+    }
+
+    #[test]
+    fn correlations_are_read_symmetric() {
+        let a = read_with(
+            "[uncertainty]\nfitted_on = \"x\"\nshots = 3\n[uncertainty.sd]\n\
+             \"gun.loss_pressure_pa\" = 1e3\n[uncertainty.relative_sd]\n\
+             \"gun.k_m2_per_s2_per_pa\" = 0.05\n\
+             [uncertainty.correlation.\"gun.k_m2_per_s2_per_pa\"]\n\
+             \"gun.loss_pressure_pa\" = 0.93\n",
+        )
+        .unwrap();
+        let u = a.uncertainty.unwrap();
+        assert_eq!(
+            u.correlation("gun.loss_pressure_pa", "gun.k_m2_per_s2_per_pa"),
+            0.93
+        );
     }
 
     #[test]
@@ -436,6 +566,35 @@ mod tests {
             (
                 &format!("{head}color = 1\n"),
                 "`uncertainty.color`: unknown key",
+            ),
+            (
+                &format!(
+                    "{head}[uncertainty.sd]\n\"gun.loss_pressure_pa\" = 1e3\n\
+                     [uncertainty.correlation.\"gun.loss_pressure_pa\"]\n\
+                     \"gun.k_m2_per_s2_per_pa\" = 0.5\n"
+                ),
+                "`uncertainty.correlation.gun.loss_pressure_pa.gun.k_m2_per_s2_per_pa`: not another uncertain constant",
+            ),
+            (
+                &format!(
+                    "{head}[uncertainty.sd]\n\"gun.loss_pressure_pa\" = 1e3\n\
+                     [uncertainty.relative_sd]\n\"gun.k_m2_per_s2_per_pa\" = 0.05\n\
+                     [uncertainty.correlation.\"gun.loss_pressure_pa\"]\n\
+                     \"gun.k_m2_per_s2_per_pa\" = 1.5\n"
+                ),
+                "1.5 is out of range; allowed: a correlation coefficient, -1 to 1",
+            ),
+            (
+                &format!(
+                    "{head}[uncertainty.sd]\n\"gun.loss_pressure_pa\" = 1e3\n\
+                     \"shaper.youngs_modulus_pa\" = 1e8\n\
+                     [uncertainty.relative_sd]\n\"gun.k_m2_per_s2_per_pa\" = 0.05\n\
+                     [uncertainty.correlation.\"gun.loss_pressure_pa\"]\n\
+                     \"gun.k_m2_per_s2_per_pa\" = 0.9\n\"shaper.youngs_modulus_pa\" = 0.9\n\
+                     [uncertainty.correlation.\"gun.k_m2_per_s2_per_pa\"]\n\
+                     \"shaper.youngs_modulus_pa\" = -0.5\n"
+                ),
+                "`uncertainty.correlation`: the correlations cannot hold together",
             ),
         ] {
             let e = read_with(table).unwrap_err().to_string();

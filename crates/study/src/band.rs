@@ -206,9 +206,41 @@ pub fn reload(
     Ok(moved)
 }
 
+/// The correlation matrix (row-major) of `inputs` as `u` states it (1 on the diagonal, a pair
+/// not listed and the gun's velocity scatter independent).
+pub fn correlation_matrix(inputs: &[BandInput], u: Option<&Uncertainty>) -> Vec<f64> {
+    let n = inputs.len();
+    let mut m = vec![0.0; n * n];
+    for (i, a) in inputs.iter().enumerate() {
+        for (j, b) in inputs.iter().enumerate() {
+            m[i * n + j] = if i == j {
+                1.0
+            } else {
+                u.map_or(0.0, |u| u.correlation(&a.key, &b.key))
+            };
+        }
+    }
+    m
+}
+
+/// σ² of the inputs' shares s (docs/physics.md §10.6): Σ_ij s_i s_j r_ij, r the stated
+/// correlations (Σ s_i² when none is stated).
+pub fn correlated_variance(inputs: &[BandInput], shares: &[f64], u: Option<&Uncertainty>) -> f64 {
+    let n = shares.len();
+    let r = correlation_matrix(&inputs[..n], u);
+    let mut v = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            v += shares[i] * shares[j] * r[i * n + j];
+        }
+    }
+    v.max(0.0)
+}
+
 /// The bands of `nominal`'s [`BANDED`] values (a run of the scene `perturb` moves) for `inputs` and the outputs'
 /// `scatter` (docs/physics.md §10.6): for each input i, runs at x_i ± sd_i (the others at their
-/// values) give its share s_i = (y₊ − y₋)/2; σ² = Σ s_i² + scatter²; band = y ± 1.645 σ. The
+/// values) give its share s_i = (y₊ − y₋)/2; σ² = Σ_ij s_i s_j r_ij + scatter² (r the stated
+/// correlations of `scatter`'s set-up, else independent); band = y ± 1.645 σ. The
 /// 2n runs are summary-only (no snapshots) and run in parallel (rayon's pool). A value some run
 /// lacks (a pulse whose foot it cannot find) gets no band and a warning; a band run that fails
 /// leaves every band out, with the error as a warning.
@@ -277,7 +309,7 @@ pub fn predict_with(
         let scatter_sd = scatter
             .and_then(|u| u.scatter_of(key))
             .map_or(0.0, |s| s.sd_at(item.value));
-        let sd = (shares.iter().map(|s| s * s).sum::<f64>() + scatter_sd * scatter_sd).sqrt();
+        let sd = (correlated_variance(inputs, &shares, scatter) + scatter_sd * scatter_sd).sqrt();
         prediction.bands.push(Band {
             key: key.to_string(),
             unit: item.unit,
@@ -320,26 +352,42 @@ pub fn apply(out: &mut RunOutput, prediction: &Prediction) {
     out.warnings.extend(prediction.warnings.iter().cloned());
 }
 
-/// A Monte-Carlo ensemble of the same inputs: `n` runs with every input drawn at once, normal and
-/// independent (seeded [`Rng`], Φ⁻¹ of uniforms), each value's sample mean, sd and 5th/95th
-/// percentiles per [`BANDED`] key (the keys every run has). What the linear bands are checked
+/// A Monte-Carlo ensemble of the same inputs: `n` runs with every input drawn at once, normal
+/// with the correlations `u` states (seeded [`Rng`], Φ⁻¹ of uniforms, through the Cholesky
+/// factor of the correlation matrix; independent when none is stated), each value's sample
+/// values per [`BANDED`] key (the keys every run has). What the linear bands are checked
 /// against (validation/bands/REPORT.md).
 pub fn monte_carlo(
     inputs: &[BandInput],
+    u: Option<&Uncertainty>,
     n: usize,
     seed: u64,
     perturb: &Perturb,
 ) -> Result<Vec<(String, Vec<f64>)>> {
     let mut rng = Rng::new(seed);
+    let m = inputs.len();
+    let r = nalgebra::DMatrix::from_row_slice(m, m, &correlation_matrix(inputs, u));
+    // A semi-definite matrix (r = ±1) gets a tiny diagonal so that Cholesky exists.
+    let l = r
+        .clone()
+        .cholesky()
+        .or_else(|| (r + nalgebra::DMatrix::identity(m, m) * 1e-12).cholesky())
+        .map(|c| c.l())
+        .ok_or_else(|| Error::Input {
+            file: "[uncertainty]".into(),
+            key: "correlation".into(),
+            problem: "the correlation matrix is not positive semi-definite".into(),
+            allowed: "the correlations of one covariance matrix".into(),
+        })?;
     let draws: Vec<Vec<(String, f64)>> = (0..n)
         .map(|_| {
+            let z: Vec<f64> = (0..m).map(|_| normal_quantile(rng.uniform())).collect();
             inputs
                 .iter()
-                .map(|i| {
-                    (
-                        i.key.clone(),
-                        i.value + i.sd * normal_quantile(rng.uniform()),
-                    )
+                .enumerate()
+                .map(|(i, input)| {
+                    let zi: f64 = (0..=i).map(|j| l[(i, j)] * z[j]).sum();
+                    (input.key.clone(), input.value + input.sd * zi)
                 })
                 .collect()
         })
@@ -373,6 +421,35 @@ pub fn sample_stats(y: &[f64]) -> (f64, f64, f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn correlated_shares_add_by_their_correlation() {
+        use shpb_core::uncertainty::Correlation;
+        let inputs: Vec<BandInput> = ["k", "p", "d"]
+            .iter()
+            .map(|k| BandInput {
+                key: k.to_string(),
+                value: 1.0,
+                sd: 0.1,
+            })
+            .collect();
+        let u = Uncertainty {
+            fitted_on: "x".into(),
+            shots: 2,
+            inputs: vec![],
+            correlations: vec![Correlation {
+                a: "p".into(),
+                b: "k".into(),
+                r: 0.8,
+            }],
+            scatter: vec![],
+        };
+        // Var(a k + b p + c d) = a² + b² + c² + 2ab r_kp for unit shares' sds.
+        let s = [3.0, -2.0, 1.0];
+        let v = correlated_variance(&inputs, &s, Some(&u));
+        assert!((v - (9.0 + 4.0 + 1.0 + 2.0 * 3.0 * -2.0 * 0.8)).abs() < 1e-12);
+        assert!((correlated_variance(&inputs, &s, None) - 14.0).abs() < 1e-12);
+    }
 
     #[test]
     fn z_90_is_the_95th_percentile_of_the_normal() {

@@ -144,3 +144,73 @@ fn the_strain_factor_of_an_unshaped_shot_reads_its_plateau_as_v_over_2c() {
         f.value
     );
 }
+
+/// The scatter about the calibrated model (`calibrate::model_scatter`): shots simulated on bars
+/// of density 7900 kg/m³ with the incident gauge 0.55 m from the specimen, calibrated by their
+/// arrivals from the 8110 kg/m³ / 0.644525 m base, each shot naming its virtual test. On the
+/// calibrated set-up the tests give the records' own delays back to the feet's reading (a few
+/// tenths of a µs, §7.6: below 1.5 µs after the Student factor for three shots,
+/// t₀.₉₅(2)/z₀.₉₅ = 1.78, or no scatter at all when they agree to the sample); on the base
+/// set-up the reflected pulse comes (0.644525 − 0.55) · 2/c0 = 38.9 µs late on every shot, which
+/// the scatter then carries. The measured peak is the record's largest sample (the calibration's
+/// reading), above the noise-free plateau the test simulates by the noise's extreme over the
+/// plateau's few hundred samples, σ √(2 ln N) ≈ 3.5 σ (σ = noise_rms_v over the channel's volts
+/// per strain): each shot's peak residual lies between 0 and 4 σ of its plateau.
+#[test]
+fn shots_on_the_calibrated_model_scatter_by_their_reading_only() {
+    use shpb_study::calibrate::model_scatter::about_model;
+    let d = tempfile::tempdir().unwrap();
+    let truth = setup(d.path(), "truth", 7900.0, 0.55);
+    let base = setup(d.path(), "base", 8110.0, 0.644525);
+    let mut shots = String::from("calibrate = [\"arrivals\"]\n");
+    for (name, v) in [("a", 4.0), ("b", 5.0), ("c", 6.0)] {
+        let scene = SPECIMEN_SHOT.replace("5.0", &format!("{v:?}"));
+        shot(d.path(), name, &scene, &truth);
+        std::fs::write(
+            d.path().join(format!("{name}-test.toml")),
+            scene.replace("BARS", "base.toml"),
+        )
+        .unwrap();
+        shots.push_str(&format!(
+            "[[shot]]\nfile = \"{name}.csv\"\nscene = \"{name}-test.toml\"\n"
+        ));
+    }
+    let manifest = ShotManifest::from_toml(&shots, "shots.toml", d.path()).unwrap();
+    let a = shpb_core::apparatus::Apparatus::from_file(&base).unwrap();
+    let data = Data::read(a, &manifest).unwrap();
+    let c = calibrate(&data, &mut |_| {}).unwrap();
+    let m = about_model(&data, &c)
+        .unwrap()
+        .expect("the shots name their tests");
+    assert_eq!(m.shots.len(), 3, "{m:?}");
+    let sd = |k: &str| m.scatter.iter().find(|s| s.0 == k).map(|s| s.1);
+    let reflected = sd("reflected_delay_s").unwrap_or(0.0);
+    assert!(reflected < 1.5e-6, "reflected delay scatter {reflected}");
+    let ch = data.base.gauges.channel("incident").unwrap();
+    let noise_strain = ch.digitiser.noise_rms_v / (ch.voltage_from_strain(1e-4) / 1e-4).abs();
+    let e = data.base.material.youngs_modulus_pa;
+    for s in &m.shots {
+        let (measured, simulated) = (s.measured[0].unwrap(), s.simulated[0].unwrap());
+        let r = measured / simulated - 1.0;
+        let bound = 4.0 * noise_strain * e / simulated;
+        assert!(
+            (0.0..bound).contains(&r),
+            "{}: peak residual {r}, bound {bound}",
+            s.label
+        );
+    }
+    // The uncalibrated base: the reflected pulse 38.9 µs late on every shot.
+    let none = shpb_study::calibrate::Calibration {
+        constants: Vec::new(),
+        correlations: Vec::new(),
+        ..c.clone()
+    };
+    let m0 = about_model(&data, &none).unwrap().unwrap();
+    let r0 = m0
+        .scatter
+        .iter()
+        .find(|s| s.0 == "reflected_delay_s")
+        .unwrap()
+        .1;
+    assert!(r0 > 38e-6, "uncalibrated reflected delay scatter {r0}");
+}

@@ -8,7 +8,7 @@ use shpb_input::shots::ShotManifest;
 use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, check_output_path, write_text_atomically};
 use shpb_study::calibrate::{
-    Calibration, Data, Fitted, SdFrom, calibrate as run_calibrations, setup_file,
+    Calibration, Data, Fitted, SdFrom, calibrate as run_calibrations, model_scatter, setup_file,
 };
 use std::path::{Path, PathBuf};
 
@@ -72,6 +72,7 @@ pub fn calibrate(
     inputs.extend(shots.map(Path::to_path_buf));
     if let Some(m) = &manifest {
         inputs.extend(m.shots.iter().map(|s| s.file.clone()));
+        inputs.extend(m.shots.iter().filter_map(|s| s.scene.clone()));
     }
     if let Some((v, s)) = paired {
         inputs.extend([v.to_path_buf(), s.to_path_buf()]);
@@ -89,12 +90,28 @@ pub fn calibrate(
                     eprintln!("calibrate: {line}");
                 }
             };
-            run_calibrations(&data, &mut progress)?
+            let mut c = run_calibrations(&data, &mut progress)?;
+            if let Some(m) = model_scatter::about_model(&data, &c)? {
+                for s in &m.shots {
+                    progress(&format!(
+                        "scatter about the model: {}: measured/simulated peak {}, energy {}, \
+                         reflected delay {}, transmitted delay {}",
+                        s.label,
+                        ratio(s.measured[0], s.simulated[0]),
+                        ratio(s.measured[1], s.simulated[1]),
+                        difference_us(s.measured[2], s.simulated[2]),
+                        difference_us(s.measured[3], s.simulated[3]),
+                    ));
+                }
+                c.scatter = m.scatter;
+            }
+            c
         }
         None => Calibration {
             fitted_on: String::new(),
             shots: 0,
             constants: Vec::new(),
+            correlations: Vec::new(),
             scatter: Vec::new(),
             ran: Vec::new(),
         },
@@ -192,6 +209,22 @@ fn check_loads(texts: &setup_file::SetupTexts, gauges_name: &str) {
     }
 }
 
+/// measured/simulated, or `—`.
+fn ratio(m: Option<f64>, y: Option<f64>) -> String {
+    match (m, y) {
+        (Some(m), Some(y)) => format!("{:.3}", m / y),
+        _ => "—".into(),
+    }
+}
+
+/// measured − simulated in µs, or `—`.
+fn difference_us(m: Option<f64>, y: Option<f64>) -> String {
+    match (m, y) {
+        (Some(m), Some(y)) => format!("{:+.1} us", (m - y) * 1e6),
+        _ => "—".into(),
+    }
+}
+
 /// A number with 4 significant digits.
 fn g4(x: f64) -> String {
     format!("{x:.4e}")
@@ -213,6 +246,12 @@ fn text(c: &Calibration) -> String {
         };
         t.push_str(&format!("  {:<46} {} {}{sd}\n", f.key, g4(f.value), f.unit));
         t.push_str(&format!("      fitted on: {}\n", f.fitted_on));
+    }
+    if !c.correlations.is_empty() {
+        t.push_str("correlations of constants fitted together:\n");
+        for r in &c.correlations {
+            t.push_str(&format!("  {} ~ {}: {:+.3}\n", r.a, r.b, r.r));
+        }
     }
     if !c.scatter.is_empty() {
         t.push_str("shot-to-shot scatter (1-sigma):\n");
@@ -250,6 +289,11 @@ fn json(c: &Calibration, setup: &Path, gauges: Option<&Path>) -> serde_json::Val
         .iter()
         .map(|(k, v)| (k.to_string(), serde_json::json!(v)))
         .collect();
+    let correlations: Vec<serde_json::Value> = c
+        .correlations
+        .iter()
+        .map(|r| serde_json::json!({"a": r.a, "b": r.b, "r": r.r}))
+        .collect();
     let skipped: serde_json::Map<String, serde_json::Value> = c
         .ran
         .iter()
@@ -259,6 +303,7 @@ fn json(c: &Calibration, setup: &Path, gauges: Option<&Path>) -> serde_json::Val
         "fitted_on": c.fitted_on,
         "shots": c.shots,
         "constants": constants,
+        "correlations": correlations,
         "scatter": scatter,
         "not_calibrated": skipped,
         "setup": setup.display().to_string(),

@@ -80,12 +80,7 @@ impl Calibrator for ArrivalFit {
         })
     }
 
-    fn fit(
-        &self,
-        data: &Data,
-        _: &[Fitted],
-        progress: &mut dyn FnMut(&str),
-    ) -> Result<Vec<Fitted>> {
+    fn fit(&self, data: &Data, _: &[Fitted], progress: &mut dyn FnMut(&str)) -> Result<super::Fit> {
         let a = &data.base;
         let dt = data
             .shots
@@ -182,6 +177,6 @@ impl Calibrator for ArrivalFit {
                 uncertain: true,
             });
         }
-        Ok(out)
+        Ok(out.into())
     }
 }

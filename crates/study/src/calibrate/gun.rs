@@ -127,12 +127,7 @@ impl Calibrator for GunLine {
         })
     }
 
-    fn fit(
-        &self,
-        data: &Data,
-        _: &[Fitted],
-        progress: &mut dyn FnMut(&str),
-    ) -> Result<Vec<Fitted>> {
+    fn fit(&self, data: &Data, _: &[Fitted], progress: &mut dyn FnMut(&str)) -> Result<super::Fit> {
         let pts = points(data);
         let f = fit_line(&pts).expect("skip_reason checked the points");
         let used: Vec<_> = data
@@ -167,7 +162,7 @@ impl Calibrator for GunLine {
             fitted_on: what.into(),
             uncertain: false,
         };
-        Ok(vec![
+        let constants = vec![
             Fitted {
                 key: "gun.k_m2_per_s2_per_pa".into(),
                 value: f.k,
@@ -216,7 +211,20 @@ impl Calibrator for GunLine {
                 "Pa",
                 "the highest pressure of the shots",
             ),
-        ])
+        ];
+        Ok(super::Fit {
+            constants,
+            correlations: f
+                .correlation
+                .is_finite()
+                .then(|| super::Correlation {
+                    a: "gun.k_m2_per_s2_per_pa".into(),
+                    b: "gun.loss_pressure_pa".into(),
+                    r: f.correlation.clamp(-1.0, 1.0),
+                })
+                .into_iter()
+                .collect(),
+        })
     }
 }
 

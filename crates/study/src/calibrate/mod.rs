@@ -10,20 +10,28 @@
 //!   (weighted least squares);
 //! - [`shaper`]: the Frew shaper's diameter, thickness and effective modulus from incident
 //!   pulses at several pressures (tied to the gun line) or measured velocities (argmin's
-//!   Nelder–Mead).
+//!   Nelder–Mead);
+//! - [`specimen_arrivals`]: the transmission gauge's effective distance from specimen shots'
+//!   virtual tests (shots naming their `scene`).
+//!
+//! [`model_scatter`] then states the shots' scatter about the calibrated model when shots name
+//! their virtual tests.
 //!
 //! The strain factor from paired volt and strain files (`--paired VOLTS STRAINS`) is
 //! `crate::strain_factor` (helper RECORDS); the command is the place it is wired in.
 
 pub mod arrivals;
 pub mod gun;
+pub mod model_scatter;
 pub mod optimise;
 pub mod setup_file;
 pub mod shaper;
+pub mod specimen_arrivals;
 pub mod velocity_factor;
 
 use shpb_core::apparatus::Apparatus;
 use shpb_core::reduce::{Arrivals, ReductionInput, ReductionOptions, ReductionSetup};
+pub use shpb_core::uncertainty::Correlation;
 use shpb_input::shots::{Shot, ShotManifest};
 use shpb_input::{Error, Result};
 
@@ -109,6 +117,9 @@ pub struct Data {
     pub shots: Vec<ShotData>,
     /// Which calibrations to run (None: every one whose data is given).
     pub only: Option<Vec<String>>,
+    /// The base set-up's texts ([`setup_file::read_base`]), for the shots' virtual tests on a
+    /// calibrated set-up ([`model_scatter`]); None when its file cannot be read again.
+    pub base_texts: Option<model_scatter::BaseTexts>,
 }
 
 impl Data {
@@ -134,11 +145,19 @@ impl Data {
                 arrivals,
             });
         }
+        let source = base
+            .source
+            .strip_prefix("built-in set-up `")
+            .and_then(|s| s.strip_suffix('`'))
+            .unwrap_or(&base.source)
+            .to_string();
+        let base_texts = setup_file::read_base(std::path::Path::new(&source)).ok();
         Ok(Data {
             base,
             fitted_on: manifest.fitted_on.clone(),
             shots,
             only: manifest.only.clone(),
+            base_texts,
         })
     }
 
@@ -154,6 +173,25 @@ impl Data {
     }
 }
 
+/// What one calibration fitted: its constants and the correlations of those one fit gave
+/// together (from the fit's covariance matrix).
+#[derive(Debug, Clone, Default)]
+pub struct Fit {
+    /// The constants.
+    pub constants: Vec<Fitted>,
+    /// Correlations of pairs of uncertain constants (a pair not listed: independent).
+    pub correlations: Vec<Correlation>,
+}
+
+impl From<Vec<Fitted>> for Fit {
+    fn from(constants: Vec<Fitted>) -> Self {
+        Fit {
+            constants,
+            correlations: Vec::new(),
+        }
+    }
+}
+
 /// A calibration: a named fit that runs when the shots carry its data.
 pub trait Calibrator: Sync {
     /// Its name (`arrivals`, `strain-factor`, `gun`, `shaper`).
@@ -162,20 +200,16 @@ pub trait Calibrator: Sync {
     fn skip_reason(&self, data: &Data, earlier: &[Fitted]) -> Option<String>;
     /// Fits its constants; `earlier` holds what the calibrations before it fitted, `progress`
     /// gets one line per stage of a long fit.
-    fn fit(
-        &self,
-        data: &Data,
-        earlier: &[Fitted],
-        progress: &mut dyn FnMut(&str),
-    ) -> Result<Vec<Fitted>>;
+    fn fit(&self, data: &Data, earlier: &[Fitted], progress: &mut dyn FnMut(&str)) -> Result<Fit>;
 }
 
 /// Every calibration, in the order they run (the registration).
-pub const CALIBRATIONS: [&dyn Calibrator; 4] = [
+pub const CALIBRATIONS: [&dyn Calibrator; 5] = [
     &arrivals::ArrivalFit,
     &velocity_factor::VelocityFactor,
     &gun::GunLine,
     &shaper::ShaperFit,
+    &specimen_arrivals::SpecimenArrivals,
 ];
 
 /// The names of [`CALIBRATIONS`], for messages.
@@ -196,6 +230,8 @@ pub struct Calibration {
     pub shots: usize,
     /// The calibrated constants, in the order fitted.
     pub constants: Vec<Fitted>,
+    /// Correlations of pairs of the constants (`[uncertainty.correlation]`).
+    pub correlations: Vec<Correlation>,
     /// Shot-to-shot scatter beyond the model (`[uncertainty.scatter]` keys and 1-sigma).
     pub scatter: Vec<(&'static str, f64)>,
     /// The calibrations that ran and those skipped, with why.
@@ -217,6 +253,7 @@ pub fn calibrate(data: &Data, progress: &mut dyn FnMut(&str)) -> Result<Calibrat
         });
     }
     let mut constants: Vec<Fitted> = Vec::new();
+    let mut correlations: Vec<Correlation> = Vec::new();
     let mut ran = Vec::new();
     for c in CALIBRATIONS {
         if data
@@ -235,7 +272,12 @@ pub fn calibrate(data: &Data, progress: &mut dyn FnMut(&str)) -> Result<Calibrat
             continue;
         }
         let fitted = c.fit(data, &constants, progress)?;
-        constants.extend(fitted);
+        // A later fit of a key replaces the earlier value and its correlations.
+        for f in &fitted.constants {
+            correlations.retain(|r| r.a != f.key && r.b != f.key);
+        }
+        constants.extend(fitted.constants);
+        correlations.extend(fitted.correlations);
         ran.push((c.name(), None));
     }
     if constants.is_empty() {
@@ -257,6 +299,7 @@ pub fn calibrate(data: &Data, progress: &mut dyn FnMut(&str)) -> Result<Calibrat
         fitted_on: data.fitted_on.clone(),
         shots: data.shots.len(),
         constants,
+        correlations,
         scatter: scatter(data),
         ran,
     })

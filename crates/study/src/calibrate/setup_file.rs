@@ -278,7 +278,8 @@ fn set_gauge(g: &mut DocumentMut, channel: &str, key: &str, f: &Fitted, file: &s
 pub fn uncertainty_table(c: &Calibration, channels_inline: bool) -> String {
     let mut t = String::from(
         "\n# What the calibrated constants are uncertain by, and the shot-to-shot scatter the\n\
-         # calibration shots show; written by `shpb calibrate` (1-sigma, normal, independent).\n\
+         # calibration shots show; written by `shpb calibrate` (1-sigma, normal; the\n\
+         # correlations of constants one fit gave together, the others independent).\n\
          [uncertainty]\n",
     );
     t.push_str(&format!(
@@ -320,6 +321,24 @@ pub fn uncertainty_table(c: &Calibration, channels_inline: bool) -> String {
             ));
         }
     }
+    // Correlations of pairs the table above states (a gauge key only with inline channels).
+    let stated = |k: &str| {
+        uncertain
+            .iter()
+            .any(|f| f.key == k && (channels_inline || !k.starts_with("gauges.")))
+    };
+    let mut rows: Vec<&str> = Vec::new();
+    for r in &c.correlations {
+        if stated(&r.a) && stated(&r.b) && !rows.contains(&r.a.as_str()) {
+            rows.push(&r.a);
+        }
+    }
+    for a in rows {
+        t.push_str(&format!("[uncertainty.correlation.\"{a}\"]\n"));
+        for r in c.correlations.iter().filter(|r| r.a == a && stated(&r.b)) {
+            t.push_str(&format!("\"{}\" = {:.6}\n", r.b, r.r));
+        }
+    }
     if !c.scatter.is_empty() {
         t.push_str("[uncertainty.scatter]\n");
         for (k, v) in &c.scatter {
@@ -336,7 +355,7 @@ pub fn uncertainty_table(c: &Calibration, channels_inline: bool) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::SdFrom;
+    use super::super::{Correlation, SdFrom};
     use super::*;
 
     fn fitted(key: &str, value: f64, sd: Option<f64>) -> Fitted {
@@ -369,6 +388,18 @@ mod tests {
                     Some(1e-3),
                 ),
                 fitted("gauges.incident.strain_per_volt", -1.5e-3, Some(1e-5)),
+            ],
+            correlations: vec![
+                Correlation {
+                    a: "gun.k_m2_per_s2_per_pa".into(),
+                    b: "gun.loss_pressure_pa".into(),
+                    r: 0.93,
+                },
+                Correlation {
+                    a: "gun.k_m2_per_s2_per_pa".into(),
+                    b: "gauges.transmission.distance_from_specimen_m".into(),
+                    r: 0.1,
+                },
             ],
             scatter: vec![("incident_peak_stress", 0.02)],
             ran: vec![],
@@ -413,6 +444,13 @@ mod tests {
         );
         assert_eq!(u["sd"]["gun.loss_pressure_pa"].as_float(), Some(3e3));
         assert_eq!(u["scatter"]["incident_peak_stress"].as_float(), Some(0.02));
+        // The gauge key is not in the table (its channels are in their own file), so neither is
+        // its correlation.
+        let r = u["correlation"]["gun.k_m2_per_s2_per_pa"]
+            .as_table()
+            .unwrap();
+        assert_eq!(r["gun.loss_pressure_pa"].as_float(), Some(0.93));
+        assert_eq!(r.len(), 1);
         let g: toml::Table = toml::from_str(t.gauges.as_ref().unwrap()).unwrap();
         let ch = g["channel"].as_array().unwrap();
         assert_eq!(ch[1]["distance_from_specimen_m"].as_float(), Some(0.31));

@@ -443,7 +443,7 @@ impl Calibrator for ShaperFit {
         data: &Data,
         earlier: &[Fitted],
         progress: &mut dyn FnMut(&str),
-    ) -> Result<Vec<Fitted>> {
+    ) -> Result<super::Fit> {
         let a = &data.base;
         let (shots, group, velocities) =
             groups(data, earlier_gun(earlier)).expect("skip_reason checked the shots");
@@ -482,6 +482,9 @@ impl Calibrator for ShaperFit {
         let nv = problem.velocity_parameters();
         let sd_log = |i: usize| r.covariance.as_ref().map(|c| c[(i, i)].max(0.0).sqrt());
         let mut out = Vec::new();
+        // Rows of G = ∂(constant)/∂(log-space parameter): the covariance of the constants is
+        // G C Gᵀ (the delta method), whose correlations are written beside their 1-sigma.
+        let mut gradients: Vec<(&'static str, Vec<f64>)> = Vec::new();
         for (i, (key, value, unit)) in [
             ("shaper.diameter_m", s.diameter_m, "m"),
             ("shaper.thickness_m", s.thickness_m, "m"),
@@ -490,6 +493,9 @@ impl Calibrator for ShaperFit {
         .into_iter()
         .enumerate()
         {
+            let mut g = vec![0.0; r.x.len()];
+            g[nv + i] = value;
+            gradients.push((key, g));
             out.push(Fitted {
                 key: key.into(),
                 value,
@@ -518,6 +524,12 @@ impl Calibrator for ShaperFit {
                         .sqrt()
                 })
             };
+            // The gun line's parameters are ln v1 and ln v2, the first two.
+            let mut gk = vec![0.0; r.x.len()];
+            let mut gl = vec![0.0; r.x.len()];
+            (gk[0], gk[1], gl[0], gl[1]) = (dk[0], dk[1], dl[0], dl[1]);
+            gradients.push(("gun.k_m2_per_s2_per_pa", gk));
+            gradients.push(("gun.loss_pressure_pa", gl));
             let line_on = format!(
                 "{on}; the line through the fitted velocities {v1:.3} m/s at {:.2} psi and \
                  {v2:.3} m/s at {:.2} psi",
@@ -584,8 +596,49 @@ impl Calibrator for ShaperFit {
                 });
             }
         }
-        Ok(out)
+        let correlations = r
+            .covariance
+            .as_ref()
+            .map(|c| correlations(&gradients, c))
+            .unwrap_or_default();
+        Ok(super::Fit {
+            constants: out,
+            correlations,
+        })
     }
+}
+
+/// The correlations of the constants whose gradients in the log-space parameters are
+/// `gradients`, from the parameters' covariance `c`: (G C Gᵀ)_ij / √((G C Gᵀ)_ii (G C Gᵀ)_jj),
+/// each pair once, pairs with a zero variance left out.
+fn correlations(
+    gradients: &[(&'static str, Vec<f64>)],
+    c: &DMatrix<f64>,
+) -> Vec<super::Correlation> {
+    let cov = |a: &[f64], b: &[f64]| -> f64 {
+        let mut s = 0.0;
+        for i in 0..a.len() {
+            for j in 0..b.len() {
+                s += a[i] * c[(i, j)] * b[j];
+            }
+        }
+        s
+    };
+    let mut out = Vec::new();
+    for (i, (ka, ga)) in gradients.iter().enumerate() {
+        for (kb, gb) in &gradients[i + 1..] {
+            let (va, vb) = (cov(ga, ga), cov(gb, gb));
+            if va > 0.0 && vb > 0.0 {
+                let r = (cov(ga, gb) / (va * vb).sqrt()).clamp(-1.0, 1.0);
+                out.push(super::Correlation {
+                    a: (*ka).into(),
+                    b: (*kb).into(),
+                    r,
+                });
+            }
+        }
+    }
+    out
 }
 
 /// The gun's velocity scatter from the records' energies: the pooled within-pressure relative

@@ -56,12 +56,7 @@ impl Calibrator for VelocityFactor {
             .then(|| "no shot gives striker_velocity_m_s".into())
     }
 
-    fn fit(
-        &self,
-        data: &Data,
-        _: &[Fitted],
-        progress: &mut dyn FnMut(&str),
-    ) -> Result<Vec<Fitted>> {
+    fn fit(&self, data: &Data, _: &[Fitted], progress: &mut dyn FnMut(&str)) -> Result<super::Fit> {
         let a = &data.base;
         let ch = a.gauges.channel("incident").ok_or_else(|| Error::Input {
             file: a.source.clone(),
@@ -117,7 +112,8 @@ impl Calibrator for VelocityFactor {
                 data.on(used)
             ),
             uncertain: true,
-        }])
+        }]
+        .into())
     }
 }
 

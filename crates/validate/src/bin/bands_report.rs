@@ -96,9 +96,13 @@ fn main() {
             banded.push(t.elapsed().as_secs_f64());
         }
         cost_rows.push((psi, median(plain), median(banded), prediction.runs));
-        let ensemble = band::monte_carlo(&prediction.inputs, SAMPLES, SEED, &|values| {
-            band::reload(&params, &provenance, values)
-        })
+        let ensemble = band::monte_carlo(
+            &prediction.inputs,
+            band::uncertainty(&params),
+            SAMPLES,
+            SEED,
+            &|values| band::reload(&params, &provenance, values),
+        )
         .expect("the Monte-Carlo runs");
         writeln!(r, "## {psi} psi\n").unwrap();
         writeln!(
