@@ -62,6 +62,25 @@ pub struct Correlation {
     pub r: f64,
 }
 
+/// The correlation of keys `a` and `b` among `correlations`: 1 for a key with itself, the stated
+/// r of a listed pair (either order), else 0 (independent).
+pub fn correlation_of(correlations: &[Correlation], a: &str, b: &str) -> f64 {
+    if a == b {
+        return 1.0;
+    }
+    correlations
+        .iter()
+        .find(|c| (c.a == a && c.b == b) || (c.a == b && c.b == a))
+        .map_or(0.0, |c| c.r)
+}
+
+/// The correlation matrix (row-major) of `keys` under `correlations` ([`correlation_of`]).
+pub fn correlation_matrix(correlations: &[Correlation], keys: &[&str]) -> Vec<f64> {
+    keys.iter()
+        .flat_map(|a| keys.iter().map(move |b| correlation_of(correlations, a, b)))
+        .collect()
+}
+
 /// Whether the symmetric matrix `m` (row-major, n × n) is positive semi-definite: its smallest
 /// eigenvalue is not below −1e-6 times the largest magnitude (a correlation matrix must be; the
 /// margin takes correlations written to six decimals).
@@ -100,13 +119,7 @@ impl Uncertainty {
     /// The correlation of constants `a` and `b`: 1 for a key with itself, the stated r of a
     /// listed pair (either order), else 0 (independent).
     pub fn correlation(&self, a: &str, b: &str) -> f64 {
-        if a == b {
-            return 1.0;
-        }
-        self.correlations
-            .iter()
-            .find(|c| (c.a == a && c.b == b) || (c.a == b && c.b == a))
-            .map_or(0.0, |c| c.r)
+        correlation_of(&self.correlations, a, b)
     }
 }
 

@@ -21,7 +21,7 @@
 use crate::error::{Error, Result, Validator};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::uncertainty::{
-    Correlation, OutputScatter, SCATTER_OUTPUTS, UncertainInput, Uncertainty,
+    Correlation, OutputScatter, SCATTER_OUTPUTS, UncertainInput, Uncertainty, correlation_matrix,
     is_positive_semidefinite,
 };
 
@@ -401,20 +401,9 @@ fn correlations(
             });
         }
     }
-    let n = inputs.len();
-    let mut m = vec![0.0; n * n];
-    for (i, x) in inputs.iter().enumerate() {
-        for (j, y) in inputs.iter().enumerate() {
-            m[i * n + j] = if i == j {
-                1.0
-            } else {
-                out.iter()
-                    .find(|c| (c.a == x.key && c.b == y.key) || (c.a == y.key && c.b == x.key))
-                    .map_or(0.0, |c| c.r)
-            };
-        }
-    }
-    if !is_positive_semidefinite(&m, n) {
+    let keys: Vec<&str> = inputs.iter().map(|i| i.key.as_str()).collect();
+    let m = correlation_matrix(&out, &keys);
+    if !is_positive_semidefinite(&m, keys.len()) {
         return Err(v.error(
             "correlation",
             "the correlations cannot hold together (the matrix is not positive semi-definite)",

@@ -209,18 +209,8 @@ pub fn reload(
 /// The correlation matrix (row-major) of `inputs` as `u` states it (1 on the diagonal, a pair
 /// not listed and the gun's velocity scatter independent).
 pub fn correlation_matrix(inputs: &[BandInput], u: Option<&Uncertainty>) -> Vec<f64> {
-    let n = inputs.len();
-    let mut m = vec![0.0; n * n];
-    for (i, a) in inputs.iter().enumerate() {
-        for (j, b) in inputs.iter().enumerate() {
-            m[i * n + j] = if i == j {
-                1.0
-            } else {
-                u.map_or(0.0, |u| u.correlation(&a.key, &b.key))
-            };
-        }
-    }
-    m
+    let keys: Vec<&str> = inputs.iter().map(|i| i.key.as_str()).collect();
+    shpb_core::uncertainty::correlation_matrix(u.map_or(&[][..], |u| &u.correlations), &keys)
 }
 
 /// σ² of the inputs' shares s (docs/physics.md §10.6): Σ_ij s_i s_j r_ij, r the stated
