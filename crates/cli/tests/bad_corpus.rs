@@ -183,7 +183,7 @@ fn parse_case(file: &str, t: &toml::Table) -> Result<Case, String> {
             if s.is_none() && python_message.is_none() {
                 return Err("a Python-only case needs `stderr` or `python_message`".into());
             }
-            for k in ["stdout", "stdout_empty", "env", "tmp_empty_after"] {
+            for k in ["stdout", "stdout_empty", "env"] {
                 if t.contains_key(k) {
                     return Err(format!("`{k}` without `args`"));
                 }
