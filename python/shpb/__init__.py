@@ -17,6 +17,9 @@ Errors carry the command line's message: :class:`InputError` (a ``ValueError``) 
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import functools
 import html
 import os
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
@@ -254,6 +257,61 @@ class Table:
         return f"<shpb.Table: {len(self)} runs over {', '.join(self.keys_swept)}>"
 
 
+@contextlib.contextmanager
+def _missing_file_is_os_error(*paths: Optional[str]) -> Iterator[None]:
+    """A missing input file is a ``FileNotFoundError`` and a directory given for one an
+    ``IsADirectoryError`` (both ``OSError``), as :func:`run` raises them for a scene (README,
+    Python), with the command line's message: the library reports them as bad input (exit 2)."""
+    try:
+        yield
+    except InputError as e:
+        for path in paths:
+            if path is None:
+                continue
+            if os.path.isdir(path):
+                raise IsADirectoryError(errno.EISDIR, str(e)) from e
+            if not os.path.exists(path):
+                raise FileNotFoundError(errno.ENOENT, str(e)) from e
+        raise
+
+
+def _whole(name: str, value: Any, allowed: str) -> int:
+    """``value`` as a whole number for the argument ``name``, or an :class:`InputError` naming
+    it and ``allowed``: ``int()`` would truncate 2.5 to 2 without a word, and a negative or huge
+    number would fail in the binding with an ``OverflowError`` that names no argument."""
+    try:
+        whole = int(value)
+        exact = not isinstance(value, bool) and whole == value
+    except (TypeError, ValueError, OverflowError):
+        exact = False
+    if not exact:
+        raise InputError(f"python: `{name}`: {value!r} is not a whole number; allowed: {allowed}")
+    if not -(2**63) <= whole < 2**64:
+        raise InputError(f"python: `{name}`: {whole} is out of range; allowed: {allowed}")
+    if whole < 0:
+        raise InputError(f"python: `{name}`: {whole} is negative; allowed: {allowed}")
+    return whole
+
+
+def _number(name: str, value: Any, allowed: str) -> float:
+    """``value`` as a float for the argument ``name``, or an :class:`InputError` naming it (the
+    range itself is checked by the library, with the command line's message)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"python: `{name}`: {value!r} is not a number; allowed: {allowed}") from e
+
+
+def _mapping(name: str, value: Any) -> Dict[str, Any]:
+    """``value`` as a dict of scene keys, or a ``TypeError`` naming the argument."""
+    if not isinstance(value, Mapping):
+        raise TypeError(
+            f"{name}: expected a mapping of scene keys to values (e.g. {{'pressure': '12psi'}}), "
+            f"not {type(value).__name__}"
+        )
+    return dict(value)
+
+
 def _call(name: str, *args: Any, **kwargs: Any) -> str:
     parts = [repr(a) for a in args] + [f"{k}={v!r}" for k, v in kwargs.items() if v is not None]
     return f"python: shpb.{name}({', '.join(parts)})"
@@ -286,13 +344,19 @@ def run(
         set=set,
         **({} if bands else {"no_bands": True}),
     )
-    return Run(_shpb.run(scene, fidelity, dict(set) if set else None, line, bands))
+    overrides = _mapping("set", set) if set is not None else None
+    return Run(_shpb.run(scene, fidelity, overrides or None, line, bands))
 
 
 def load(path: PathLike) -> Run:
     """Reads a run file written by ``shpb run -o`` or :meth:`Run.save` (or a reduction file of
     ``shpb reduce -o``)."""
-    return Run(_shpb.load(os.fspath(path)))
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        raise IsADirectoryError(errno.EISDIR, f"{path}: {os.strerror(errno.EISDIR)}")
+    if not os.path.exists(path):
+        raise FileNotFoundError(errno.ENOENT, f"{path}: {os.strerror(errno.ENOENT)}")
+    return Run(_shpb.load(path))
 
 
 def gun(pressure: Union[str, float], bars: PathLike = "authors") -> float:
@@ -312,7 +376,13 @@ def curve(
 ) -> Tuple[np.ndarray, np.ndarray]:
     """The loading curve F(δ) of a specimen (``shpb curve``): ``(displacement_m, force_N)`` on
     ``points`` approaches from 0 to ``to`` (m) at the global strain rate ``rate`` (1/s)."""
-    return _shpb.curve(pair, float(rate), float(to), int(points), law)
+    return _shpb.curve(
+        pair,
+        _number("rate", rate, "0 to 1e9 1/s"),
+        _number("to", to, "greater than 0, in m"),
+        _whole("points", points, "2 to 10000000"),
+        law,
+    )
 
 
 def reduce(
@@ -348,24 +418,39 @@ def reduce(
     ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
+    record = os.fspath(record)
+    specimen_path = None if specimen is None else os.fspath(specimen)
+    with _missing_file_is_os_error(record, specimen_path):
+        return _reduce(record, bars, dispersion, tyas_pope, align, smooth, specimen_length_m,
+                       specimen_diameter_m, layout, balance_bound_s, specimen_path)
+
+
+def _reduce(record, bars, dispersion, tyas_pope, align, smooth, specimen_length_m,  # type: ignore[no-untyped-def]
+            specimen_diameter_m, layout, balance_bound_s, specimen) -> Run:
+    """The body of :func:`reduce`, its arguments checked."""
     return Run(
         _shpb.reduce(
-            os.fspath(record),
+            record,
             None if bars is None else os.fspath(bars),
             dispersion,
             bool(tyas_pope),
             align,
-            float(smooth),
+            _number("smooth", smooth, "0 (off) or a positive width in seconds"),
             specimen_length_m,
             specimen_diameter_m,
             None if layout is None else os.fspath(layout),
-            float(balance_bound_s),
-            None if specimen is None else os.fspath(specimen),
+            _number("balance_bound_s", balance_bound_s, "a positive bound in seconds"),
+            specimen,
         )
     )
 
 
-def _label(v: Any) -> str:
+def _label(v: Any, key: str = "") -> str:
+    if v is None or not isinstance(v, (str, bool, int, float, np.integer, np.floating)):
+        raise InputError(
+            f"python: `{key}`: a value of type {type(v).__name__} cannot be swept; allowed: "
+            "str, int, float or bool values, e.g. ['8psi', '10psi'] or [0.5e-3, 1e-3]"
+        )
     if isinstance(v, str):
         return v
     if isinstance(v, bool):
@@ -375,6 +460,18 @@ def _label(v: Any) -> str:
     return repr(float(v))
 
 
+def _scene_missing_is_os_error(fn: Any) -> Any:
+    """:func:`_missing_file_is_os_error` for the ``scene`` (first argument) of ``fn``."""
+
+    @functools.wraps(fn)
+    def wrapper(scene: PathLike, *args: Any, **kwargs: Any) -> Any:
+        with _missing_file_is_os_error(os.path.abspath(os.fspath(scene))):
+            return fn(scene, *args, **kwargs)
+
+    return wrapper
+
+
+@_scene_missing_is_os_error
 def sweep(
     scene: PathLike,
     set: Mapping[str, Union[Sequence[Any], str]],
@@ -400,11 +497,22 @@ def sweep(
     ``set={"fidelity": [fidelity]}``; a key given both ways is refused.
     """
     specs = []
-    for key, values in set.items():
+    axes = _mapping("set", set)
+    if not axes:
+        raise InputError(
+            "python: `set`: no key to sweep; allowed: scene keys with their values, "
+            "e.g. {'pressure': ['8psi', '10psi']} (shpb sweep --set)"
+        )
+    jobs = _whole("jobs", jobs, "a number of worker threads (0 counts as 1)")
+    if shards is not None and _whole("shards", shards, "a whole number ≥ 1") < 1:
+        raise InputError(f"python: `shards`: {shards}; allowed: a whole number ≥ 1")
+    for key, values in axes.items():
         if isinstance(values, str):
             specs.append(f"{key}={values}")
+        elif isinstance(values, (bool, int, float, np.integer, np.floating)) or values is None:
+            specs.append(f"{key}={_label(values, key)}")
         else:
-            specs.append(f"{key}={','.join(_label(v) for v in values)}")
+            specs.append(f"{key}={','.join(_label(v, key) for v in values)}")
     if fidelity is not None:
         # `--fidelity NAME` is the one-value axis `--set fidelity=NAME`, after the others.
         specs.append(f"fidelity={fidelity}")
@@ -454,6 +562,7 @@ class Study:
         return f"<shpb.Study: {len(self.runs)} samples of {', '.join(self.runs.keys_swept) or 'no input'}>"
 
 
+@_scene_missing_is_os_error
 def study(
     scene: PathLike,
     samples: int = 32,
@@ -476,6 +585,11 @@ def study(
     ``fidelity``: ``"fast"``, ``"standard"`` or ``"reference"`` for every run, in place of the
     scene's (``shpb study --fidelity``).
     """
+    samples = _whole("samples", samples, "2 to 1000000 samples")
+    seed = _whole("seed", seed, "a whole number from 0 to 18446744073709551615")
+    jobs = _whole("jobs", jobs, "a number of worker threads (0 counts as 1)")
+    if shards is not None and _whole("shards", shards, "a whole number ≥ 1") < 1:
+        raise InputError(f"python: `shards`: {shards}; allowed: a whole number ≥ 1")
     path = os.path.abspath(os.fspath(scene))
     args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter), fidelity)
     if client is None:

@@ -152,6 +152,25 @@ impl From<LawArg> for LawKind {
     }
 }
 
+/// A whole number for a count option (`--samples`, `--repeats`, ...), with `allow_hyphen_values`
+/// so that `-4` reaches it: clap's own messages ("unexpected argument '-4' found", "invalid digit
+/// found in string") name no range, this one names `allowed`. The range itself is checked where
+/// the option is used (`allowed` repeats it).
+fn whole_number<T: std::str::FromStr>(
+    allowed: &'static str,
+) -> impl Fn(&str) -> std::result::Result<T, String> + Clone + Send + Sync + 'static {
+    move |text: &str| {
+        text.trim().parse::<T>().map_err(|_| {
+            let what = if text.trim().parse::<i128>().is_ok_and(|v| v < 0) {
+                "negative"
+            } else {
+                "not a whole number"
+            };
+            format!("`{text}` is {what}; allowed: {allowed}")
+        })
+    }
+}
+
 /// `-j/--jobs`: worker threads of `sweep` and `study` (one definition for both).
 #[derive(Args, Debug, Clone, Copy)]
 pub struct Jobs {
@@ -225,8 +244,9 @@ pub enum Command {
         /// A `shpb` scene file.
         #[arg(default_value = "scenes/shpb-ss440c-10psi.toml")]
         scene: PathBuf,
-        /// Runs per timing (median reported).
-        #[arg(long, default_value_t = 5, allow_hyphen_values = true)]
+        /// Runs per timing (median reported), 1 to 1000.
+        #[arg(long, default_value_t = 5, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("1 to 1000 runs per timing"))]
         repeats: usize,
         /// Also write the tables as markdown to this file.
         #[arg(long)]
@@ -253,7 +273,7 @@ pub enum Command {
         #[command(flatten)]
         jobs: Jobs,
         /// Run only shard k of n (k/n): every n-th run from the k-th, deterministic.
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         shard: Option<String>,
         /// HDF5 output: /summary table and one /runs/<index> group per run.
         #[arg(short, long)]
@@ -281,10 +301,12 @@ pub enum Command {
         /// The scene TOML file.
         scene: PathBuf,
         /// Samples (runs), 2 to 1000000.
-        #[arg(long, default_value_t = 32)]
+        #[arg(long, default_value_t = 32, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("2 to 1000000 samples"))]
         samples: usize,
         /// Seed of the Latin hypercube: the same seed gives the same samples and files.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_hyphen_values = true,
+              value_parser = whole_number::<u64>("a whole number from 0 to 18446744073709551615"))]
         seed: u64,
         /// Worker threads (`-j`).
         #[command(flatten)]
@@ -338,11 +360,14 @@ pub enum Command {
         /// Accepted |quantity − target|, relative to the target: a percentage or a fraction.
         #[arg(long, default_value = "0.2%", allow_hyphen_values = true)]
         tol: String,
-        /// Values of the second --vary (bounds included) at which the first is solved.
-        #[arg(long, default_value_t = 5)]
-        grid: usize,
-        /// The most runs one 1-D search may use (fast and standard together).
-        #[arg(long, default_value_t = 20)]
+        /// Values of the second --vary (bounds included) at which the first is solved, 2 to 50
+        /// [default: 5]; only with a second --vary.
+        #[arg(long, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("2 to 50 values of the second --vary"))]
+        grid: Option<usize>,
+        /// The most runs one 1-D search may use (fast and standard together), 3 to 1000.
+        #[arg(long, default_value_t = 20, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("3 to 1000 runs per 1-D search"))]
         max_runs: usize,
     },
     /// Join the HDF5 files of the shards of one sweep into one file.
@@ -488,10 +513,10 @@ pub enum Command {
         /// Length of a cylindrical specimen, m (with --specimen-diameter): also its 1/2/3-wave
         /// stress, strain, strain rate and true stress/strain (/reduction/cylinder) [default: a
         /// run file's own cylinder, if it has one].
-        #[arg(long, value_name = "L")]
+        #[arg(long, value_name = "L", allow_hyphen_values = true)]
         specimen_length: Option<f64>,
         /// Diameter of a cylindrical specimen, m (with --specimen-length).
-        #[arg(long, value_name = "D")]
+        #[arg(long, value_name = "D", allow_hyphen_values = true)]
         specimen_diameter: Option<f64>,
         /// The specimen: a TOML file with a `[specimen]` table as in a scene (spheres of any
         /// diameter, a chain, or shape = "cylinder"): spheres give the strain rate δ̇/Σrᵢ over
@@ -517,14 +542,10 @@ pub enum Command {
             allow_hyphen_values = true
         )]
         smooth: f64,
-        /// Bound of `--align balance`'s search on each window shift, s (docs/physics.md §7.6).
-        #[arg(
-            long,
-            value_name = "SECONDS",
-            default_value_t = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S,
-            allow_hyphen_values = true
-        )]
-        balance_bound: f64,
+        /// Bound of `--align balance`'s search on each window shift, s (docs/physics.md §7.6)
+        /// [default: 6e-5]; only with `--align balance`.
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        balance_bound: Option<f64>,
         /// Incident window start on the record clock, s (overrides the detected foot).
         #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
         incident_start: Option<f64>,
@@ -570,7 +591,9 @@ pub enum Command {
         layout: Option<PathBuf>,
         /// Samples at the start of each channel whose mean is removed (the pre-trigger baseline,
         /// as `shpb reduce` removes it); 0 keeps the record's offsets.
-        #[arg(long, value_name = "N", default_value_t = shpb_core::reduce::ReductionOptions::default().baseline_samples)]
+        #[arg(long, value_name = "N", default_value_t = shpb_core::reduce::ReductionOptions::default().baseline_samples,
+              allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("0 (keep the offsets) up to half the record's samples"))]
         baseline_samples: usize,
         /// CSV output.
         #[arg(long)]
@@ -677,12 +700,44 @@ pub struct SetupNewArgs {
 pub fn main() -> i32 {
     // First, before any thread starts: SIGINT/SIGTERM remove temporary files and say what stopped.
     crate::interrupt::install();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(&e),
+    };
     match dispatch(cli) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("shpb: error: {e}");
             e.exit_code()
+        }
+    }
+}
+
+/// Prints a command-line parse error as every other error (`shpb: error: ` first, clap's usage
+/// and tip lines after it) and returns its exit code (2); `--help` and `--version` print to
+/// stdout with exit code 0, and a missing subcommand prints the help to stderr, then the error.
+fn usage_error(e: &clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            0
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprint!("{}", e.render());
+            eprintln!(
+                "shpb: error: no subcommand given; allowed: one of the commands listed above"
+            );
+            2
+        }
+        _ => {
+            let text = e.render().to_string();
+            let text = text.strip_prefix("error: ").unwrap_or(&text);
+            eprint!("shpb: error: {text}");
+            if !text.ends_with('\n') {
+                eprintln!();
+            }
+            2
         }
     }
 }
@@ -738,7 +793,16 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             repeats,
             report,
             force,
-        } => cmd::bench::bench(&scene, repeats, report.as_deref(), force),
+        } => {
+            if !(1..=1000).contains(&repeats) {
+                return Err(shpb_study::api::input_err(
+                    "--repeats",
+                    format!("{repeats}"),
+                    "1 to 1000 runs per timing",
+                ));
+            }
+            cmd::bench::bench(&scene, repeats, report.as_deref(), force)
+        }
         Command::Sweep {
             scene,
             mut set,
@@ -800,23 +864,49 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             tol,
             grid,
             max_runs,
-        } => cmd::design::design(
-            &scene,
-            &cmd::design::DesignOptions {
-                target: &target,
-                vary: &vary,
-                require: &require,
-                tol: &tol,
-                grid,
-                max_runs,
-            },
-        ),
+        } => {
+            // A grid without a second --vary would be ignored without a word.
+            if let Some(g) = grid
+                && vary.len() < 2
+            {
+                return Err(shpb_study::api::input_err(
+                    "--grid",
+                    format!("{g} given with one --vary"),
+                    "--grid N with a second --vary (the input set on the grid)",
+                ));
+            }
+            cmd::design::design(
+                &scene,
+                &cmd::design::DesignOptions {
+                    target: &target,
+                    vary: &vary,
+                    require: &require,
+                    tol: &tol,
+                    grid: grid.unwrap_or(5),
+                    max_runs,
+                },
+            )
+        }
         Command::Merge {
             inputs,
             output,
             csv,
             force,
-        } => cmd::merge::merge(&inputs, &output, csv.as_deref(), force),
+        } => {
+            // A missing shard or a directory: named as such, not by the HDF5 library's errno.
+            if let Some(p) = inputs.iter().find(|p| !p.is_file()) {
+                return Err(shpb_study::api::input_err(
+                    "INPUTS",
+                    format!(
+                        "cannot read {}: {}",
+                        p.display(),
+                        shpb_input::files::not_a_file(p)
+                    ),
+                    "HDF5 files written by `shpb sweep --shard k/n -o`",
+                ));
+            }
+            cmd::merge::merge(&inputs, &output, csv.as_deref(), force)
+        }
         Command::Convergence {
             scene,
             output,
@@ -882,6 +972,17 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                 Some(set) => vec![set.name()],
                 None => record,
             };
+            // A bound without the search it bounds would be ignored without a word.
+            if let Some(b) = balance_bound
+                && !matches!(align, AlignArg::Balance)
+            {
+                return Err(shpb_study::api::input_err(
+                    "--balance-bound",
+                    format!("{b} s given without --align balance"),
+                    "--balance-bound SECONDS with --align balance",
+                ));
+            }
+            let balance_bound = balance_bound.unwrap_or(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S);
             let window = shpb_core::reduce::WindowOverride {
                 incident_start_s: incident_start,
                 reflected_delay_s: reflected_delay,

@@ -148,8 +148,8 @@ impl From<shpb_core::Error> for Error {
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
-    /// Process exit code for this error: 2 for bad input (a missing input file included,
-    /// wherever it is read, and a run too large for the machine), 3 for an unstable run, 130 for
+    /// Process exit code for this error: 2 for bad input (a missing input file or a directory
+    /// named as a file included, wherever it is read, and a run too large for the machine), 3 for an unstable run, 130 for
     /// a run interrupted by its caller (as SIGINT), 4 for a design search without a solution, 5
     /// for a design whose solutions violate a `--require` constraint, 1 otherwise.
     pub fn exit_code(&self) -> i32 {
@@ -159,7 +159,18 @@ impl Error {
             | Error::OutputExists(_)
             | Error::TooLarge { .. }
             | Error::Invalid { .. } => 2,
-            Error::Io { source, .. } if source.kind() == std::io::ErrorKind::NotFound => 2,
+            // A missing input, or a directory named where a file belongs (or a file where a
+            // directory belongs): the user's input, not a failing disk.
+            Error::Io { source, .. }
+                if matches!(
+                    source.kind(),
+                    std::io::ErrorKind::NotFound
+                        | std::io::ErrorKind::IsADirectory
+                        | std::io::ErrorKind::NotADirectory
+                ) =>
+            {
+                2
+            }
             Error::Unstable { .. } => 3,
             Error::NoSolution(_) => 4,
             Error::RequirementUnmet(_) => 5,

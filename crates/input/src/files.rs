@@ -82,6 +82,17 @@ pub fn read_to_string(path: &Path) -> std::io::Result<String> {
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
 }
 
+/// Why `path` is not a readable file, for the message of an [`is_file`] check: "no such file",
+/// "a directory, not a file", or the operating system's reason.
+pub fn not_a_file(path: &Path) -> String {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => "a directory, not a file".into(),
+        Ok(_) => "not a regular file".into(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => "no such file".into(),
+        Err(e) => e.to_string(),
+    }
+}
+
 /// Whether `path` is a readable file (while replaying: whether the run file stored it).
 pub fn is_file(path: &Path) -> bool {
     match replayed(&path.display().to_string()) {

@@ -90,19 +90,90 @@ impl SceneFile for Params {
     /// Reads a scene file with some keys replaced (dotted paths such as `shaper.thickness_m`
     /// reach into tables); the stored scene text is the modified TOML.
     fn from_file_overridden(path: &Path, overrides: &[(String, toml::Value)]) -> Result<Params> {
-        let text = crate::files::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let file = path.display().to_string();
+        not_a_scene(path, &file)?;
+        let original = crate::files::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let text = if overrides.is_empty() {
-            text
+            original.clone()
         } else {
-            with_overrides(&text, &file, overrides)?
+            with_overrides(&original, &file, overrides)?
         };
         let base = path
             .parent()
             .map(Path::to_path_buf)
             .unwrap_or_else(|| PathBuf::from("."));
-        Params::from_toml(&text, &file, &base)
+        Params::from_toml(&text, &file, &base).map_err(|e| match e {
+            Error::Parse { .. } if !overrides.is_empty() => {
+                blame_override(&original, &file, &base, overrides).unwrap_or(e)
+            }
+            e => e,
+        })
     }
+}
+
+/// Refuses a file that is plainly not a scene by its extension (a record, a spreadsheet, or an
+/// `.h5` that is not HDF5, since a run file would have been read as one): the TOML parser's
+/// message about its first line would mislead.
+fn not_a_scene(path: &Path, file: &str) -> Result<()> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let what = match ext.as_str() {
+        "csv" | "txt" | "tsv" | "dat" | "lvm" | "xls" | "xlsx" => {
+            format!("a .{ext} file is a record, not a scene")
+        }
+        "h5" | "hdf5" if crate::files::is_file(path) => {
+            "not an HDF5 file (no HDF5 signature), so not a run file of `shpb run -o`".into()
+        }
+        _ => return Ok(()),
+    };
+    Err(Error::Input {
+        file: file.to_string(),
+        key: "kind".into(),
+        problem: what,
+        allowed: "a scene .toml file (with a `kind` key) or a run file (.h5) of `shpb run -o`; \
+                  `shpb reduce`, `strain` and `incident` read records"
+            .into(),
+    })
+}
+
+/// The override that makes a valid scene fail to parse (an unknown key, a value of the wrong
+/// type), named as set on the command line: the parser's own message would quote a line of the
+/// rewritten text that the file does not have. `None` when the file itself does not parse (its
+/// own message, with its own lines, is then the right one) or no single override is to blame.
+fn blame_override(
+    original: &str,
+    file: &str,
+    base: &Path,
+    overrides: &[(String, toml::Value)],
+) -> Option<Error> {
+    if let Err(e @ Error::Parse { .. }) = Params::from_toml(original, file, base) {
+        return Some(e);
+    }
+    overrides.iter().find_map(|(key, value)| {
+        let text = with_overrides(original, file, &[(key.clone(), value.clone())]).ok()?;
+        let Err(Error::Parse { message, .. }) = Params::from_toml(&text, file, base) else {
+            return None;
+        };
+        // The parser's reason is its last line (after the quoted line and the caret).
+        let reason = message
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or(&message)
+            .trim()
+            .to_string();
+        Some(Error::Input {
+            file: file.to_string(),
+            key: key.clone(),
+            problem: format!("set to {value} on the command line: {reason}"),
+            allowed: "a key of this scene's kind, with a value of its type (README.md, the \
+                      scene kinds)"
+                .into(),
+        })
+    })
 }
 
 /// Scene TOML `text` with `overrides` applied: each dotted key path (`pressure`,

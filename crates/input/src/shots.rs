@@ -100,7 +100,11 @@ impl ShotManifest {
             if !crate::files::is_file(&p) {
                 return Err(v.error(
                     key,
-                    format!("cannot read {}: no such file", p.display()),
+                    format!(
+                        "cannot read {}: {}",
+                        p.display(),
+                        crate::files::not_a_file(&p)
+                    ),
                     "a record layout .toml file (relative to the manifest)",
                 ));
             }
@@ -124,7 +128,11 @@ impl ShotManifest {
             if !crate::files::is_file(&file) {
                 return Err(t.error(
                     "file",
-                    format!("cannot read {}: no such file", file.display()),
+                    format!(
+                        "cannot read {}: {}",
+                        file.display(),
+                        crate::files::not_a_file(&file)
+                    ),
                     "a gauge record (relative to the manifest)",
                 ));
             }

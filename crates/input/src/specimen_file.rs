@@ -43,7 +43,7 @@ impl SpecimenFile {
             return Err(Error::Input {
                 file: "command line".into(),
                 key: "--specimen".into(),
-                problem: format!("cannot read {file}: no such file"),
+                problem: format!("cannot read {file}: {}", crate::files::not_a_file(path)),
                 allowed: format!("a specimen .toml file: {SPECIMEN_FILE_FORM}"),
             });
         }

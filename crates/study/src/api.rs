@@ -41,8 +41,9 @@ pub fn require_bars(bars: &Path) -> Result<()> {
         return Err(input_err(
             "--bars",
             format!(
-                "cannot read {}: not a built-in set-up and no such file",
-                bars.display()
+                "cannot read {}: not a built-in set-up and {}",
+                bars.display(),
+                shpb_input::files::not_a_file(bars)
             ),
             format!(
                 "a built-in set-up ({}) or a bar set-up .toml file such as bars/authors.toml",
@@ -522,7 +523,11 @@ pub fn reduce_record_with(
     if !record.is_file() {
         return Err(input_err(
             "RECORD",
-            format!("cannot read {}: no such file", record.display()),
+            format!(
+                "cannot read {}: {}",
+                record.display(),
+                shpb_input::files::not_a_file(record)
+            ),
             "a raw gauge record (.csv: time_s,incident_V,transmission_V) or an HDF5 file of `shpb run`",
         ));
     }

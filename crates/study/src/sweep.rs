@@ -49,6 +49,11 @@ pub use shpb_input::units::number_and_unit;
 /// The TOML value of one text value of `key`: lengths in m for `_m` keys, numbers as floats,
 /// anything else (a pressure with unit, a law name) as a string the scene validates.
 fn value_of(key: &str, text: &str, spec: &str) -> Result<shpb_input::scene::Value> {
+    // `nan`, `inf`, `infinity` (any case, signed) are numbers to Rust but words to
+    // `number_and_unit`: refused here rather than passed on as text the scene calls a string.
+    if text.trim().parse::<f64>().is_ok_and(|v| !v.is_finite()) {
+        return Err(bad_set(spec, format!("{text}: not finite")));
+    }
     match number_and_unit(text) {
         Some((v, _)) if !v.is_finite() => Err(bad_set(spec, format!("{text}: not finite"))),
         // A whole number stays an integer (a count such as `points` takes no float; a float key
@@ -339,7 +344,11 @@ pub fn require_scene(scene: &Path) -> Result<()> {
     Err(Error::Input {
         file: "command line".into(),
         key: "SCENE".into(),
-        problem: format!("cannot read {}: no such file", scene.display()),
+        problem: format!(
+            "cannot read {}: {}",
+            scene.display(),
+            shpb_input::files::not_a_file(scene)
+        ),
         allowed: "a scene .toml file".into(),
     })
 }

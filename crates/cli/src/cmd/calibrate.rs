@@ -58,7 +58,11 @@ pub fn calibrate(
     {
         return Err(shpb_study::api::input_err(
             "SHOTS",
-            format!("cannot read {}: no such file", shots.display()),
+            format!(
+                "cannot read {}: {}",
+                shots.display(),
+                shpb_input::files::not_a_file(shots)
+            ),
             "a shots manifest .toml ([[shot]] tables with file and pressure or \
              striker_velocity_m_s)",
         ));

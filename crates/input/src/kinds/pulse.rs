@@ -223,7 +223,11 @@ pub(super) fn parse_bars(
     if crate::builtin::setup(&f.bars).is_none() && !crate::files::is_file(&set_up) {
         return Err(v.error(
             "bars",
-            format!("cannot read {}: no such file", set_up.display()),
+            format!(
+                "cannot read {}: {}",
+                set_up.display(),
+                crate::files::not_a_file(&set_up)
+            ),
             format!(
                 "a built-in set-up ({}) or a bar set-up .toml file, relative to the scene file",
                 crate::builtin::setup_names()
@@ -469,7 +473,11 @@ fn incident_drive(
     if !crate::files::is_file(&path) {
         return Err(rv.error(
             "file",
-            format!("cannot read {}: no such file", path.display()),
+            format!(
+                "cannot read {}: {}",
+                path.display(),
+                crate::files::not_a_file(&path)
+            ),
             "a gauge record (time_s, incident_V, transmission_V) relative to the scene file",
         ));
     }
@@ -482,7 +490,11 @@ fn incident_drive(
             if !crate::files::is_file(&layout_path) {
                 return Err(rv.error(
                     "layout",
-                    format!("cannot read {}: no such file", layout_path.display()),
+                    format!(
+                        "cannot read {}: {}",
+                        layout_path.display(),
+                        crate::files::not_a_file(&layout_path)
+                    ),
                     "a record layout .toml (README, *Record layouts*) relative to the scene file",
                 ));
             }
