@@ -462,7 +462,7 @@ pub enum Command {
         /// transmission, repeated; a gauge's several files are averaged (e.g. gauges on opposite
         /// faces). Instead of RECORD.
         #[arg(long, value_name = "ROLE=FILE", conflicts_with_all = ["record", "layout"])]
-        channel: Vec<String>,
+        channel: Vec<std::ffi::OsString>,
         /// Bar set-up (bars, gauge distances, bridge, gain, polarity): a built-in set-up
         /// (`shpb list`) or a set-up file [default: a run file's own set-up, else `authors`].
         /// For a run file, a set-up that differs from the one it was simulated with is refused.

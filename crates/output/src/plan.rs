@@ -234,6 +234,11 @@ fn directory_of(path: &Path) -> PathBuf {
         .to_path_buf()
 }
 
+/// Whether two paths name the same file once written (their directories resolved).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    !is_stdout(a) && !is_stdout(b) && target(a) == target(b)
+}
+
 /// The path a file will have: its directory resolved, the name kept.
 fn target(path: &Path) -> PathBuf {
     std::fs::canonicalize(directory_of(path))

@@ -56,6 +56,23 @@ pub fn sweep(
     let anchor = output
         .filter(|p| !is_stdout(p))
         .or(csv.filter(|p| !is_stdout(p)));
+    // The checkpoint beside the anchor is not also an output (it is removed when the sweep ends).
+    if let Some(a) = anchor {
+        let checkpoint = checkpoint_path(a);
+        for (p, flag) in [(output, "--output"), (csv, "--csv"), (plot, "--plot")] {
+            if p.is_some_and(|p| shpb_output::plan::same_file(p, &checkpoint)) {
+                return Err(Error::Input {
+                    file: "command line".into(),
+                    key: flag.into(),
+                    problem: format!(
+                        "{} is the checkpoint of this sweep, removed when it ends",
+                        checkpoint.display()
+                    ),
+                    allowed: "an output name that is not OUTPUT.partial.csv".into(),
+                });
+            }
+        }
+    }
     if resume && anchor.is_none() {
         return Err(Error::Input {
             file: "command line".into(),
