@@ -59,8 +59,8 @@ pub struct Cli {
     /// No result table and no `wrote` lines (warnings and errors still go to stderr).
     #[arg(short, long, global = true)]
     pub quiet: bool,
-    /// Print the result of `run`, `reduce`, `incident`, `sweep`, `study` and `design` as one JSON
-    /// object on stdout.
+    /// Print the result of `run`, `reduce`, `incident`, `sweep`, `study`, `design` and `calibrate`
+    /// as one JSON object on stdout (refused by the other commands).
     #[arg(long, global = true)]
     pub json: bool,
 }
@@ -487,7 +487,7 @@ pub enum Command {
         /// transmission, repeated; a gauge's several files are averaged (e.g. gauges on opposite
         /// faces). Instead of RECORD.
         #[arg(long, value_name = "ROLE=FILE", conflicts_with_all = ["record", "layout"])]
-        channel: Vec<String>,
+        channel: Vec<std::ffi::OsString>,
         /// Bar set-up (bars, gauge distances, bridge, gain, polarity): a built-in set-up
         /// (`shpb list`) or a set-up file [default: a run file's own set-up, else `authors`].
         /// For a run file, a set-up that differs from the one it was simulated with is refused.
@@ -745,6 +745,30 @@ fn usage_error(e: &clap::Error) -> i32 {
 /// Runs one parsed command.
 pub fn dispatch(cli: Cli) -> Result<()> {
     cmd::common::set_output_mode(cli.quiet, cli.json);
+    // Standard output holds one thing: a command without a JSON result does not print its
+    // table (or CSV) where JSON was asked for.
+    let without_json = match &cli.command {
+        Command::Convergence { .. } => Some("convergence"),
+        Command::Bench { .. } => Some("bench"),
+        Command::Merge { .. } => Some("merge"),
+        Command::Curve { .. } => Some("curve"),
+        Command::Gun { .. } => Some("gun"),
+        Command::Strain { .. } => Some("strain"),
+        Command::Validate { .. } => Some("validate"),
+        Command::List => Some("list"),
+        Command::Setup { .. } => Some("setup new"),
+        _ => None,
+    };
+    if cli.json
+        && let Some(name) = without_json
+    {
+        return Err(cmd::common::input_err(
+            "command line",
+            "--json",
+            format!("`shpb {name}` has no JSON result"),
+            "--json with run, reduce, incident, sweep, study, design or calibrate",
+        ));
+    }
     match cli.command {
         Command::Setup {
             action: SetupAction::New(a),

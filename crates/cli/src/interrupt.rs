@@ -91,7 +91,9 @@ fn stop(signal: libc::c_int) -> ! {
 /// The command line of this process with `--force` removed and `--resume` added (if missing),
 /// quoted for a POSIX shell: what resumes a stopped sweep.
 pub fn resume_command() -> String {
-    let args: Vec<String> = std::env::args().collect();
+    let args: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
     let mut out: Vec<String> = Vec::new();
     for (i, a) in args.iter().enumerate() {
         if i > 0 && a == "--force" {

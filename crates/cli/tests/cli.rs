@@ -57,7 +57,7 @@ fn run_scene(dir: &Path, scene: &Path) -> Output {
     )
 }
 
-/// Entries of `dir` whose names start with `.tmp-` (the atomic writer's temporary files).
+/// Entries of `dir` whose names start with `.shpb-tmp-` (the atomic writer's temporary files).
 fn temporaries(dir: &Path) -> Vec<String> {
     std::fs::read_dir(dir)
         .expect("list temp dir")
@@ -67,7 +67,7 @@ fn temporaries(dir: &Path) -> Vec<String> {
                 .to_string_lossy()
                 .into_owned()
         })
-        .filter(|n| n.starts_with(".tmp-"))
+        .filter(|n| n.starts_with(".shpb-tmp-"))
         .collect()
 }
 

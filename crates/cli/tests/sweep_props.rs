@@ -210,7 +210,7 @@ fn temporaries_of(dir: &Path, pid: u32) -> Vec<String> {
     std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(&format!(".tmp-{pid}-")))
+        .filter(|n| n.starts_with(&format!(".shpb-tmp-{pid}-")))
         .collect()
 }
 

@@ -502,7 +502,7 @@ fn a_stopped_sweep_removes_its_temporary_files_and_says_how_to_resume() {
             e.unwrap()
                 .file_name()
                 .to_string_lossy()
-                .starts_with(".tmp-")
+                .starts_with(".shpb-tmp-")
         })
     };
     let o = stopped(d, &args, libc::SIGTERM, temporary);

@@ -355,11 +355,15 @@ pub struct ChannelSet {
 impl ChannelSet {
     /// The set of `--channel ROLE=FILE` specifications (`key` names the flag in errors): every
     /// role at least once.
-    pub fn from_specs(specs: &[String], key: &str) -> Result<ChannelSet> {
+    /// A file name that is not UTF-8 is taken as it is.
+    pub fn from_specs<S: AsRef<std::ffi::OsStr>>(specs: &[S], key: &str) -> Result<ChannelSet> {
+        use std::os::unix::ffi::OsStrExt;
         let allowed = "ROLE=FILE with ROLE incident or transmission, each role at least once";
         let mut files = Vec::new();
-        for s in specs {
-            let Some((role, file)) = s.split_once('=') else {
+        for spec in specs {
+            let bytes = spec.as_ref().as_bytes();
+            let s = spec.as_ref().to_string_lossy();
+            let Some(at) = bytes.iter().position(|&b| b == b'=') else {
                 return Err(Error::Input {
                     file: "command line".into(),
                     key: key.into(),
@@ -367,6 +371,7 @@ impl ChannelSet {
                     allowed: allowed.into(),
                 });
             };
+            let role = String::from_utf8_lossy(&bytes[..at]);
             let role = Role::ALL
                 .iter()
                 .find(|(_, n)| *n == role.trim())
@@ -377,7 +382,8 @@ impl ChannelSet {
                     problem: format!("unknown channel role `{}`", role.trim()),
                     allowed: allowed.into(),
                 })?;
-            if file.trim().is_empty() {
+            let file = bytes[at + 1..].trim_ascii();
+            if file.is_empty() {
                 return Err(Error::Input {
                     file: "command line".into(),
                     key: key.into(),
@@ -385,7 +391,7 @@ impl ChannelSet {
                     allowed: allowed.into(),
                 });
             }
-            files.push((role, PathBuf::from(file.trim())));
+            files.push((role, PathBuf::from(std::ffi::OsStr::from_bytes(file))));
         }
         for (role, name) in Role::ALL {
             if !files.iter().any(|(r, _)| *r == role) {

@@ -91,7 +91,53 @@ pub fn check_output_flag(path: &Path, force: bool, flag: &str) -> Result<()> {
             allowed,
         ));
     }
-    if path.exists() && !force {
+    let name = path.file_name().unwrap_or_default();
+    let name_max = name_max(dir);
+    if name.len() > name_max {
+        return Err(bad_output(
+            flag,
+            format!(
+                "the file name {} is {} bytes long; the file system of {} allows {name_max}",
+                path.display(),
+                name.len(),
+                dir.display()
+            ),
+            &format!("a file name of at most {name_max} bytes"),
+        ));
+    }
+    if name
+        .as_encoded_bytes()
+        .starts_with(TEMPORARY_PREFIX.as_bytes())
+        || name.as_encoded_bytes().starts_with(b".shpb-probe-")
+    {
+        return Err(bad_output(
+            flag,
+            format!(
+                "{} has the form of shpb's temporary files, which another shpb removes",
+                path.display()
+            ),
+            &format!("a file name not beginning with {TEMPORARY_PREFIX} or .shpb-probe-"),
+        ));
+    }
+    // A symbolic link whose target does not exist: writing through it is not what was meant
+    // and replacing it would lose the link.
+    if let Ok(m) = std::fs::symlink_metadata(path)
+        && m.file_type().is_symlink()
+        && !path.exists()
+    {
+        return Err(bad_output(
+            flag,
+            format!(
+                "{} is a symbolic link to a file that does not exist ({})",
+                path.display(),
+                std::fs::read_link(path)
+                    .map(|t| t.display().to_string())
+                    .unwrap_or_default()
+            ),
+            "a file name, or a link to an existing file (with --force)",
+        ));
+    }
+    if std::fs::symlink_metadata(path).is_ok() && !force {
         return Err(Error::OutputExists(path.to_path_buf()));
     }
     // Writable? Create and remove a probe file (permission bits do not tell for root or ACLs).
@@ -111,6 +157,17 @@ pub fn check_output_flag(path: &Path, force: bool, flag: &str) -> Result<()> {
             allowed,
         )),
     }
+}
+
+/// The longest file name the file system of `dir` takes (`pathconf(_PC_NAME_MAX)`, else 255).
+fn name_max(dir: &Path) -> usize {
+    use std::os::unix::ffi::OsStrExt;
+    let Ok(c) = std::ffi::CString::new(dir.as_os_str().as_bytes()) else {
+        return 255;
+    };
+    // SAFETY: `c` is a valid NUL-terminated path.
+    let n = unsafe { libc::pathconf(c.as_ptr(), libc::_PC_NAME_MAX) };
+    if n > 0 { n as usize } else { 255 }
 }
 
 /// [`check_output_flag`] and then [`check_extension`]: every check of an output path given by
@@ -186,61 +243,285 @@ fn unique() -> usize {
     NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
-/// Writes a file through `write` to a temporary name beside `path`, then renames it into place;
-/// on failure the temporary file is removed, so no half-written output is left.
+/// How the name of every temporary file of shpb begins: `.shpb-tmp-<pid>-…`. An output may not
+/// have such a name (another process would remove it as its own temporary).
+pub const TEMPORARY_PREFIX: &str = ".shpb-tmp-";
+
+/// A fresh temporary file beside `path`, created empty with `O_EXCL` (so a temporary name is
+/// never a file this process did not create) and registered for removal on a signal. The name
+/// keeps the output's extension (plotters picks the image format from it) but not its stem,
+/// so a long output name does not make a longer temporary one.
+fn new_temporary(dir: &Path, path: &Path) -> Result<PathBuf> {
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .filter(|e| e.len() <= 16)
+        .unwrap_or_default();
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    loop {
+        let tmp = dir.join(format!(
+            "{TEMPORARY_PREFIX}{}-{}-{nanos:x}{ext}",
+            std::process::id(),
+            unique()
+        ));
+        let mut held = temporaries();
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+        {
+            Ok(_) => {
+                held.push(tmp.clone());
+                return Ok(tmp);
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(Error::io(path, e)),
+        }
+    }
+}
+
+/// Forgets and removes a temporary file of this process.
+fn drop_temporary(tmp: &Path) {
+    temporaries().retain(|t| t != tmp);
+    let _ = std::fs::remove_file(tmp);
+}
+
+/// A finished temporary file waiting to be moved to its final name (`-`: standard output).
+#[derive(Debug)]
+pub(crate) struct Pending {
+    pub(crate) tmp: PathBuf,
+    pub(crate) path: PathBuf,
+    pub(crate) force: bool,
+}
+
+thread_local! {
+    /// The finished temporaries of the output plan open on this thread ([`crate::plan`]):
+    /// while it is `Some`, [`write_atomically`] leaves its file under the temporary name.
+    pub(crate) static DEFERRED: std::cell::RefCell<Option<Vec<Pending>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Writes a file through `write` to a temporary name beside `path`, then moves it into place;
+/// on failure the temporary file is removed, so no half-written output is left. Inside an
+/// output plan ([`crate::plan::OutputPlan::write`]) the move waits for the plan's other outputs.
 pub fn write_atomically(
     path: &Path,
     force: bool,
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<()> {
-    if is_stdout(path) {
-        return write_to_stdout(write);
+    let deferred = DEFERRED.with(|d| d.borrow().is_some());
+    let tmp = if is_stdout(path) {
+        // The `.png` ending lets plotters choose its format; HDF5 and CSV writers ignore it.
+        new_temporary(&std::env::temp_dir(), Path::new("stdout.png"))?
+    } else {
+        check_output(path, force)?;
+        new_temporary(directory_of(path), path)?
+    };
+    test_pause(&format!("write:{}", path.display()));
+    if let Err(e) = write(&tmp) {
+        drop_temporary(&tmp);
+        return Err(e);
     }
-    check_output(path, force)?;
-    let dir = directory_of(path);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| "out".into());
-    // The temporary name keeps the extension (plotters picks the image format from it).
-    let tmp: PathBuf = dir.join(format!(".tmp-{}-{}-{name}", std::process::id(), unique()));
-    temporaries().push(tmp.clone());
-    let result = write(&tmp).and_then(|_| {
-        // Moved under the lock: a signal handler's `remove_temporaries` comes before or after.
-        let mut held = temporaries();
-        held.retain(|t| t != &tmp);
-        move_into_place(&tmp, path, force)
+    let pending = Pending {
+        tmp,
+        path: path.to_path_buf(),
+        force,
+    };
+    if deferred {
+        DEFERRED.with(|d| d.borrow_mut().as_mut().map(|v| v.push(pending)));
+        return Ok(());
+    }
+    commit(vec![pending], &mut |_| {})
+}
+
+/// Moves every finished temporary file to its final name, all or none: under the lock of the
+/// temporaries, so a SIGINT/SIGTERM comes before the first move (and removes them all) or after
+/// the last; an existing file replaced with `force` is kept under a temporary name until every
+/// move has succeeded and put back if one fails. `wrote` is called for each output once all are
+/// in place, still under the lock, so a stop cannot lose the report of a file written. Outputs
+/// to standard output are copied last.
+pub(crate) fn commit(pending: Vec<Pending>, wrote: &mut dyn FnMut(&Path)) -> Result<()> {
+    let mut held = temporaries();
+    let mut done: Vec<(&Pending, Option<PathBuf>)> = Vec::new();
+    let mut result = Ok(());
+    let files: Vec<&Pending> = pending.iter().filter(|p| !is_stdout(&p.path)).collect();
+    // Several files: what the moves are is written down first, so that a process killed by
+    // SIGKILL among them has its moves completed by the next plan writing there.
+    let journal = (files.len() > 1).then(|| write_journal(&files)).transpose();
+    let journal = match journal {
+        Ok(j) => j,
+        Err(e) => {
+            drop(held);
+            discard(pending);
+            return Err(e);
+        }
+    };
+    for (k, p) in files.iter().enumerate() {
+        // A file replaced with --force is first kept under a temporary name.
+        let backup = (p.force && std::fs::symlink_metadata(&p.path).is_ok())
+            .then(|| p.tmp.with_extension("old"))
+            .filter(|b| std::fs::hard_link(&p.path, b).is_ok());
+        if let Some(b) = &backup {
+            held.push(b.clone());
+        }
+        if let Err(e) = move_into_place(&p.tmp, &p.path, p.force) {
+            if let Some(b) = &backup {
+                let _ = std::fs::remove_file(b);
+            }
+            result = Err(e);
+            break;
+        }
+        done.push((p, backup));
+        test_pause(&format!("commit:{}", k + 1));
+    }
+    if result.is_err() {
+        // Undo the moves made: the old file back, or the new name removed.
+        for (p, backup) in done.drain(..).rev() {
+            match backup {
+                Some(b) => {
+                    let _ = std::fs::rename(&b, &p.path);
+                }
+                None => {
+                    let _ = std::fs::remove_file(&p.path);
+                }
+            }
+        }
+    }
+    if result.is_ok() {
+        for p in pending.iter().filter(|p| is_stdout(&p.path)) {
+            if let Err(e) = copy_to_stdout(&p.tmp) {
+                result = Err(e);
+                break;
+            }
+        }
+    }
+    if result.is_ok() {
+        for p in &pending {
+            wrote(&p.path);
+        }
+    }
+    for (_, backup) in &done {
+        if let Some(b) = backup {
+            let _ = std::fs::remove_file(b);
+        }
+    }
+    for p in &pending {
+        let _ = std::fs::remove_file(&p.tmp);
+    }
+    if let Some(j) = &journal {
+        let _ = std::fs::remove_file(j);
+    }
+    held.retain(|t| {
+        !pending.iter().any(|p| &p.tmp == t) && !done.iter().any(|(_, b)| b.as_ref() == Some(t))
     });
-    temporaries().retain(|t| t != &tmp);
-    let _ = std::fs::remove_file(&tmp);
     result
 }
 
-/// Writes through `write` to a temporary file, then copies it to standard output (a closed
-/// pipe is not an error).
-fn write_to_stdout(write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    use std::io::Write;
-    // The `.png` ending lets plotters choose its format; HDF5 and CSV writers ignore it.
-    let tmp = std::env::temp_dir().join(format!(
-        ".shpb-stdout-{}-{}.png",
-        std::process::id(),
-        unique()
-    ));
-    temporaries().push(tmp.clone());
-    let result = write(&tmp).and_then(|_| {
-        let bytes = std::fs::read(&tmp).map_err(|e| Error::io(&tmp, e))?;
-        let mut out = std::io::stdout().lock();
-        match out.write_all(&bytes).and_then(|_| out.flush()) {
-            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-                Err(Error::io(Path::new("stdout"), e))
-            }
-            _ => Ok(()),
-        }
+/// The journal of a commit of several files: beside the first, named as a temporary of this
+/// process with the ending `.journal`, one line per file: `force` (0 or 1), the temporary and
+/// the final name, absolute, their bytes in hex.
+fn write_journal(files: &[&Pending]) -> Result<PathBuf> {
+    let first = files[0];
+    let journal = first.tmp.with_extension("journal");
+    let hex = |p: &Path| -> String {
+        let absolute = std::fs::canonicalize(directory_of(p))
+            .map(|d| d.join(p.file_name().unwrap_or_default()))
+            .unwrap_or_else(|_| p.to_path_buf());
+        absolute
+            .as_os_str()
+            .as_encoded_bytes()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    };
+    let text: String = files
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.force as u8, hex(&p.tmp), hex(&p.path)))
+        .collect();
+    let written = std::fs::File::create_new(&journal).and_then(|mut f| {
+        use std::io::Write;
+        f.write_all(text.as_bytes())?;
+        f.sync_all()
     });
-    temporaries().retain(|t| t != &tmp);
-    let _ = std::fs::remove_file(&tmp);
-    result
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&journal);
+        return Err(Error::io(&first.path, e));
+    }
+    Ok(journal)
 }
+
+/// Completes the commit whose `journal` a process killed among its moves left: every
+/// temporary still there is moved to its final name (replacing it where the commit had
+/// `--force`), then the journal is removed.
+pub(crate) fn roll_forward(journal: &Path) {
+    use std::os::unix::ffi::OsStringExt;
+    let Ok(text) = std::fs::read_to_string(journal) else {
+        return;
+    };
+    let path = |h: &str| -> Option<PathBuf> {
+        let bytes: Option<Vec<u8>> = (0..h.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(h.get(i..i + 2)?, 16).ok())
+            .collect();
+        Some(PathBuf::from(std::ffi::OsString::from_vec(bytes?)))
+    };
+    for line in text.lines() {
+        let mut f = line.split(' ');
+        let (Some(force), Some(tmp), Some(path)) =
+            (f.next(), f.next().and_then(path), f.next().and_then(path))
+        else {
+            continue;
+        };
+        if std::fs::symlink_metadata(&tmp).is_ok() {
+            let _ = move_into_place(&tmp, &path, force == "1");
+            let _ = std::fs::remove_file(&tmp);
+        }
+    }
+    let _ = std::fs::remove_file(journal);
+}
+
+/// Removes finished temporaries that will not be committed (a plan that failed).
+pub(crate) fn discard(pending: Vec<Pending>) {
+    for p in pending {
+        drop_temporary(&p.tmp);
+    }
+}
+
+/// Copies a finished temporary file to standard output (a closed pipe is not an error).
+fn copy_to_stdout(tmp: &Path) -> Result<()> {
+    use std::io::Write;
+    let bytes = std::fs::read(tmp).map_err(|e| Error::io(tmp, e))?;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(&bytes).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Error::io(Path::new("stdout"), e))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Tests only (feature `test-hooks`): stops for `SHPB_TEST_PAUSE_S` seconds (default 30) at
+/// the output step named by `SHPB_TEST_PAUSE_AT` (`write:PATH` before an output's temporary is
+/// written, `commit:K` after the K-th move into place), announced on stderr as
+/// `shpb-test: paused at STEP`, so a test can stop the process there.
+#[cfg(feature = "test-hooks")]
+pub fn test_pause(step: &str) {
+    if std::env::var_os("SHPB_TEST_PAUSE_AT").is_some_and(|s| s == step) {
+        let seconds = std::env::var("SHPB_TEST_PAUSE_S")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(30.0);
+        eprintln!("shpb-test: paused at {step}");
+        std::thread::sleep(std::time::Duration::from_secs_f64(seconds));
+    }
+}
+
+/// Without the feature `test-hooks`: nothing.
+#[cfg(not(feature = "test-hooks"))]
+#[inline(always)]
+pub fn test_pause(_step: &str) {}
 
 /// Moves the finished temporary file to `path`: a rename with `force`; otherwise a hard link,
 /// which fails if `path` exists (another writer got there first), then the temporary name is
@@ -254,7 +535,9 @@ fn move_into_place(tmp: &Path, path: &Path, force: bool) -> Result<()> {
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
             Err(Error::OutputExists(path.to_path_buf()))
         }
-        Err(_) if !path.exists() => std::fs::rename(tmp, path).map_err(|e| Error::io(path, e)),
+        Err(_) if std::fs::symlink_metadata(path).is_err() => {
+            std::fs::rename(tmp, path).map_err(|e| Error::io(path, e))
+        }
         Err(_) => Err(Error::OutputExists(path.to_path_buf())),
     }
 }

@@ -83,7 +83,7 @@ pub fn write_hdf5(
     out: &RunOutput,
 ) -> Result<()> {
     write_atomically(path, force, |tmp| {
-        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        let f = crate::h5::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
         string_attr(&f, "scene", scene_text, path)?;
         let origin = |g: &hdf5::Group, name: &str, origin: &str, offset_s: f64| -> Result<()> {

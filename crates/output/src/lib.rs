@@ -11,6 +11,7 @@ pub mod atomic;
 pub mod batch;
 pub mod h5;
 pub mod io;
+pub mod plan;
 pub mod plot;
 pub mod provenance;
 pub mod reduction;

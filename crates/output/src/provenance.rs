@@ -54,7 +54,7 @@ pub fn read_provenance(path: &Path) -> Result<Provenance> {
         allowed: "a run file written by `shpb run -o` (shpb 0.1.0 or later, with /provenance)"
             .into(),
     };
-    let f = hdf5::File::open(path).map_err(|e| bad(format!("cannot open as HDF5: {e}")))?;
+    let f = crate::h5::open(path).map_err(|e| bad(format!("cannot open as HDF5: {e}")))?;
     let g = f
         .group("provenance")
         .map_err(|_| bad("no /provenance group: this file cannot be rerun".into()))?;

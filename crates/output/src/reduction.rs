@@ -11,7 +11,7 @@ use std::path::Path;
 /// Reads `/time` and `/gauges/{incident,transmission}/strain` of an HDF5 file written by
 /// `shpb run`.
 pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
-    let f = hdf5::File::open(path).map_err(h5err(path))?;
+    let f = crate::h5::open(path).map_err(h5err(path))?;
     let read = |name: &str| -> Result<Vec<f64>> {
         let ds = f.dataset(name).map_err(|e| {
             Error::Input {
@@ -33,7 +33,7 @@ pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
 /// `/time` and `/gauges/{incident,transmission}/voltage` of a run file (the digitised bridge
 /// outputs, V), or None when the file has no such datasets.
 pub fn read_hdf5_voltages(path: &Path) -> Result<Option<shpb_core::gauge::RawRecord>> {
-    let f = hdf5::File::open(path).map_err(h5err(path))?;
+    let f = crate::h5::open(path).map_err(h5err(path))?;
     let read = |name: &str| -> Option<Vec<f64>> { f.dataset(name).ok()?.read_raw::<f64>().ok() };
     Ok(
         match (
@@ -259,7 +259,7 @@ pub fn write_reduction_hdf5_with(
     cylinder: Option<&CylinderReduction>,
 ) -> Result<()> {
     write_atomically(path, force, |tmp| {
-        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        let f = crate::h5::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", env!("CARGO_PKG_VERSION"), path)?;
         string_attr(&f, "scene", scene, path)?;
         let g = f.create_group("reduction").map_err(h5err(path))?;

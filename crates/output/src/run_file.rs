@@ -157,7 +157,7 @@ pub struct RunFile {
 /// Reads every numeric dataset, the summary, the warnings and the provenance of a run or
 /// reduction file.
 pub fn read_run_file(path: &Path) -> Result<RunFile> {
-    let f = hdf5::File::open(path).map_err(h5err(path))?;
+    let f = crate::h5::open(path).map_err(h5err(path))?;
     let text_attr = |loc: &hdf5::Location, name: &str| -> Option<String> {
         loc.attr(name)
             .and_then(|a| a.read_scalar::<VarLenUnicode>())

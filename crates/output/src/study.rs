@@ -158,7 +158,7 @@ pub fn write_study_hdf5(path: &Path, force: bool, table: &StudyTable) -> Result<
         });
     }
     write_atomically(path, force, |tmp| {
-        let f = hdf5::File::create(tmp).map_err(h5err(path))?;
+        let f = crate::h5::create(tmp).map_err(h5err(path))?;
         string_attr(&f, "shpb_version", &table.shpb_version, path)?;
         string_attr(&f, "scene", &table.scene, path)?;
         string_attr(&f, "sweep", &table.sweep.join("\n"), path)?;
@@ -252,7 +252,7 @@ pub fn read_study_hdf5(path: &Path) -> Result<StudyTable> {
         problem: e,
         allowed: "an HDF5 file written by `shpb sweep -o`".into(),
     };
-    let f = hdf5::File::open(path).map_err(|e| bad("file", e.to_string()))?;
+    let f = crate::h5::open(path).map_err(|e| bad("file", e.to_string()))?;
     let text = |loc: &hdf5::Location, name: &str| -> Result<String> {
         loc.attr(name)
             .and_then(|a| a.read_scalar::<VarLenUnicode>())

@@ -371,48 +371,62 @@ impl RunData {
     /// Writes the file `shpb run -o` (or `shpb reduce -o`) writes; a file read back is copied.
     #[pyo3(signature = (path, force = false))]
     fn save(&self, py: Python<'_>, path: PathBuf, force: bool) -> PyResult<()> {
-        use shpb_output::atomic::{check_extension, check_not_input, check_output_flag};
+        use shpb_output::atomic::{check_not_input, is_stdout};
         detached(py, || {
-            check_output_flag(&path, force, "path")?;
-            check_extension(&path, "path", &["h5", "hdf5"])?;
-            match &self.source {
-                Source::Simulated {
-                    params,
-                    out,
-                    provenance,
-                } => {
-                    let inputs: Vec<PathBuf> = provenance
-                        .inputs
-                        .iter()
-                        .filter(|f| !f.name.starts_with("built-in:"))
-                        .map(|f| PathBuf::from(&f.name))
-                        .collect();
-                    check_not_input(&path, "path", &inputs)?;
-                    shpb_output::Hdf5 {
-                        provenance: Some(provenance.clone()),
-                    }
-                    .write_run(&path, force, params, out)
-                }
-                Source::Reduced {
-                    scene,
-                    reduction,
-                    cylinder,
-                } => shpb_output::reduction::write_reduction_hdf5_with(
-                    &path,
-                    force,
-                    scene,
-                    reduction,
-                    cylinder.as_deref(),
-                ),
-                Source::Loaded { path: source, .. } => {
-                    check_not_input(&path, "path", std::slice::from_ref(source))?;
-                    shpb_output::atomic::write_atomically(&path, force, |tmp| {
-                        std::fs::copy(source, tmp)
-                            .map(|_| ())
-                            .map_err(|e| Error::io(source, e))
-                    })
-                }
+            if is_stdout(&path) {
+                return Err(Error::Input {
+                    file: "save".into(),
+                    key: "path".into(),
+                    problem: "`-` (standard output on the command line) is not a file name here"
+                        .into(),
+                    allowed: "a .h5 or .hdf5 file path".into(),
+                });
             }
+            let plan = shpb_output::plan::OutputPlan::new(
+                force,
+                &[(Some(path.as_path()), "path", &["h5", "hdf5"])],
+            )?;
+            plan.write(
+                || match &self.source {
+                    Source::Simulated {
+                        params,
+                        out,
+                        provenance,
+                    } => {
+                        let inputs: Vec<PathBuf> = provenance
+                            .inputs
+                            .iter()
+                            .filter(|f| !f.name.starts_with("built-in:"))
+                            .map(|f| PathBuf::from(&f.name))
+                            .collect();
+                        check_not_input(&path, "path", &inputs)?;
+                        shpb_output::Hdf5 {
+                            provenance: Some(provenance.clone()),
+                        }
+                        .write_run(&path, force, params, out)
+                    }
+                    Source::Reduced {
+                        scene,
+                        reduction,
+                        cylinder,
+                    } => shpb_output::reduction::write_reduction_hdf5_with(
+                        &path,
+                        force,
+                        scene,
+                        reduction,
+                        cylinder.as_deref(),
+                    ),
+                    Source::Loaded { path: source, .. } => {
+                        check_not_input(&path, "path", std::slice::from_ref(source))?;
+                        shpb_output::atomic::write_atomically(&path, force, |tmp| {
+                            std::fs::copy(source, tmp)
+                                .map(|_| ())
+                                .map_err(|e| Error::io(source, e))
+                        })
+                    }
+                },
+                |_| {},
+            )
         })
     }
 }

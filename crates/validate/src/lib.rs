@@ -20,7 +20,6 @@ mod restitution;
 
 use shpb_core::run::RunOutput;
 use shpb_input::{Error, Result};
-use shpb_output::io::check_output;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -585,11 +584,15 @@ pub fn command_with_data(
     force: bool,
 ) -> Result<()> {
     let cases = select_cases(names)?;
-    if let Some(dir) = report {
-        for p in report_files(dir, &cases) {
-            check_output(&p, force)?;
-        }
-    }
+    // The report and its figures: checked before the cases run, written all or none.
+    let files: Vec<PathBuf> = report.map_or(Vec::new(), |dir| report_files(dir, &cases));
+    let outputs = shpb_output::plan::OutputPlan::new(
+        force,
+        &files
+            .iter()
+            .map(|p| (Some(p.as_path()), "--report", &[][..]))
+            .collect::<Vec<_>>(),
+    )?;
     let ctx = match data {
         Some(dir) => Context::from_dir(dir)?,
         None => Context::embedded()?,
@@ -607,7 +610,7 @@ pub fn command_with_data(
     let failed: usize = results.iter().map(CaseResult::failures).sum();
     print(&format!("{} of {rules} checks pass", rules - failed))?;
     if let Some(dir) = report {
-        write_report(dir, force, &results, &ctx)?;
+        outputs.write(|| write_report(dir, force, &results, &ctx), |_| {})?;
         eprintln!(
             "wrote {} and {} figures",
             dir.join("REPORT.md").display(),

@@ -1,6 +1,6 @@
 //! `shpb calibrate`: a set-up's constants fitted to a lab's own shots (shpb_study::calibrate).
 
-use super::common::{quiet_mode, report, warn, wrote};
+use super::common::{quiet_mode, report, warn};
 use shpb_core::apparatus::Apparatus;
 use shpb_core::gauge::GaugeSetup;
 use shpb_input::prelude::*;
@@ -44,7 +44,17 @@ pub fn calibrate(
             "a .toml file path",
         ));
     }
-    check_output_path(output, force, "-o", &["toml"])?;
+    if output.file_name().is_some_and(|n| n.to_str().is_none()) {
+        return Err(shpb_study::api::input_err(
+            "-o",
+            format!(
+                "{} is not valid UTF-8: the set-up names its gauge file inside it, in TOML",
+                output.display()
+            ),
+            "a .toml file name in UTF-8",
+        ));
+    }
+    check_output_path(output, force, "-o", &["toml"][..])?;
     let gauges_out = gauges_path(output);
     if shots.is_none() && paired.is_none() {
         return Err(shpb_study::api::input_err(
@@ -69,9 +79,17 @@ pub fn calibrate(
     }
     let (base_name, base_text, base_gauges) = setup_file::read_base(bars)?;
     let manifest = shots.map(ShotManifest::from_file).transpose()?;
-    if base_gauges.is_some() {
-        check_output_path(&gauges_out, force, "-o", &["toml"])?;
-    }
+    let outputs = super::common::plan(
+        force,
+        &[
+            (Some(output), "-o", &["toml"]),
+            (
+                base_gauges.is_some().then_some(gauges_out.as_path()),
+                "-o (its gauge file)",
+                &["toml"],
+            ),
+        ],
+    )?;
     let mut inputs: Vec<PathBuf> = vec![bars.to_path_buf()];
     inputs.extend(shots.map(Path::to_path_buf));
     if let Some(m) = &manifest {
@@ -81,7 +99,7 @@ pub fn calibrate(
     if let Some((v, s)) = paired {
         inputs.extend([v.to_path_buf(), s.to_path_buf()]);
     }
-    check_not_input(output, "-o", &inputs)?;
+    outputs.not_inputs(&inputs)?;
     check_not_input(&gauges_out, "-o", &inputs)?;
 
     let base = shpb_study::api::load_apparatus(bars)?;
@@ -148,12 +166,12 @@ pub fn calibrate(
         &header,
     )?;
     check_loads(&texts, &gauges_name);
-    if let Some(g) = &texts.gauges {
-        write_text_atomically(&gauges_out, force, g)?;
-        wrote(&gauges_out);
-    }
-    write_text_atomically(output, force, &texts.setup)?;
-    wrote(output);
+    super::common::write_all(&outputs, || {
+        if let Some(g) = &texts.gauges {
+            write_text_atomically(&gauges_out, force, g)?;
+        }
+        write_text_atomically(output, force, &texts.setup)
+    })?;
     let gauges_written = texts.gauges.as_ref().map(|_| gauges_out.as_path());
     report(&text(&c), || json(&c, output, gauges_written))
 }

@@ -120,36 +120,12 @@ impl ProgressLine {
     }
 }
 
-/// Refuses outputs that will not fit on their file system: the run's estimated output size
-/// (`bytes`, [`shpb_core::estimate::RunEstimate::output_bytes`]) against the space free where
-/// each output goes (exit 2, with both numbers).
-pub fn check_disk(outputs: &[(Option<&Path>, &str)], bytes: f64) -> Result<()> {
-    use shpb_core::error::format_si;
-    for (path, flag) in outputs {
-        let Some(path) = path.filter(|p| !shpb_output::atomic::is_stdout(p)) else {
-            continue;
-        };
-        let dir = path
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if let Some(free) = free_space(dir)
-            && bytes > free as f64
-        {
-            return Err(input_err(
-                "command line",
-                flag,
-                format!(
-                    "the run writes about {} to {} but only {} are free there",
-                    format_si(bytes, "B"),
-                    path.display(),
-                    format_si(free as f64, "B")
-                ),
-                "an output on a file system with room for it, or a smaller run",
-            ));
-        }
-    }
-    Ok(())
+/// The command line of this process as text (a name that is not UTF-8 shown with U+FFFD).
+pub fn command_line() -> String {
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// A number for JSON, which has no NaN or infinity: those become null.
@@ -179,7 +155,35 @@ pub fn stdout_once(outputs: &[Option<&Path>]) -> Result<bool> {
     Ok(to_stdout == 1)
 }
 
+/// The output plan of a command ([`OutputPlan`]): every output (`(path, flag, extensions)`)
+/// checked before anything runs, at most one on standard output and none there with `--json`.
+/// A command that has an output `-` prints nothing else on stdout ([`OutputPlan::to_stdout`]).
+pub fn plan(force: bool, outputs: &[(Option<&Path>, &str, &[&str])]) -> Result<OutputPlan> {
+    let plan = OutputPlan::new(force, outputs)?;
+    plan.refuse_stdout_with(json_mode().then_some("--json"))?;
+    Ok(plan)
+}
+
+/// Writes the outputs of `plan` through `write`, all or none, and prints a `wrote` line for each
+/// once all are in place.
+pub fn write_all(plan: &OutputPlan, write: impl FnOnce() -> Result<()>) -> Result<()> {
+    plan.write(write, wrote)
+}
+
+/// [`report`], unless an output goes to standard output (which then holds only that file).
+pub fn report_unless_stdout(
+    plan: &OutputPlan,
+    text: &str,
+    json: impl FnOnce() -> serde_json::Value,
+) -> Result<()> {
+    if plan.to_stdout() {
+        return Ok(());
+    }
+    report(text, json)
+}
+
 pub use shpb_output::atomic::free_space;
+pub use shpb_output::plan::OutputPlan;
 pub use shpb_study::api::DEFAULT_BARS;
 
 /// An input error (exit code 2) naming the file (or "command line"), the key, the problem and
@@ -223,7 +227,8 @@ pub fn say(line: &str) -> Result<()> {
 pub use shpb_study::api::{gun_shot, load_apparatus, require_bars};
 
 /// Writes a study's summary `table` as CSV and its HDF5 (atomically; an existing file is
-/// replaced only with `replace`), the HDF5 stamped with the sweep's `identity`.
+/// replaced only with `replace`), the HDF5 stamped with the sweep's `identity`; called inside
+/// the command's [`write_all`], which reports the files.
 #[allow(clippy::too_many_arguments)]
 pub fn write_study(
     scene_text: &str,
@@ -237,11 +242,9 @@ pub fn write_study(
 ) -> Result<()> {
     if let Some(p) = csv {
         shpb_output::io::write_text_atomically(p, replace, table)?;
-        wrote(p);
     }
     if let Some(p) = output {
         shpb_study::file::write_sweep_hdf5(p, replace, scene_text, spec, identity, keys, rows)?;
-        wrote(p);
     }
     Ok(())
 }
@@ -251,16 +254,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn an_output_larger_than_the_free_space_is_refused_with_both_numbers() {
+    fn outputs_larger_than_the_free_space_together_are_refused_with_both_numbers() {
         let dir = std::env::temp_dir();
-        let out = dir.join("run.h5");
+        let (out, csv) = (dir.join("run.h5"), dir.join("run.csv"));
         let free = free_space(&dir).expect("statvfs of the temporary directory") as f64;
-        assert!(check_disk(&[(Some(&out), "--output")], 0.5 * free).is_ok());
-        let e = check_disk(&[(Some(&out), "--output")], 2.0 * free + 1e9)
+        let both = OutputPlan::new(
+            true,
+            &[(Some(&out), "--output", &[]), (Some(&csv), "--csv", &[])],
+        )
+        .unwrap();
+        assert!(
+            both.check_space(&[Some(0.3 * free), Some(0.3 * free)])
+                .is_ok()
+        );
+        // Each fits alone, not both together.
+        let e = both
+            .check_space(&[Some(0.6 * free + 1e6), Some(0.6 * free + 1e6)])
             .unwrap_err()
             .to_string();
         assert!(e.contains("--output") && e.contains("free there"), "{e}");
-        // stdout and absent outputs take no disk space.
-        assert!(check_disk(&[(Some(Path::new("-")), "--csv"), (None, "-o")], 1e30).is_ok());
+        // stdout takes no disk space.
+        let dash = OutputPlan::new(true, &[(Some(Path::new("-")), "--csv", &[])]).unwrap();
+        assert!(dash.check_space(&[Some(1e30)]).is_ok());
     }
 }

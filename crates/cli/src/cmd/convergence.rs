@@ -1,8 +1,7 @@
 //! `shpb convergence`: a scene on a ladder of resolutions.
 
-use super::common::say;
+use super::common::{plan, say, write_all};
 use shpb_input::Result;
-use shpb_output::io::check_output;
 use std::path::Path;
 
 /// `shpb convergence`: runs the ladder with a progress line per level, prints the table, writes
@@ -13,21 +12,28 @@ pub fn convergence(
     plot: Option<&Path>,
     force: bool,
 ) -> Result<()> {
-    for p in [output, plot].into_iter().flatten() {
-        check_output(p, force)?;
-    }
+    let outputs = plan(
+        force,
+        &[
+            (output, "--output", &["csv"][..]),
+            (plot, "--plot", &["png"][..]),
+        ],
+    )?;
+    outputs.not_inputs(&[scene.to_path_buf()])?;
     let study = shpb_study::convergence::study(scene, |i, value| {
         eprintln!("shpb: convergence level {} ({value:e})", i + 1);
     })?;
     let table = shpb_study::convergence::table_text(&study);
-    say(&table)?;
-    if let Some(p) = output {
-        shpb_study::convergence::write_csv(p, force, &study)?;
-        super::common::wrote(p);
+    if !outputs.to_stdout() {
+        say(&table)?;
     }
-    if let Some(p) = plot {
-        shpb_study::convergence::plot(p, force, &study)?;
-        super::common::wrote(p);
-    }
-    Ok(())
+    write_all(&outputs, || {
+        if let Some(p) = output {
+            shpb_study::convergence::write_csv(p, force, &study)?;
+        }
+        if let Some(p) = plot {
+            shpb_study::convergence::plot(p, force, &study)?;
+        }
+        Ok(())
+    })
 }

@@ -1,9 +1,8 @@
 //! `shpb reduce`: the lab's reduction of raw records or run files, one or a batch.
 
-use super::common::{DEFAULT_BARS, finite, report, require_bars, stdout_once, warn, wrote};
+use super::common::{DEFAULT_BARS, finite, plan, report, require_bars, warn, write_all};
 use shpb_core::reduce::{DispersionCorrection, Reduction, ReductionSetup};
 use shpb_input::{Error, Result};
-use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::batch::{
     BatchRecord, record_figure, reduction_figure, write_report, write_summary,
 };
@@ -119,24 +118,21 @@ pub fn reduce_command(
             .collect(),
         None => Vec::new(),
     };
-    let outputs = [
+    let mut outputs: Vec<(Option<&Path>, &str, &[&str])> = vec![
         (o.output, "--output", &["h5", "hdf5"][..]),
         (o.csv, "--csv", &["csv"][..]),
         (o.summary, "--summary", &["csv"][..]),
         (o.report, "--report", &["md"][..]),
         (o.plot, "--plot", &["png"][..]),
     ];
-    for (p, flag, extensions) in outputs {
-        if let Some(p) = p {
-            check_output_path(p, o.force, flag, extensions)?;
-            check_not_input(p, flag, &inputs)?;
-        }
-    }
-    for f in &figures {
-        check_output_path(f, o.force, "--report (figure)", &["png"])?;
-        check_not_input(f, "--report (figure)", &inputs)?;
-    }
-    let data_on_stdout = stdout_once(&[o.output, o.csv, o.summary, o.report, o.plot])?;
+    outputs.extend(
+        figures
+            .iter()
+            .map(|f| (Some(f.as_path()), "--report (figure)", &["png"][..])),
+    );
+    let out_plan = plan(o.force, &outputs)?;
+    out_plan.not_inputs(&inputs)?;
+    let data_on_stdout = out_plan.to_stdout();
 
     let mut reduced: Vec<Result<Reduced>> = records
         .iter()
@@ -153,62 +149,65 @@ pub fn reduce_command(
         |b| b.display().to_string(),
     );
     let command = command_line(records, &set_up_name, &o, choices);
-    if let Ok(r) = &reduced[0]
-        && records.len() == 1
-    {
-        if let Some(out) = o.output {
-            write_reduction_hdf5_with(out, o.force, &command, &r.reduction, r.cylinder.as_ref())?;
-            wrote(out);
-        }
-        if let Some(c) = o.csv {
-            write_reduction_csv_with(c, o.force, &r.reduction, r.cylinder.as_ref())?;
-            wrote(c);
-        }
-        if let Some(p) = o.plot {
-            record_figure(
-                p,
-                o.force,
-                &stem(&records[0]),
-                &r.reduction,
-                r.cylinder.as_ref(),
-            )?;
-            wrote(p);
-        }
-    }
-    let mut batch = Vec::new();
-    for (k, (record, result)) in records.iter().zip(&reduced).enumerate() {
-        let figure = match (result, figures.get(k)) {
-            (Ok(r), Some(path)) => {
-                reduction_figure(path, o.force, &stem(record), &r.reduction)?;
-                wrote(path);
-                path.file_name().map(|n| n.to_string_lossy().into_owned())
+    write_all(&out_plan, || {
+        if let Ok(r) = &reduced[0]
+            && records.len() == 1
+        {
+            if let Some(out) = o.output {
+                write_reduction_hdf5_with(
+                    out,
+                    o.force,
+                    &command,
+                    &r.reduction,
+                    r.cylinder.as_ref(),
+                )?;
             }
-            _ => None,
-        };
-        batch.push(BatchRecord {
-            record: record.display().to_string(),
-            reduction: result
-                .as_ref()
-                .map(|r| &r.reduction)
-                .map_err(|e| e.to_string()),
-            bars: match result {
-                Ok(r) => ReductionSetup::from_apparatus(&r.apparatus)
-                    .ok()
-                    .map(|s| (s.incident_bar, s.transmission_bar)),
-                Err(_) => None,
-            },
-            figure,
-            cylinder: result.as_ref().ok().and_then(|r| r.cylinder.as_ref()),
-        });
-    }
-    if let Some(s) = o.summary {
-        write_summary(s, o.force, &batch)?;
-        wrote(s);
-    }
-    if let Some(rep) = o.report {
-        write_report(rep, o.force, &command, &batch)?;
-        wrote(rep);
-    }
+            if let Some(c) = o.csv {
+                write_reduction_csv_with(c, o.force, &r.reduction, r.cylinder.as_ref())?;
+            }
+            if let Some(p) = o.plot {
+                record_figure(
+                    p,
+                    o.force,
+                    &stem(&records[0]),
+                    &r.reduction,
+                    r.cylinder.as_ref(),
+                )?;
+            }
+        }
+        let mut batch = Vec::new();
+        for (k, (record, result)) in records.iter().zip(&reduced).enumerate() {
+            let figure = match (result, figures.get(k)) {
+                (Ok(r), Some(path)) => {
+                    reduction_figure(path, o.force, &stem(record), &r.reduction)?;
+                    path.file_name().map(|n| n.to_string_lossy().into_owned())
+                }
+                _ => None,
+            };
+            batch.push(BatchRecord {
+                record: record.display().to_string(),
+                reduction: result
+                    .as_ref()
+                    .map(|r| &r.reduction)
+                    .map_err(|e| e.to_string()),
+                bars: match result {
+                    Ok(r) => ReductionSetup::from_apparatus(&r.apparatus)
+                        .ok()
+                        .map(|s| (s.incident_bar, s.transmission_bar)),
+                    Err(_) => None,
+                },
+                figure,
+                cylinder: result.as_ref().ok().and_then(|r| r.cylinder.as_ref()),
+            });
+        }
+        if let Some(s) = o.summary {
+            write_summary(s, o.force, &batch)?;
+        }
+        if let Some(rep) = o.report {
+            write_report(rep, o.force, &command, &batch)?;
+        }
+        Ok(())
+    })?;
     for (record, result) in records.iter().zip(&reduced) {
         if let Ok(r) = result {
             for w in &r.reduction.warnings {

@@ -1,13 +1,12 @@
 //! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
 //! summary and write its results.
 
-use super::common::{ProgressLine, check_disk, finite, report, stdout_once, warn, wrote};
+use super::common::{ProgressLine, finite, plan, report, warn, write_all};
 use shpb_core::fidelity::Fidelity;
 use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::Result;
 use shpb_input::files::Provenance;
-use shpb_output::atomic::{check_not_input, check_output_path};
 use shpb_output::writer::{Csv, Hdf5, Png, Writer};
 use std::path::{Path, PathBuf};
 
@@ -28,17 +27,15 @@ pub fn run(
     bands: bool,
 ) -> Result<()> {
     let overrides = overrides(set)?;
-    let outputs = [
-        (output, "--output", &["h5", "hdf5"][..]),
-        (csv, "--csv", &["csv"][..]),
-        (plot, "--plot", &["png"][..]),
-    ];
-    for (p, flag, extensions) in outputs {
-        if let Some(p) = p {
-            check_output_path(p, force, flag, extensions)?;
-        }
-    }
-    let data_on_stdout = stdout_once(&[output, csv, plot])?;
+    let outputs = plan(
+        force,
+        &[
+            (output, "--output", &["h5", "hdf5"][..]),
+            (csv, "--csv", &["csv"][..]),
+            (plot, "--plot", &["png"][..]),
+        ],
+    )?;
+    let data_on_stdout = outputs.to_stdout();
     let (params, provenance) = load(scene, fidelity, &overrides)?;
     // An output may never be one of the inputs (not even with --force).
     let mut inputs: Vec<PathBuf> = vec![scene.to_path_buf()];
@@ -49,12 +46,20 @@ pub fn run(
             .filter(|f| !f.name.starts_with("built-in:"))
             .map(|f| PathBuf::from(&f.name)),
     );
-    for (p, flag, _) in outputs {
-        if let Some(p) = p {
-            check_not_input(p, flag, &inputs)?;
-        }
-    }
-    check_disk(&[(output, "--output")], params.estimate().output_bytes)?;
+    outputs.not_inputs(&inputs)?;
+    // The HDF5 file holds every series, the CSV some of them in text (no more bytes than the
+    // HDF5 file by the same estimate), the figure under half a megabyte: checked together.
+    let bytes = params.estimate().output_bytes;
+    let sizes: Vec<Option<f64>> = [
+        output.map(|_| bytes),
+        csv.map(|_| bytes),
+        plot.map(|_| 0.5e6),
+    ]
+    .into_iter()
+    .flatten()
+    .map(Some)
+    .collect();
+    outputs.check_space(&sizes)?;
     let mut progress = ProgressLine::new(&params.source);
     let out = shpb_study::api::run_scene_with_bands(&params, &provenance, bands, &mut |f| {
         progress.update(f);
@@ -67,22 +72,21 @@ pub fn run(
     if !data_on_stdout {
         print_summary(&params, &out)?;
     }
-    if let Some(p) = output {
-        Hdf5 {
-            provenance: Some(provenance),
+    write_all(&outputs, || {
+        if let Some(p) = output {
+            Hdf5 {
+                provenance: Some(provenance),
+            }
+            .write_run(p, force, &params, &out)?;
         }
-        .write_run(p, force, &params, &out)?;
-        wrote(p);
-    }
-    if let Some(p) = csv {
-        Csv.write_run(p, force, &params, &out)?;
-        wrote(p);
-    }
-    if let Some(p) = plot {
-        Png.write_run(p, force, &params, &out)?;
-        wrote(p);
-    }
-    Ok(())
+        if let Some(p) = csv {
+            Csv.write_run(p, force, &params, &out)?;
+        }
+        if let Some(p) = plot {
+            Png.write_run(p, force, &params, &out)?;
+        }
+        Ok(())
+    })
 }
 
 /// Reads the scene (recording every input it reads), or a run file's stored scene and inputs.
@@ -91,7 +95,7 @@ fn load(
     fidelity: Option<Fidelity>,
     overrides: &[(String, shpb_input::scene::Value)],
 ) -> Result<(Params, Provenance)> {
-    let command_line = std::env::args().collect::<Vec<_>>().join(" ");
+    let command_line = super::common::command_line();
     shpb_study::api::load_scene(
         shpb_study::api::Scene::File(scene),
         fidelity,

@@ -188,7 +188,10 @@ impl SetupNew {
         let channel = self.check()?;
         let nu = self.poisson.unwrap_or(0.3);
         let c0 = (self.modulus_pa / self.density_kg_m3).sqrt();
-        let command: Vec<String> = std::env::args().collect();
+        // One comment line: a name that is not UTF-8 shown with U+FFFD, line ends as spaces.
+        let command: Vec<String> = std::env::args_os()
+            .map(|a| a.to_string_lossy().replace(['\n', '\r'], " "))
+            .collect();
         let mut t = String::new();
         t.push_str(&format!(
             "# A split Hopkinson bar set-up, written by `shpb setup new` from the numbers a lab \
@@ -329,10 +332,11 @@ impl SetupNew {
 /// --incident-length L --transmission-length L --incident-gauge X --transmission-gauge X ...`:
 /// writes the commented set-up (atomically, no clobbering without `--force`).
 pub fn new(args: &SetupNew, output: &Path, force: bool) -> Result<()> {
+    let outputs = super::common::plan(force, &[(Some(output), "--output", &["toml"])])?;
     let text = args.text()?;
-    shpb_output::atomic::check_output_path(output, force, "--output", &["toml"])?;
-    shpb_output::atomic::write_text_atomically(output, force, &text)?;
-    super::common::wrote(output);
+    super::common::write_all(&outputs, || {
+        shpb_output::atomic::write_text_atomically(output, force, &text)
+    })?;
     if args.striker_length_m.is_none() {
         eprintln!(
             "note: no --striker-length: [striker] length_m is a placeholder (edit it before a \

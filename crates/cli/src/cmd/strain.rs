@@ -1,9 +1,8 @@
 //! `shpb strain`: a raw gauge record converted to bar strain with the set-up's gauge channels.
 
-use super::common::say;
+use super::common::{plan, say, write_all};
 use shpb_core::run::RunOutput;
 use shpb_input::{Error, Result};
-use shpb_output::atomic::{check_not_input, check_output_path};
 use std::path::Path;
 
 /// How `shpb strain` reads the record.
@@ -25,18 +24,16 @@ pub fn strain(
     csv: Option<&Path>,
     force: bool,
 ) -> Result<()> {
-    let outputs = [
-        (output, "--output", &["h5", "hdf5"][..]),
-        (csv, "--csv", &["csv"][..]),
-    ];
+    let outputs = plan(
+        force,
+        &[
+            (output, "--output", &["h5", "hdf5"][..]),
+            (csv, "--csv", &["csv"][..]),
+        ],
+    )?;
     let mut inputs_given = vec![record.to_path_buf(), bars.to_path_buf()];
     inputs_given.extend(read_as.layout.map(Path::to_path_buf));
-    for (p, flag, extensions) in outputs {
-        if let Some(p) = p {
-            check_output_path(p, force, flag, extensions)?;
-            check_not_input(p, flag, &inputs_given)?;
-        }
-    }
+    outputs.not_inputs(&inputs_given)?;
     let (read, inputs) = shpb_input::files::capture(|| -> Result<_> {
         // A set-up, or a lab's input deck (its bridges and gains; `load_record_apparatus`).
         let (apparatus, _) = shpb_study::api::load_record_apparatus(bars)?;
@@ -101,20 +98,21 @@ pub fn strain(
         record.display(),
         bars.display()
     );
-    if let Some(p) = output {
-        let provenance = shpb_input::files::Provenance {
-            scene_file: String::new(),
-            fidelity_override: None,
-            command_line: std::env::args().collect::<Vec<_>>().join(" "),
-            inputs: inputs.clone(),
-        };
-        shpb_output::io::write_hdf5(p, force, &text, Some(&provenance), &out)?;
-        super::common::wrote(p);
-    }
-    if let Some(p) = csv {
-        shpb_output::io::write_csv(p, force, &out)?;
-        super::common::wrote(p);
-    }
+    write_all(&outputs, || {
+        if let Some(p) = output {
+            let provenance = shpb_input::files::Provenance {
+                scene_file: String::new(),
+                fidelity_override: None,
+                command_line: super::common::command_line(),
+                inputs: inputs.clone(),
+            };
+            shpb_output::io::write_hdf5(p, force, &text, Some(&provenance), &out)?;
+        }
+        if let Some(p) = csv {
+            shpb_output::io::write_csv(p, force, &out)?;
+        }
+        Ok(())
+    })?;
     if output.is_none() && csv.is_none() {
         let peak = |s: &[f64]| s.iter().cloned().fold(0.0, f64::min);
         say(&format!(

@@ -2,9 +2,8 @@
 //! scatter) drawn by a seeded Latin hypercube, each sample a normal run, and the statistics of
 //! every summary quantity (`shpb_study::uq`, docs/physics.md §10).
 
-use super::common::{finite, quiet_mode, report, warn, wrote};
+use super::common::{finite, quiet_mode, report_unless_stdout, warn, write_all};
 use shpb_input::{Error, Result};
-use shpb_output::io::check_output;
 use shpb_study::uq::{RunTraces, Study, StudyPlan, Trace, bands};
 use std::path::Path;
 
@@ -31,10 +30,16 @@ pub fn study(
     outputs: StudyOutputs,
     force: bool,
 ) -> Result<()> {
-    let paths = [outputs.output, outputs.csv, outputs.summary, outputs.plot];
-    for p in paths.into_iter().flatten() {
-        check_output(p, force)?;
-    }
+    let out_plan = super::common::plan(
+        force,
+        &[
+            (outputs.output, "--output", &["h5", "hdf5"][..]),
+            (outputs.csv, "--csv", &["csv"][..]),
+            (outputs.summary, "--summary", &["csv"][..]),
+            (outputs.plot, "--plot", &["png"][..]),
+        ],
+    )?;
+    out_plan.not_inputs(&[scene.to_path_buf()])?;
     let bar = indicatif::ProgressBar::new(plan.samples as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -58,27 +63,36 @@ pub fn study(
         }
     }
     let stats = study.statistics_csv();
-    report(&study.statistics_table(), || study_json(&study))?;
+    report_unless_stdout(&out_plan, &study.statistics_table(), || study_json(&study))?;
     let keys = study.keys();
-    if let Some(p) = outputs.csv {
-        let table = shpb_study::sweep::summary_csv_keys(&keys, &study.rows);
-        shpb_output::io::write_text_atomically(p, force, &table)?;
-        wrote(p);
-    }
-    if let Some(p) = outputs.summary {
-        shpb_output::io::write_text_atomically(p, force, &stats)?;
-        wrote(p);
-    }
-    if let Some(p) = outputs.output {
-        let scene_text = std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?;
-        shpb_study::file::write_sweep_hdf5(p, force, &scene_text, &spec, None, &keys, &study.rows)?;
-        wrote(p);
-    }
-    if let Some(p) = outputs.plot {
-        band_plot(p, force, &study.traces)?;
-        wrote(p);
-    }
-    Ok(())
+    let scene_text = match outputs.output {
+        Some(_) => std::fs::read_to_string(scene).map_err(|e| Error::io(scene, e))?,
+        None => String::new(),
+    };
+    write_all(&out_plan, || {
+        if let Some(p) = outputs.csv {
+            let table = shpb_study::sweep::summary_csv_keys(&keys, &study.rows);
+            shpb_output::io::write_text_atomically(p, force, &table)?;
+        }
+        if let Some(p) = outputs.summary {
+            shpb_output::io::write_text_atomically(p, force, &stats)?;
+        }
+        if let Some(p) = outputs.output {
+            shpb_study::file::write_sweep_hdf5(
+                p,
+                force,
+                &scene_text,
+                &spec,
+                None,
+                &keys,
+                &study.rows,
+            )?;
+        }
+        if let Some(p) = outputs.plot {
+            band_plot(p, force, &study.traces)?;
+        }
+        Ok(())
+    })
 }
 
 /// The band figure: the contact force on loading against approach, the reduced back force and

@@ -1,7 +1,8 @@
 //! `shpb sweep`: a scene over the Cartesian product of swept parameters.
 
-use super::common::{finite, report, write_study};
+use super::common::{finite, plan, report_unless_stdout, write_all, write_study};
 use shpb_input::{Error, Result};
+use shpb_output::atomic::is_stdout;
 use shpb_output::io::check_output;
 use shpb_study::identity::Stamp;
 use shpb_study::sweep::{Axis, Limits, Point, RunSummary};
@@ -27,11 +28,16 @@ pub fn sweep(
         run_points, shard_points,
     };
     let outputs = [output, csv, plot];
-    if !resume {
-        for p in outputs.into_iter().flatten() {
-            check_output(p, force)?;
-        }
-    }
+    // A resumed sweep owns the outputs it left; the other checks hold for it too.
+    let out_plan = plan(
+        force || resume,
+        &[
+            (output, "--output", &["h5", "hdf5"][..]),
+            (csv, "--csv", &["csv"][..]),
+            (plot, "--plot", &["png"][..]),
+        ],
+    )?;
+    out_plan.not_inputs(&[scene.to_path_buf()])?;
     shpb_study::sweep::require_scene(scene)?;
     let axes = parse_axes(set)?;
     if plot.is_some() && axes.len() > 2 {
@@ -46,7 +52,27 @@ pub fn sweep(
         Some(s) => parse_shard(s)?,
         None => (1, 1),
     };
-    let anchor = output.or(csv);
+    // The file the checkpoint sits beside (not standard output).
+    let anchor = output
+        .filter(|p| !is_stdout(p))
+        .or(csv.filter(|p| !is_stdout(p)));
+    // The checkpoint beside the anchor is not also an output (it is removed when the sweep ends).
+    if let Some(a) = anchor {
+        let checkpoint = checkpoint_path(a);
+        for (p, flag) in [(output, "--output"), (csv, "--csv"), (plot, "--plot")] {
+            if p.is_some_and(|p| shpb_output::plan::same_file(p, &checkpoint)) {
+                return Err(Error::Input {
+                    file: "command line".into(),
+                    key: flag.into(),
+                    problem: format!(
+                        "{} is the checkpoint of this sweep, removed when it ends",
+                        checkpoint.display()
+                    ),
+                    allowed: "an output name that is not OUTPUT.partial.csv".into(),
+                });
+            }
+        }
+    }
     if resume && anchor.is_none() {
         return Err(Error::Input {
             file: "command line".into(),
@@ -71,6 +97,7 @@ pub fn sweep(
     let total = plan.runs_total.expect("checked") as u64;
     let points = shard_points(&axes, k, n);
     let files = check_points(scene, &axes, &points)?;
+    out_plan.not_inputs(&files.iter().map(|f| f.path.clone()).collect::<Vec<_>>())?;
     let stamp = Stamp::new(
         scene,
         &files,
@@ -96,7 +123,7 @@ pub fn sweep(
     {
         let rows = finished_rows(output, csv, &stamp, &axes, &points)?;
         let table = shpb_study::sweep::summary_csv_keys(&keys, &rows);
-        report(&table, || sweep_json(&keys, &rows))?;
+        report_unless_stdout(&out_plan, &table, || sweep_json(&keys, &rows))?;
         eprintln!(
             "shpb: the sweep is complete: {} holds all its {} runs; nothing to run (--force \
              runs it again and replaces the outputs)",
@@ -107,21 +134,30 @@ pub fn sweep(
         fn missing(p: Option<&Path>) -> Option<&Path> {
             p.filter(|p| !p.exists())
         }
-        write_study(
-            &scene_text,
-            &spec,
-            Some(&stamp.identity),
-            &keys,
-            &rows,
-            &table,
-            (missing(output), missing(csv)),
+        let missing_plan = super::common::plan(
             false,
+            &[
+                (missing(output), "--output", &[]),
+                (missing(csv), "--csv", &[]),
+                (missing(plot), "--plot", &[]),
+            ],
         )?;
-        if let Some(p) = missing(plot) {
-            sweep_plot(p, false, &axes, &rows)?;
-            super::common::wrote(p);
-        }
-        return Ok(());
+        return write_all(&missing_plan, || {
+            write_study(
+                &scene_text,
+                &spec,
+                Some(&stamp.identity),
+                &keys,
+                &rows,
+                &table,
+                (missing(output), missing(csv)),
+                false,
+            )?;
+            if let Some(p) = missing(plot) {
+                sweep_plot(p, false, &axes, &rows)?;
+            }
+            Ok(())
+        });
     }
 
     let checkpoint = match anchor {
@@ -208,23 +244,25 @@ pub fn sweep(
     rows.extend(new_rows);
     rows.sort_by_key(|r| r.index);
     let table = shpb_study::sweep::summary_csv_keys(&keys, &rows);
-    report(&table, || sweep_json(&keys, &rows))?;
+    report_unless_stdout(&out_plan, &table, || sweep_json(&keys, &rows))?;
     // The outputs were checked before the runs; a resumed sweep owns the ones it left.
     let replace = force || took_over;
-    write_study(
-        &scene_text,
-        &spec,
-        Some(&stamp.identity),
-        &keys,
-        &rows,
-        &table,
-        (output, csv),
-        replace,
-    )?;
-    if let Some(p) = plot {
-        sweep_plot(p, replace || resume, &axes, &rows)?;
-        super::common::wrote(p);
-    }
+    write_all(&out_plan, || {
+        write_study(
+            &scene_text,
+            &spec,
+            Some(&stamp.identity),
+            &keys,
+            &rows,
+            &table,
+            (output, csv),
+            replace,
+        )?;
+        if let Some(p) = plot {
+            sweep_plot(p, replace || resume, &axes, &rows)?;
+        }
+        Ok(())
+    })?;
     if let Some(c) = checkpoint {
         c.finish()?;
     }
