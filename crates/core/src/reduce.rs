@@ -27,6 +27,7 @@ pub mod align;
 pub mod baseline;
 pub mod correction;
 pub mod options;
+pub mod plausibility;
 pub mod quality;
 pub mod specimen;
 pub mod waves;

@@ -24,10 +24,43 @@ pub fn read_text(path: &Path) -> Result<String> {
     }
     let text = String::from_utf8(bytes)
         .map_err(|e| not_text(e.utf8_error().valid_up_to(), "invalid UTF-8"))?;
-    Ok(match text.strip_prefix('\u{feff}') {
+    Ok(normalise_line_ends(match text.strip_prefix('\u{feff}') {
         Some(rest) => rest.to_string(),
         None => text,
-    })
+    }))
+}
+
+/// The text with every line end written `\n`: CRLF (Windows) and a lone CR (classic Mac OS,
+/// some oscilloscopes) alike, so a file with CR-only line ends is read line by line rather than
+/// as one long header line.
+pub fn normalise_line_ends(text: String) -> String {
+    if !text.contains('\r') {
+        return text;
+    }
+    text.replace("\r\n", "\n").replace('\r', "\n")
+}
+
+/// The delimiter a header line seems to use when it is not shpb's comma: `;` or a tab, whichever
+/// appears more often than commas; None for a comma-separated (or one-column) header.
+pub fn foreign_delimiter(header: &str) -> Option<(char, &'static str)> {
+    let commas = header.matches(',').count();
+    [(';', "semicolons (`;`)"), ('\t', "tabs")]
+        .into_iter()
+        .map(|(c, name)| (header.matches(c).count(), c, name))
+        .filter(|&(n, _, _)| n > commas)
+        .max_by_key(|&(n, _, _)| n)
+        .map(|(_, c, name)| (c, name))
+}
+
+/// Whether the cells of a row, taken two by two, read as numbers written with a decimal comma
+/// (`0,5,12,25` as `0,5` and `12,25`): the sign of a CSV written in a decimal-comma locale.
+fn looks_decimal_comma(row: &str, header_columns: usize) -> bool {
+    let cells: Vec<&str> = row.split(',').map(str::trim).collect();
+    cells.len() == 2 * header_columns
+        && cells.chunks(2).all(|c| {
+            c[1].chars().next().is_some_and(|ch| ch.is_ascii_digit())
+                && f64::from_str(&format!("{}.{}", c[0], c[1])).is_ok()
+        })
 }
 
 /// The sign convention of a force or approach column ([`CsvTable::compression_column`]).
@@ -72,6 +105,13 @@ impl CsvTable {
     /// the source in errors.
     pub fn parse(text: &str, file: &str) -> Result<CsvTable> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let normalised;
+        let text = if text.contains('\r') {
+            normalised = normalise_line_ends(text.to_string());
+            normalised.as_str()
+        } else {
+            text
+        };
         let input = |line: usize, key: &str, problem: String, allowed: &str| Error::Input {
             file: format!("{file}:{line}"),
             key: key.to_string(),
@@ -91,6 +131,16 @@ impl CsvTable {
                 "a header line naming the columns, then numeric rows",
             )
         })?;
+        if let Some((_, name)) = foreign_delimiter(header) {
+            return Err(input(
+                hline,
+                "header",
+                format!("`{header}` is separated by {name}, not commas"),
+                "comma-separated columns with decimal points (`time_s,force_N` then rows such as \
+                 `1.5e-6,120.5`): save the file as CSV with `,` between columns and `.` as the \
+                 decimal mark",
+            ));
+        }
         let names: Vec<String> = header.split(',').map(|s| s.trim().to_string()).collect();
         if names.iter().any(|n| n.is_empty()) {
             return Err(input(
@@ -106,11 +156,23 @@ impl CsvTable {
             // parsed straight from the row, without collecting them.
             let count = row.bytes().filter(|&b| b == b',').count() + 1;
             if count != names.len() {
+                let problem = if looks_decimal_comma(row, names.len()) {
+                    format!(
+                        "`{row}` is written with decimal commas ({count} comma-separated cells \
+                         where the header has {} columns)",
+                        names.len()
+                    )
+                } else if let Some((_, name)) = foreign_delimiter(row) {
+                    format!("`{row}` is separated by {name}, not commas")
+                } else {
+                    format!("{count} values where the header has {}", names.len())
+                };
                 return Err(input(
                     line,
                     "row",
-                    format!("{count} values where the header has {}", names.len()),
-                    "one value per header column",
+                    problem,
+                    "one value per header column, comma-separated, with decimal points \
+                     (`1.5e-6,120.5`)",
                 ));
             }
             let mut rest = row;
@@ -264,11 +326,86 @@ impl CsvTable {
         }
         Ok(t)
     }
+
+    /// Refuses a time column `t` (of column `name`) spanning more than [`MAX_RECORD_SPAN_S`]:
+    /// an impact lasts microseconds to milliseconds, so such times are µs or ms under a seconds
+    /// header, not a record to run for hours (which would be refused later as a bad
+    /// `end_time_s` the scene does not have).
+    pub fn check_time_span(&self, name: &str, t: &[f64]) -> Result<()> {
+        let (Some(first), Some(last)) = (t.first(), t.last()) else {
+            return Ok(());
+        };
+        let span = last - first;
+        if span > MAX_RECORD_SPAN_S {
+            return Err(Error::Input {
+                file: self.file.clone(),
+                key: name.to_string(),
+                problem: format!(
+                    "the times span {}, from {first:e} to {last:e}: a record of an impact lasts \
+                     microseconds to milliseconds, so these look like µs or ms written under a \
+                     seconds header",
+                    shpb_core::error::format_si(span, "s"),
+                ),
+                allowed: format!(
+                    "times in seconds (1.5e-6 for 1.5 µs) spanning at most {MAX_RECORD_SPAN_S} s"
+                ),
+            });
+        }
+        Ok(())
+    }
 }
+
+/// The longest time a record of one test may span, s: an SHPB or impact test is over within
+/// milliseconds (the authors' records span 1 ms), and a scene's `end_time_s` is at most 1 s.
+pub const MAX_RECORD_SPAN_S: f64 = 1.0;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cr_only_line_ends_read_like_lf() {
+        let lf = CsvTable::parse("time_s,force_N\n0,1\n1e-6,2.5\n", "lf.csv").unwrap();
+        let cr = CsvTable::parse("time_s,force_N\r0,1\r1e-6,2.5\r", "cr.csv").unwrap();
+        assert_eq!(lf.columns, cr.columns);
+        assert_eq!(normalise_line_ends("a\r\nb\rc\n".into()), "a\nb\nc\n");
+    }
+
+    #[test]
+    fn semicolons_and_decimal_commas_are_named_not_counted() {
+        let e = CsvTable::parse("time_s;force_N\n0;1\n", "s.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("separated by semicolons"), "{e}");
+        let e = CsvTable::parse("time_s\tforce_N\n0\t1\n", "t.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("separated by tabs"), "{e}");
+        let e = CsvTable::parse("time_s,force_N\n0,5,12,25\n", "d.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("decimal commas"), "{e}");
+        // A row that is merely short is still counted.
+        let e = CsvTable::parse("time_s,force_N\n0\n", "c.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("1 values where the header has 2"), "{e}");
+    }
+
+    #[test]
+    fn times_spanning_more_than_a_second_are_named_as_other_units() {
+        let t = CsvTable::parse("time_s,force_N\n0,1\n150,2\n", "us.csv").unwrap();
+        let e = t
+            .check_time_span("time_s", t.column("time_s").unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("µs or ms written under a seconds header"), "{e}");
+        let t = CsvTable::parse("time_s,force_N\n0,1\n1.5e-4,2\n", "s.csv").unwrap();
+        assert!(
+            t.check_time_span("time_s", t.column("time_s").unwrap())
+                .is_ok()
+        );
+    }
 
     fn temp(name: &str, bytes: &[u8]) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("shpb-csv-{}", std::process::id()));

@@ -550,6 +550,7 @@ impl ApparatusFile for Apparatus {
             gauges: gauge_setup,
             uncertainty: None,
         };
+        check_gauges_on_bars(&apparatus, raw.gauges.as_deref(), &v)?;
         if let Some(u) = &raw.uncertainty {
             let read = crate::uncertainty::read(u, text, &apparatus.source, &apparatus, &|t| {
                 Apparatus::from_toml(t, &apparatus.source, gauges)
@@ -558,6 +559,41 @@ impl ApparatusFile for Apparatus {
         }
         Ok(apparatus)
     }
+}
+
+/// Refuses a gauge placed beyond its bar's far end (`distance_from_specimen_m` longer than the
+/// bar): it would record nothing of the test, or the far end's reflections, and its delays
+/// would place every window wrong. `gauges` is the set-up's gauge file (None: inline channels).
+fn check_gauges_on_bars(a: &Apparatus, gauges: Option<&str>, v: &Validator) -> Result<()> {
+    for (i, ch) in a.gauges.channels.iter().enumerate() {
+        let length_m = match ch.bar.as_str() {
+            "incident" => a.incident.length_m,
+            "transmission" => a.transmission.length_m,
+            _ => continue,
+        };
+        if ch.distance_from_specimen_m > length_m {
+            let key = format!("channel[{i}].distance_from_specimen_m");
+            return Err(v.error(
+                &match gauges {
+                    Some(g) => format!("gauges` ({g}): `{key}"),
+                    None => key,
+                },
+                format!(
+                    "the `{}` gauge sits {} from the specimen, beyond the end of the {} bar, \
+                     which is {} long",
+                    ch.name,
+                    shpb_core::error::format_si(ch.distance_from_specimen_m, "m"),
+                    ch.bar,
+                    shpb_core::error::format_si(length_m, "m")
+                ),
+                format!(
+                    "a gauge on its bar: 0 to {} from the specimen face",
+                    shpb_core::error::format_si(length_m, "m")
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A scene's shaper override table (same keys as the set-up file's `[shaper]`, all optional).

@@ -60,7 +60,7 @@ pub fn decode_text(bytes: &[u8], encoding: Option<TextEncoding>, file: &str) -> 
     };
     decoder
         .decode_without_bom_handling_and_without_replacement(bytes)
-        .map(|t| t.into_owned())
+        .map(|t| crate::csv::normalise_line_ends(t.into_owned()))
         .ok_or_else(|| Error::Parse {
             file: file.to_string(),
             message: format!(
@@ -136,8 +136,9 @@ fn name_and_unit(header: &str) -> (String, String) {
 /// The channel unit a header's unit names (module docs), if any.
 fn channel_unit(unit: &str) -> Option<ChannelUnit> {
     match unit {
-        "V" | "v" | "volt" | "volts" | "voltage" | "Voltage" => Some(ChannelUnit::Volt),
-        "mV" | "mv" => Some(ChannelUnit::Millivolt),
+        // SI symbols case-exact (`mv`, `v` are refused: not symbols), or the words.
+        "V" | "volt" | "volts" | "voltage" | "Voltage" => Some(ChannelUnit::Volt),
+        "mV" => Some(ChannelUnit::Millivolt),
         "ε" | "strain" | "Strain" => Some(ChannelUnit::Strain),
         "με" | "µε" | "ue" | "uε" | "microstrain" | "Microstrain" => {
             Some(ChannelUnit::Microstrain)
@@ -316,13 +317,59 @@ pub fn read_record(path: &Path, layout: Option<&RecordLayout>) -> Result<LayoutR
         Delimiter::Semicolon => header_line.split(';').map(str::to_string).collect(),
         _ => header_line.split(',').map(str::to_string).collect(),
     };
+    let decimal = sniff_decimal(&text, header_row, delimiter);
     let authors = ["time_s", "incident_V", "transmission_V"];
-    if authors.iter().all(|a| names.iter().any(|n| n.trim() == *a)) {
-        return Ok(LayoutRecord::Voltages(shpb_core::gauge::RawRecord::parse(
-            &text, &file,
-        )?));
+    let column = |a: &str| names.iter().position(|n| n.trim() == a);
+    if let [Some(t), Some(i), Some(tr)] = authors.map(column) {
+        if delimiter == Delimiter::Comma {
+            return Ok(LayoutRecord::Voltages(shpb_core::gauge::RawRecord::parse(
+                &text, &file,
+            )?));
+        }
+        // The authors' columns written in a semicolon or tab locale: read as such, not refused
+        // for a column count.
+        let channel = |column| ChannelLayout {
+            column,
+            unit: ChannelUnit::Volt,
+            polarity: 1.0,
+        };
+        return RecordLayout {
+            source: format!("columns of {file} by their headers"),
+            delimiter,
+            decimal,
+            skip_lines: header_row + 1,
+            time: TimeSource::Column {
+                column: t,
+                factor: 1.0,
+            },
+            incident: channel(i),
+            transmission: channel(tr),
+            sheet: None,
+            encoding: None,
+        }
+        .parse(&text, &file);
     }
-    auto_layout(&names, header_row, delimiter, &file)?.parse(&text, &file)
+    let mut layout = auto_layout(&names, header_row, delimiter, &file)?;
+    layout.decimal = decimal;
+    layout.parse(&text, &file)
+}
+
+/// The decimal mark of a text record whose columns are separated by `delimiter`: `,` when the
+/// columns are not comma-separated and the first data line after the header row writes its
+/// numbers with commas (`-9,99e-05;0,00011`), else `.`.
+fn sniff_decimal(text: &str, header_row: usize, delimiter: Delimiter) -> char {
+    if delimiter == Delimiter::Comma {
+        return '.';
+    }
+    let first = text
+        .lines()
+        .skip(header_row + 1)
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'));
+    match first {
+        Some(l) if l.contains(',') && !l.contains('.') => ',',
+        _ => '.',
+    }
 }
 
 #[cfg(test)]

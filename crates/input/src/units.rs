@@ -19,14 +19,31 @@ pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
         .trim()
         .parse()
         .map_err(|_| format!("`{text}` is not a number with a unit"))?;
-    let scale = match unit.trim().to_ascii_lowercase().as_str() {
+    // Case-exact SI symbols: `mPa` is the millipascal, not the megapascal `MPa`, so a unit in
+    // any other case is refused rather than guessed.
+    let scale = match unit.trim() {
         "psi" => PSI_PA,
-        "pa" => 1.0,
-        "kpa" => 1e3,
-        "mpa" => 1e6,
+        "Pa" => 1.0,
+        "kPa" => 1e3,
+        "MPa" => 1e6,
         "bar" => 1e5,
         "" => return Err(format!("`{text}` has no unit")),
-        u => return Err(format!("unknown pressure unit `{u}`")),
+        u => {
+            let hint = match u.to_ascii_lowercase().as_str() {
+                "mpa" if u == "mPa" => {
+                    " (`mPa` is the millipascal; the megapascal is `MPa`, case matters)".to_string()
+                }
+                l @ ("psi" | "pa" | "kpa" | "mpa" | "bar") => {
+                    let exact = ["psi", "Pa", "kPa", "MPa", "bar"]
+                        .into_iter()
+                        .find(|e| e.to_ascii_lowercase() == l)
+                        .unwrap_or("");
+                    format!(" (units are case-sensitive: did you mean `{exact}`?)")
+                }
+                _ => String::new(),
+            };
+            return Err(format!("unknown pressure unit `{u}`{hint}"));
+        }
     };
     let p = value * scale;
     if !p.is_finite() {
@@ -36,8 +53,8 @@ pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
 }
 
 /// Allowed pressure syntax, for error messages.
-pub const PRESSURE_SYNTAX: &str =
-    "a number with a unit: psi, Pa, kPa, MPa or bar (gauge), e.g. 10psi or 68.9kPa";
+pub const PRESSURE_SYNTAX: &str = "a number with a unit: psi, Pa, kPa, MPa or bar (gauge), \
+    written case-exact (mPa is the millipascal), e.g. 10psi or 68.9kPa";
 
 /// Validates a pressure given as text (`10psi`) for key `key`.
 pub fn pressure_from_text(text: &str, v: &Validator, key: &str) -> Result<f64> {
@@ -71,4 +88,25 @@ pub fn number_and_unit(text: &str) -> Option<(f64, String)> {
     }
     let value: f64 = num.parse().ok()?;
     Some((value, unit.trim().to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_are_case_exact_si() {
+        assert_eq!(parse_pressure("0.1MPa"), Ok(1e5));
+        assert_eq!(parse_pressure("68.9kPa"), Ok(68.9e3));
+        assert_eq!(parse_pressure("1e5Pa"), Ok(1e5));
+        assert_eq!(parse_pressure("10psi"), Ok(10.0 * PSI_PA));
+        assert_eq!(parse_pressure("1bar"), Ok(1e5));
+        // The millipascal is not the megapascal: refused, naming both.
+        let e = parse_pressure("0.1mPa").unwrap_err();
+        assert!(e.contains("millipascal") && e.contains("`MPa`"), "{e}");
+        for wrong in ["0.1mpa", "0.1MPA", "10PSI", "68.9KPA", "1Bar", "5pa"] {
+            let e = parse_pressure(wrong).unwrap_err();
+            assert!(e.contains("case"), "{wrong}: {e}");
+        }
+    }
 }

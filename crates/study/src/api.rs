@@ -619,13 +619,18 @@ pub fn reduce_record_with(
             options.baseline_samples,
         )?,
     };
-    let reduction = shpb_core::reduce::reduce_named(
-        &input,
-        &ReductionSetup::from_apparatus(&apparatus)?,
-        &options,
-        &record.display().to_string(),
+    let setup = ReductionSetup::from_apparatus(&apparatus)?;
+    let name = record.display().to_string();
+    // The record checked for plausibility before it is reduced, and what the reduction made of
+    // it against the specimen (shpb_core::reduce::plausibility).
+    shpb_core::reduce::plausibility::check_input(&input, &setup, &options, &name)?;
+    let reduction = shpb_core::reduce::reduce_named(&input, &setup, &options, &name)?;
+    shpb_core::reduce::plausibility::check_reduction(
+        &reduction,
+        shpb_core::reduce::plausibility::SpecimenSize::of(&specimen),
+        &name,
     )?;
-    let cylinder = specimen.reduce(&reduction, &ReductionSetup::from_apparatus(&apparatus)?)?;
+    let cylinder = specimen.reduce(&reduction, &setup)?;
     Ok(Reduced {
         reduction,
         apparatus,

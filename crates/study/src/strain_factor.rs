@@ -87,6 +87,36 @@ pub fn strain_factor(volts: &Path, strains: &Path) -> Result<StrainFactor> {
             "the shot's record in strain or microstrain second",
         ));
     };
+    // Both records checked for plausibility (a clipped or dead channel would bias the fit, a
+    // strain record in µε under a strain header would scale it by 10⁶).
+    {
+        use shpb_core::reduce::plausibility::{Channel, check_channels};
+        let baseline_samples = shpb_core::reduce::ReductionOptions::default().baseline_samples;
+        let channel = |name, time_s, strain, volts| Channel {
+            name,
+            time_s,
+            strain,
+            volts,
+            youngs_modulus_pa: None,
+            baseline_samples,
+            smoothing_window_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+            pulse_due_s: None,
+        };
+        check_channels(
+            &[
+                channel("incident", &v.time_s, &v.incident_v, true),
+                channel("transmission", &v.time_s, &v.transmission_v, true),
+            ],
+            &volts.display().to_string(),
+        )?;
+        check_channels(
+            &[
+                channel("incident", &e.time_s, &e.incident_strain, false),
+                channel("transmission", &e.time_s, &e.transmission_strain, false),
+            ],
+            &strains.display().to_string(),
+        )?;
+    }
     let n = v.time_s.len();
     let step = (v.time_s[n - 1] - v.time_s[0]) / (n - 1) as f64;
     if e.time_s.len() != n

@@ -30,6 +30,7 @@ pub fn incident(
     };
     let table = shpb_input::csv::CsvTable::read(record)?;
     let time = table.time_column("time_s")?;
+    table.check_time_span("time_s", time)?;
     // Compression positive, or refused naming the file and column (a record with compression
     // negative would otherwise imply a plausible-looking pulse of the wrong sign).
     let compression = |name: &str| {

@@ -79,6 +79,22 @@ pub fn strain(
             voltage_v: volts.clone(),
         });
     }
+    // The converted record checked for plausibility as `shpb reduce` checks it (dead, clipped,
+    // beyond the bars' elastic limit, inverted), before anything is written.
+    let input = shpb_core::reduce::ReductionInput {
+        time_s: rec.time_s.clone(),
+        incident_strain: gauges[0].strain.clone(),
+        transmission_strain: gauges[1].strain.clone(),
+    };
+    shpb_core::reduce::plausibility::check_input(
+        &input,
+        &shpb_core::reduce::ReductionSetup::from_apparatus(&apparatus)?,
+        &shpb_core::reduce::ReductionOptions {
+            baseline_samples: n,
+            ..Default::default()
+        },
+        &record.display().to_string(),
+    )?;
     let out = RunOutput {
         contact: None,
         time_s: Some(rec.time_s.clone()),

@@ -105,7 +105,7 @@ fn first_pulse(eps: &[f64], baseline: usize) -> Option<(usize, f64)> {
 
 /// Refuses a channel whose first pulse is tensile: its polarity is inverted (docs/physics.md §7.3,
 /// "Polarity"). `channel` is `incident` or `transmission`.
-fn check_polarity(
+pub(crate) fn check_polarity(
     eps: &[f64],
     baseline: usize,
     time_s: &[f64],

@@ -217,6 +217,45 @@ pub(crate) fn place(
     let samples = (duration_s / dt * (1.0 + 1e-12)).floor() as usize + 1;
     let s_r = s_i + reflected_delay_s / dt;
     let s_t = s_i + transmitted_delay_s / dt;
+    // The record's end cut the window short: refused as truncated when a pulse is still on at
+    // the end (docs/physics.md §7.10), not reduced over the part of it the record holds.
+    let clean_s = longest_clean.min(reflected_delay_s);
+    if ov.duration_s.is_none() && duration_s < clean_s - dt && duration_s > 0.0 {
+        let tail = ((1e-6 / dt).round() as usize).clamp(1, n);
+        let at_end = |e: &[f64]| e[n - tail..].iter().sum::<f64>() / tail as f64;
+        let transmitted_peak = eps_t.iter().fold(0.0f64, |m, e| m.max(-e));
+        for (channel, pulse, end, peak) in [
+            ("incident", "reflected", at_end(eps_i), incident_peak),
+            (
+                "transmission",
+                "transmitted",
+                at_end(eps_t),
+                transmitted_peak,
+            ),
+        ] {
+            if peak > 0.0 && end.abs() > 0.1 * peak {
+                return Err(input_err(
+                    file,
+                    "time_s",
+                    format!(
+                        "the record is truncated: it ends at {:.1} µs while the {pulse} pulse is \
+                         still on ({channel} strain {:.0} % of its pulse's peak over the last \
+                         µs), so its window would hold {:.1} µs of the {:.1} µs the bars give",
+                        record_end * 1e6,
+                        100.0 * end.abs() / peak,
+                        duration_s * 1e6,
+                        clean_s * 1e6
+                    ),
+                    format!(
+                        "a record that lasts until the pulses are over (here until at least \
+                         {:.1} µs), or --duration to reduce a shorter window on purpose",
+                        (incident_start_s + reflected_delay_s.max(transmitted_delay_s) + clean_s)
+                            * 1e6
+                    ),
+                ));
+            }
+        }
+    }
     let last = (n - 1) as f64 + 1e-6;
     if samples < 8
         || s_i < -1e-6
@@ -235,7 +274,18 @@ pub(crate) fn place(
                 (incident_start_s + reflected_delay_s) * 1e6,
                 (incident_start_s + transmitted_delay_s) * 1e6,
                 duration_s.max(0.0) * 1e6
-            ),
+            ) + &if record_end < incident_start_s + reflected_delay_s.max(transmitted_delay_s) {
+                format!(
+                    " (the record is truncated: it ends before the {} pulse arrives)",
+                    if reflected_delay_s >= transmitted_delay_s {
+                        "reflected"
+                    } else {
+                        "transmitted"
+                    }
+                )
+            } else {
+                String::new()
+            },
             "a record long enough for the incident, reflected and transmitted windows (at least 8 samples each)",
         ));
     }

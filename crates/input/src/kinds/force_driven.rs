@@ -193,6 +193,8 @@ fn parse(
         }
         None => last,
     };
+    // Times in µs under `time_s` are named as such, not as an end time the scene never gave.
+    table.check_time_span(&f.time_column, &drive.time_s)?;
     if end / dt > 5e8 {
         return Err(v.error(
             "end_time_s",

@@ -523,6 +523,21 @@ fn incident_drive(
     let input = record
         .into_strains(apparatus, baseline)
         .map_err(rv.core("file"))?;
+    // The incident channel checked for plausibility as `shpb reduce` checks it (dead, clipped,
+    // beyond the bar's elastic limit, inverted), before it drives anything.
+    shpb_core::reduce::plausibility::check_channels(
+        &[shpb_core::reduce::plausibility::Channel {
+            name: "incident",
+            time_s: &input.time_s,
+            strain: &input.incident_strain,
+            volts: false,
+            youngs_modulus_pa: Some(apparatus.material.youngs_modulus_pa),
+            baseline_samples: baseline,
+            smoothing_window_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+            pulse_due_s: None,
+        }],
+        &path.display().to_string(),
+    )?;
     shpb_core::apparatus::IncidentDrive::from_incident_gauge(
         &input.time_s,
         &input.incident_strain,

@@ -138,6 +138,8 @@ impl Data {
                 options.baseline_samples,
             )?;
             let name = s.file.display().to_string();
+            // Each shot's record checked for plausibility, as `shpb reduce` checks it.
+            shpb_core::reduce::plausibility::check_input(&input, &setup, &options, &name)?;
             let arrivals = shpb_core::reduce::measured_arrivals(&input, &setup, &options, &name)?;
             shots.push(ShotData {
                 shot: s.clone(),
