@@ -31,6 +31,7 @@ pub fn study(
     outputs: StudyOutputs,
     force: bool,
 ) -> Result<()> {
+    shpb_study::sweep::check_jobs(jobs)?;
     let paths = [outputs.output, outputs.csv, outputs.summary, outputs.plot];
     for p in paths.into_iter().flatten() {
         check_output(p, force)?;

@@ -26,6 +26,7 @@ pub fn sweep(
         Checkpoint, Outputs, check_points, checkpoint_path, estimate, parse_axes, parse_shard,
         run_points, shard_points,
     };
+    shpb_study::sweep::check_jobs(jobs)?;
     let outputs = [output, csv, plot];
     if !resume {
         for p in outputs.into_iter().flatten() {
