@@ -26,7 +26,7 @@ CHILD = textwrap.dedent(
     print("started", flush=True)
     try:
         if what == "sweep":
-            shpb.sweep({scene!r}, set={{"pressure": "6psi:14psi:40", "fidelity": ["fast"]}})
+            shpb.sweep({scene!r}, set={{"pressure": "8psi:14psi:40", "fidelity": ["fast"]}})
         else:
             shpb.study({scene!r}, samples=40, fidelity="fast")
         print("finished without interruption", flush=True)

@@ -307,3 +307,25 @@ fn too_many_jobs_are_refused_naming_the_limit() {
     );
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
 }
+
+/// `curve --specimen` takes a material file, as its help says (the paper's 6.35 mm pair of it,
+/// as for a built-in name): `specimens/ss440c.toml` is the built-in ss440c, so the curves are the
+/// same text. It was refused with a TOML error about a pair file.
+#[test]
+fn curve_takes_a_material_file() {
+    let dir = TempDir::new().unwrap();
+    let file = repo().join("specimens/ss440c.toml").display().to_string();
+    let from_file = shpb(dir.path(), &["curve", "--specimen", &file, "--points", "5"]);
+    assert_eq!(from_file.status.code(), Some(0), "{}", stderr(&from_file));
+    let builtin = shpb(
+        dir.path(),
+        &["curve", "--specimen", "ss440c", "--points", "5"],
+    );
+    assert_eq!(stdout(&from_file), stdout(&builtin));
+    let pair = repo()
+        .join("specimens/pair-6.35mm-ss440c.toml")
+        .display()
+        .to_string();
+    let from_pair = shpb(dir.path(), &["curve", "--specimen", &pair, "--points", "5"]);
+    assert_eq!(stdout(&from_pair), stdout(&builtin));
+}

@@ -194,9 +194,11 @@ mod tests {
         let e = Params::from_toml(text, "c.toml", Path::new(".")).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         let msg = e.to_string();
+        // 3 Hertz contact times (14.03 µs at 5 m/s for the paper's pair) of 1 fs steps
+        // (estimate::COLLISION_ESTIMATE_CONTACT_TIMES).
         assert!(
             msg.starts_with(
-                "c.toml: the run cannot finish on this machine: it needs 1.4e12 time steps"
+                "c.toml: the run cannot finish on this machine: it needs 4.21e10 time steps"
             ),
             "{msg}"
         );

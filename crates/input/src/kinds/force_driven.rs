@@ -155,7 +155,10 @@ fn parse(
     };
     // Issue 42: the drive starts at t = 0, so rows before it were dropped without a word, and
     // a force that is zero throughout ran to an all-zero summary.
-    if let Some(row) = t.iter().position(|&x| x < 0.0) {
+    // (A record that ends at or before 0 is refused below, naming its end.)
+    if let Some(row) = t.iter().position(|&x| x < 0.0)
+        && t.last().is_some_and(|&last| last > 0.0)
+    {
         return Err(Error::Input {
             file: csv_path.display().to_string(),
             key: f.time_column.clone(),
