@@ -678,12 +678,44 @@ pub struct SetupNewArgs {
 pub fn main() -> i32 {
     // First, before any thread starts: SIGINT/SIGTERM remove temporary files and say what stopped.
     crate::interrupt::install();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(&e),
+    };
     match dispatch(cli) {
         Ok(()) => 0,
         Err(e) => {
             eprintln!("shpb: error: {e}");
             e.exit_code()
+        }
+    }
+}
+
+/// Prints a command-line parse error as every other error (`shpb: error: ` first, clap's usage
+/// and tip lines after it) and returns its exit code (2); `--help` and `--version` print to
+/// stdout with exit code 0, and a missing subcommand prints the help to stderr, then the error.
+fn usage_error(e: &clap::Error) -> i32 {
+    use clap::error::ErrorKind;
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            0
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            eprint!("{}", e.render());
+            eprintln!(
+                "shpb: error: no subcommand given; allowed: one of the commands listed above"
+            );
+            2
+        }
+        _ => {
+            let text = e.render().to_string();
+            let text = text.strip_prefix("error: ").unwrap_or(&text);
+            eprint!("shpb: error: {text}");
+            if !text.ends_with('\n') {
+                eprintln!();
+            }
+            2
         }
     }
 }
