@@ -518,7 +518,7 @@ def sweep(
         specs.append(f"fidelity={fidelity}")
     path = os.path.abspath(os.fspath(scene))
     if client is None:
-        keys, rows = _sweep_shard(path, specs, int(jobs), 1, 1)
+        keys, rows = _interruptible(_sweep_shard, path, specs, int(jobs), 1, 1)
     else:
         parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
         keys = parts[0][0]
@@ -593,12 +593,25 @@ def study(
     path = os.path.abspath(os.fspath(scene))
     args = (path, int(samples), int(seed), int(jobs), bool(gun_scatter), fidelity)
     if client is None:
-        rows = _study_shard(*args, 1, 1)
+        rows = _interruptible(_study_shard, *args, 1, 1)
     else:
         rows = [r for part in _on_cluster(client, _study_shard, shards, *args) for r in part]
     return Study(
         _shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows, fidelity)
     )
+
+
+def _interruptible(fn: Any, *args: Any) -> Any:
+    """Calls ``fn(*args)``; on Ctrl-C (KeyboardInterrupt, seen within 20 ms while runs go on)
+    the exception is raised again with the runs finished before it as ``e.table``, a
+    :class:`Table` of those rows (in sweep order), and their count as ``e.finished``."""
+    try:
+        return fn(*args)
+    except KeyboardInterrupt as e:
+        raw = getattr(e, "table", None)
+        if isinstance(raw, tuple):
+            e.table = Table(raw)
+        raise
 
 
 def _study_shard(

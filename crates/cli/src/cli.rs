@@ -174,7 +174,7 @@ fn whole_number<T: std::str::FromStr>(
 /// `-j/--jobs`: worker threads of `sweep` and `study` (one definition for both).
 #[derive(Args, Debug, Clone, Copy)]
 pub struct Jobs {
-    /// Worker threads.
+    /// Worker threads: 1 up to 4 per core of the machine (more is refused, exit 2)
     #[arg(
         short = 'j',
         long = "jobs",
@@ -387,7 +387,8 @@ pub enum Command {
     },
     /// Print the loading curve F(δ) of a specimen as CSV on stdout.
     Curve {
-        /// Built-in material (the paper's 6.35 mm pair of it) or a pair .toml file.
+        /// Built-in material or material .toml file (the paper's 6.35 mm pair of it), or a pair
+        /// .toml file ([sphere1] and [sphere2]).
         #[arg(long, default_value = "ss440c")]
         specimen: String,
         /// Global strain rate for Johnson–Cook hardening, 1/s (0: quasi-static).

@@ -110,7 +110,9 @@ fn a_femtosecond_collision_step_is_refused_before_it_allocates() {
         dir.path(),
         &out,
         &[
-            "c.toml: the run cannot finish on this machine: it needs 1.4e12 time steps",
+            // 3 Hertz contact times (14.03 µs at 5 m/s) of 1 fs steps (issue 42: the estimate
+            // took the 100 t_c time limit, 1.4e12 steps).
+            "c.toml: the run cannot finish on this machine: it needs 4.21e10 time steps",
             "TB of memory",
             "limit: 1e10 time steps, 1e12 node updates, ",
             "of memory (",
@@ -125,19 +127,19 @@ fn a_run_larger_than_the_memory_limit_is_refused_with_both_numbers() {
     let dir = TempDir::new().unwrap();
     let scene = repo().join("scenes/collision-ss440c-5ms.toml");
     let scene = scene.to_str().unwrap();
-    // 1 MB: far less than this run's 24 MB.
+    // 100 kB: less than this run's 720 kB (6000 samples of 5 numbers, 3 for growth).
     let out = shpb_env(
         dir.path(),
         &["run", scene, "-o", "out.h5"],
-        &[("SHPB_MEMORY_LIMIT", "1e6")],
+        &[("SHPB_MEMORY_LIMIT", "1e5")],
     );
     assert_refused(
         dir.path(),
         &out,
         &[
-            "the run cannot finish on this machine: it needs 2e5 time steps",
-            "MB of memory",
-            "limit: 1e10 time steps, 1e12 node updates, 1 MB of memory (SHPB_MEMORY_LIMIT in the environment)",
+            "the run cannot finish on this machine: it needs 6001 time steps",
+            "kB of memory",
+            "limit: 1e10 time steps, 1e12 node updates, 100 kB of memory (SHPB_MEMORY_LIMIT in the environment)",
         ],
     );
     // With the machine's memory it runs.
@@ -320,9 +322,11 @@ fn reduce_refuses_a_record_with_inverted_polarity() {
 // Item 10: warnings outside the model's range of validity.
 
 #[test]
-fn a_force_record_times_100_warns_that_the_approach_left_the_model() {
+fn a_force_record_times_10_warns_that_the_approach_left_the_model() {
     let dir = TempDir::new().unwrap();
-    let big = transformed_csv(&fig4_csv(), |r| vec![r[0], r[1], 100.0 * r[2]]);
+    // Ten times the force: 0.63 R of approach (a hundred times overlapped the spheres by 6 R,
+    // which issue 42 refuses: crates/cli/tests/results_trust.rs).
+    let big = transformed_csv(&fig4_csv(), |r| vec![r[0], r[1], 10.0 * r[2]]);
     write(dir.path(), "big.csv", big.as_bytes());
     let scene = force_driven_scene(dir.path(), "big.csv", "");
     let out = shpb(dir.path(), &["run", scene.to_str().unwrap()]);

@@ -5,7 +5,7 @@
 use crate::apparatus::{Apparatus, PulseOptions};
 use crate::bar::Dispersion;
 use crate::contact::{Contact, Degenerate, LawKind, LawSpec, LoadingCurve};
-use crate::error::{Result, format_si};
+use crate::error::{Error, Result, format_si};
 use crate::fidelity::Fidelity;
 use crate::material::JOHNSON_COOK_RATE_LIMIT_PER_S;
 use crate::numeric::resample;
@@ -145,7 +145,55 @@ impl Params {
         let mut out = self.run_kind(progress)?;
         let validity = self.validity_warnings(&out);
         out.warnings.extend(validity);
+        self.refuse_overlap(&out)?;
+        explain_unavailable(&mut out);
         Ok(out)
+    }
+
+    /// Refuses a run whose spheres overlapped by the smaller sphere radius or more (issue 42:
+    /// a 9999 m/s collision reached 27 mm of approach between 6.35 mm spheres): no contact law
+    /// describes such an overlap, so every result of the run would be wrong. The scene readers
+    /// refuse such closing speeds up front where they can (`solver::check_impact_speed`); this
+    /// catches the drives they cannot bound (a force record, a gun, a yielding law that
+    /// approaches further than Hertz).
+    fn refuse_overlap(&self, out: &RunOutput) -> Result<()> {
+        let radius = match &self.specimen {
+            Some(Specimen::Spheres(sp)) => sp
+                .chain
+                .spheres
+                .iter()
+                .map(|s| s.radius_m)
+                .fold(f64::INFINITY, f64::min),
+            _ => return Ok(()),
+        };
+        let series = out
+            .contact
+            .iter()
+            .flat_map(|c| c.displacement_m.iter().copied());
+        let chain = out
+            .chain
+            .iter()
+            .flat_map(|c| c.contact_approach_m.iter().flatten().copied());
+        let approach = series.chain(chain).fold(0.0f64, f64::max);
+        if approach >= radius {
+            return Err(Error::Invalid {
+                object: self.source.clone(),
+                quantity: "sphere approach".into(),
+                problem: format!(
+                    "the run reached {} ({:.2} of the smaller sphere radius {}): spheres \
+                     overlapping by a radius or more are outside every contact law, so no \
+                     result of this run can be right",
+                    format_si(approach, "m"),
+                    approach / radius,
+                    format_si(radius, "m"),
+                ),
+                allowed: "an approach below the smaller sphere radius: a lower drive \
+                          (velocity1_m_s, pressure, striker_velocity_m_s or the force_csv \
+                          record) or larger spheres"
+                    .into(),
+            });
+        }
+        Ok(())
     }
 
     /// Where a run of this scene left the range the model was fitted or calibrated over (each a
@@ -325,8 +373,10 @@ impl Params {
                     p.radius_m,
                     setup.velocity1_m_s - setup.velocity2_m_s,
                 );
+                let mut warnings = Vec::new();
+                let restitution = physical_restitution(r.restitution, "", &mut warnings);
                 let summary = vec![
-                    item("restitution", r.restitution, "1"),
+                    item("restitution", restitution, "1"),
                     item("contact_time", r.contact_time_s, "s"),
                     item("hertz_contact_time", tc, "s"),
                     item("peak_force", r.peak_force_n, "N"),
@@ -337,7 +387,9 @@ impl Params {
                     item("energy_dissipated", r.dissipated_j, "J"),
                     item("time_step", setup.dt_s, "s"),
                 ];
-                Ok(RunOutput::contact_only(r.series, summary))
+                let mut out = RunOutput::contact_only(r.series, summary);
+                out.warnings.extend(warnings);
+                Ok(out)
             }
             SceneParams::Pulse {
                 apparatus,
@@ -367,7 +419,28 @@ impl Params {
                 summary.push(item("external_work", r.energy.external_work_j, "J"));
                 summary.push(item("contact_work", r.energy.contact_work_j, "J"));
                 summary.push(item("kinetic_energy_end", r.kinetic_energy_j, "J"));
-                Ok(RunOutput::contact_only(r.series, summary))
+                // Issue 42: a run that ends before the measured peak force compared its own
+                // early approach with the measured one at peak (relative error −0.99999).
+                let ran_to = r.series.time_s.as_ref().and_then(|t| t.last().copied());
+                let peak_t = setup.drive.time_s[solver::argmax(&setup.drive.force_n)];
+                let mut warnings = Vec::new();
+                if measured_displacement_m.is_some() && ran_to.is_some_and(|t| t < peak_t) {
+                    for s in summary.iter_mut().filter(|s| {
+                        s.key.ends_with("relative_error") || s.key.ends_with("relative_error_paper")
+                    }) {
+                        s.value = f64::NAN;
+                        warnings.push(format!(
+                            "`{}` is not available (NaN): the run ends at {}, before the \
+                             measured peak force at {}; raise end_time_s",
+                            s.key,
+                            format_si(ran_to.unwrap_or(0.0), "s"),
+                            format_si(peak_t, "s"),
+                        ));
+                    }
+                }
+                let mut out = RunOutput::contact_only(r.series, summary);
+                out.warnings.extend(warnings);
+                Ok(out)
             }
         }
     }
@@ -630,6 +703,7 @@ fn run_pulse(
         ));
     }
     let scale = input.iter().copied().fold(0.0, f64::max);
+    let no_energy_balance = t.is_empty() || scale <= 0.0;
     let worst = total
         .iter()
         .zip(&input)
@@ -653,6 +727,13 @@ fn run_pulse(
     }
     energy.push(("total".into(), total));
     let mut warnings = clipping_warnings(apparatus, cylinder, &gauges);
+    if no_energy_balance {
+        warnings.push(
+            "`energy_balance_max_relative_error` is not available (NaN): the run recorded no \
+             sample with energy put in (end_time_s shorter than a sample of the recorders)"
+                .to_string(),
+        );
+    }
     // Spheres: the strain rate over their radii; a cylinder: its stress and strain (§7.8).
     let radii = spheres_specimen.map(|sp| sp.strain_rate_radii_m());
     let mut cylinder_reduction = None;
@@ -732,8 +813,46 @@ fn run_free_chain(
         .copied()
         .fold(0.0f64, f64::max);
     let dissipated: f64 = r.contact_work_j[spheres].iter().sum();
+    let mut warnings = Vec::new();
+    // Issue 42: at end_time_s = 5 µs the first contact of the 10-sphere chain was still closing
+    // and its "restitution" came out as −0.52.
+    let first_force = r.first_contact.force_n.last().copied().unwrap_or(0.0);
+    let closing = r.final_velocity_m_s[0] - r.final_velocity_m_s[1];
+    let restitution = if first_force > 0.0 || closing > 0.0 {
+        warnings.push(format!(
+            "`restitution` is not available (NaN): the first contact has not ended at \
+             end_time_s = {} (force {}, closing at {}); raise end_time_s past its end",
+            format_si(setup.end_time_s, "s"),
+            format_si(first_force, "N"),
+            format_si(closing.max(0.0), "m/s"),
+        ));
+        f64::NAN
+    } else {
+        physical_restitution(
+            r.first_restitution(),
+            "of the first contact ",
+            &mut warnings,
+        )
+    };
+    // The contacts' work is dissipated only once they have unloaded: a contact still loaded at
+    // the end holds elastic energy in it.
+    let loaded = r
+        .contact_force_n
+        .iter()
+        .filter(|f| f.last().is_some_and(|&x| x > 0.0))
+        .count();
+    let dissipated = if loaded > 0 {
+        warnings.push(format!(
+            "`energy_dissipated` is not available (NaN): {loaded} contact(s) still loaded at \
+             end_time_s = {}, whose work holds elastic energy not yet returned; raise end_time_s",
+            format_si(setup.end_time_s, "s"),
+        ));
+        f64::NAN
+    } else {
+        dissipated
+    };
     let mut summary = vec![
-        item("restitution", r.first_restitution(), "1"),
+        item("restitution", restitution, "1"),
         item("kinetic_energy_ratio", r.kinetic_energy_ratio(), "1"),
         item("peak_force", peak, "N"),
         item("peak_force_contact", (peak_contact + 1) as f64, "1"),
@@ -793,6 +912,7 @@ fn run_free_chain(
     };
     let mut out = RunOutput::contact_only(r.first_contact, summary);
     out.chain = Some(chain);
+    out.warnings.extend(warnings);
     Ok(out)
 }
 
@@ -1070,6 +1190,48 @@ fn reduced_summary(r: &crate::reduce::Reduction, apparatus: &Apparatus) -> Vec<S
         v.push(item("transmitted_delay", d, "s"));
     }
     v
+}
+
+/// Largest restitution a stepped impact may report above 1 and still be taken as 1 plus
+/// round-off: an elastic Hertz impact steps to 1 ± 1e-11 (issue 42 measurements), a gain of
+/// 1e-6 is energy the stepper made.
+pub const RESTITUTION_ROUND_OFF: f64 = 1e-6;
+
+/// A restitution as reported: NaN with a warning (pushed on `warnings`) when it is above 1 by
+/// more than [`RESTITUTION_ROUND_OFF`] or negative, which no passive contact can give.
+fn physical_restitution(e: f64, what: &str, warnings: &mut Vec<String>) -> f64 {
+    if e > 1.0 + RESTITUTION_ROUND_OFF || e < 0.0 {
+        warnings.push(format!(
+            "`restitution` is not available (NaN): the stepped restitution {what}came out as \
+             {e}, outside 0 to 1 where a passive contact keeps it (the time step or the \
+             closing speed is outside what the stepper resolves)"
+        ));
+        f64::NAN
+    } else {
+        e
+    }
+}
+
+/// Gives every summary value that is not a finite number (NaN: not available) a warning saying
+/// so, unless a warning already names it in backquotes (issue 42: NaN summaries came out with
+/// exit 0 and no word); the reason is the run's, named where a specific check knows it.
+pub fn explain_unavailable(out: &mut RunOutput) {
+    let missing: Vec<String> = out
+        .summary
+        .iter()
+        .filter(|s| !s.value.is_finite())
+        .map(|s| s.key.clone())
+        .filter(|k| {
+            let quoted = format!("`{k}`");
+            !out.warnings.iter().any(|w| w.contains(&quoted))
+        })
+        .collect();
+    for k in missing {
+        out.warnings.push(format!(
+            "`{k}` is not available (NaN): the run gave it no value (a run shorter than the \
+             events it measures, or a record with too few samples); raise end_time_s"
+        ));
+    }
 }
 
 #[cfg(test)]

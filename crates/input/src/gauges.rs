@@ -11,6 +11,11 @@ use shpb_core::reduce::{
 };
 use std::path::Path;
 
+/// The lowest recorder sample rate a gauge channel may have, Hz: 10 samples over a 100 µs
+/// pulse (the shortest SHPB pulse of the authors' set-up is ≈ 80 µs), the fewest a reduction
+/// window can be cut from.
+pub const MIN_SAMPLE_RATE_HZ: f64 = 1e5;
+
 /// One `[[channel]]` table of a gauge file (or of a set-up file's inline channels), before
 /// validation. `bridge = "linear"` takes `strain_per_volt` instead of `gauge_factor`,
 /// `excitation_v` and `poisson_ratio`.
@@ -110,7 +115,15 @@ impl ChannelSpec {
             amplifier_gain: v.positive("amplifier_gain", self.amplifier_gain, 1e6, "")?,
             polarity: self.polarity,
             digitiser: Digitiser {
-                sample_rate_hz: v.positive("sample_rate_hz", self.sample_rate_hz, 1e12, "Hz")?,
+                // Issue 42: at 1 Hz a run digitised no sample and its summaries came out NaN;
+                // 100 kHz keeps 10 samples over a 100 µs pulse, the fewest a window holds.
+                sample_rate_hz: v.in_range(
+                    "sample_rate_hz",
+                    self.sample_rate_hz,
+                    MIN_SAMPLE_RATE_HZ,
+                    1e12,
+                    "Hz",
+                )?,
                 bits: self.adc_bits as u32,
                 range_v: v.positive("adc_range_v", self.adc_range_v, 1e4, "V")?,
                 noise_rms_v: v.in_range("noise_rms_v", self.noise_rms_v, 0.0, 1e4, "V")?,

@@ -194,9 +194,11 @@ mod tests {
         let e = Params::from_toml(text, "c.toml", Path::new(".")).unwrap_err();
         assert_eq!(e.exit_code(), 2);
         let msg = e.to_string();
+        // 3 Hertz contact times (14.03 µs at 5 m/s for the paper's pair) of 1 fs steps
+        // (estimate::COLLISION_ESTIMATE_CONTACT_TIMES).
         assert!(
             msg.starts_with(
-                "c.toml: the run cannot finish on this machine: it needs 1.4e12 time steps"
+                "c.toml: the run cannot finish on this machine: it needs 4.21e10 time steps"
             ),
             "{msg}"
         );
@@ -213,11 +215,13 @@ mod tests {
         let ok = "kind = \"collision\"\nvelocity1_m_s = 5.0\nspecimen = { pair = \"ss440c\" }\n";
         let p = Params::from_toml(ok, "c.toml", Path::new(".")).unwrap();
         let est = check(&p, &limits(1e9)).unwrap();
-        assert_eq!(est.steps, 200_000.0);
-        // …but not on a machine with 1 MB to spare; the message says how much it has.
-        let msg = check(&p, &limits(1e6)).unwrap_err().to_string();
+        // 3 Hertz contact times of 2000 steps each (the standard steps_per_contact).
+        assert!((est.steps - 6000.0).abs() <= 1.0, "{}", est.steps);
+        // …but not on a machine with 100 kB to spare (it keeps 6000 samples of 5 numbers); the
+        // message says how much it has.
+        let msg = check(&p, &limits(1e5)).unwrap_err().to_string();
         assert!(
-            msg.contains("limit: 1e10 time steps, 1e12 node updates, 1 MB of memory (test)"),
+            msg.contains("limit: 1e10 time steps, 1e12 node updates, 100 kB of memory (test)"),
             "{msg}"
         );
     }

@@ -155,7 +155,8 @@ pub fn load_pair_file(path: &Path) -> Result<SpherePair> {
     spec.build(base, &Validator::new(file))
 }
 
-/// Resolves a specimen reference: a pair `.toml` path, or a built-in material name (paper pair).
+/// Resolves a specimen reference: a pair `.toml` path, or a built-in material name or material
+/// `.toml` file (the paper's 6.35 mm pair of it).
 pub fn resolve_pair(
     reference: &str,
     base_dir: &Path,
@@ -171,7 +172,17 @@ pub fn resolve_pair(
                 "a readable pair .toml file, relative to the scene file's directory",
             ));
         }
-        return load_pair_file(&path);
+        // A material file (no [sphere1]/[sphere2] table) is the paper's 6.35 mm pair of it, as
+        // a built-in name is (issue 42: `curve --specimen ss440c.toml` was refused with a TOML
+        // error although its help offers material files).
+        let text = crate::files::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        let is_pair = match text.parse::<toml::Table>() {
+            Ok(t) => t.contains_key("sphere1") || t.contains_key("sphere2"),
+            Err(_) => true,
+        };
+        if is_pair {
+            return load_pair_file(&path);
+        }
     }
     Material::resolve(reference, base_dir, v, key).map(SpherePair::paper)
 }

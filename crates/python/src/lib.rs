@@ -86,6 +86,86 @@ fn detached<T: Send>(
     }
 }
 
+/// How often a sweep or a study run by [`interruptible`] looks for a pending Ctrl-C.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// Runs `f` on a thread of its own, handing it a `keep_going` flag, while this thread waits
+/// without the GIL and takes it back every [`SIGNAL_POLL`] to run Python's signal handlers
+/// (`Python::check_signals`; only the main thread's handlers run, so a sweep's worker threads
+/// cannot see Ctrl-C themselves). The first signal's exception (KeyboardInterrupt for SIGINT)
+/// clears the flag: `f` starts no more runs, stops those running at their next 1 % and returns
+/// what it finished; that exception comes back beside `f`'s result. A panic is raised as
+/// `RuntimeError`, a shpb error as its Python exception (as [`detached`] does).
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce(&(dyn Fn() -> bool + Sync)) -> shpb_input::Result<T> + Send,
+) -> PyResult<(T, Option<PyErr>)> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stop = AtomicBool::new(false);
+    let keep_going = || !stop.load(Ordering::Relaxed);
+    let mut signal = None;
+    let joined = std::thread::scope(|s| {
+        let worker =
+            s.spawn(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(&keep_going))));
+        while !worker.is_finished() {
+            py.allow_threads(|| std::thread::sleep(SIGNAL_POLL));
+            if signal.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                signal = Some(e);
+                stop.store(true, Ordering::Relaxed);
+            }
+        }
+        worker.join()
+    });
+    match joined.and_then(|r| r) {
+        Ok(r) => Ok((r.map_err(py_err)?, signal)),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(PyRuntimeError::new_err(format!(
+                "shpb: internal error (please report it): {what}"
+            )))
+        }
+    }
+}
+
+/// The exception `signal` with the rows finished before it: attribute `table` holds them as
+/// the columns [`sweep_table`] gives (the Python package wraps them into a `Table`), `finished`
+/// their count.
+fn with_finished_rows(
+    py: Python<'_>,
+    signal: PyErr,
+    keys: &[String],
+    rows: &[shpb_study::sweep::RunSummary],
+) -> PyErr {
+    let mut rows = rows.to_vec();
+    rows.sort_by_key(|r| r.index);
+    let value = signal.value(py);
+    let table = table_columns(keys, &rows);
+    if let Ok(t) = table.into_pyobject(py) {
+        let _ = value.setattr("table", t);
+    }
+    let _ = value.setattr("finished", rows.len());
+    signal
+}
+
+/// FileNotFoundError (errno ENOENT) for a scene that is not a file, with the message of
+/// `shpb sweep` (python/README: a missing scene file is a `FileNotFoundError`).
+fn require_scene(scene: &Path) -> PyResult<()> {
+    match shpb_study::sweep::require_scene(scene) {
+        Ok(()) => Ok(()),
+        Err(e) => Err(pyo3::exceptions::PyFileNotFoundError::new_err((
+            2,
+            e.to_string(),
+            scene.display().to_string(),
+        ))),
+    }
+}
+
 fn fidelity(name: Option<&str>) -> PyResult<Option<Fidelity>> {
     name.map(|n| {
         Fidelity::parse(n).ok_or_else(|| {
@@ -691,11 +771,15 @@ fn sweep_runs(
     jobs: usize,
     shard: (usize, usize),
 ) -> PyResult<(Vec<String>, StudyRows)> {
-    let (axes, rows) = detached(py, || api::sweep_shard_rows(&scene, &set, shard, jobs))?;
-    Ok((
-        axes.iter().map(|a| a.key.clone()).collect(),
-        travelling(&rows),
-    ))
+    require_scene(&scene)?;
+    let ((axes, finished), signal) = interruptible(py, |keep_going| {
+        api::sweep_shard_rows_until(&scene, &set, shard, jobs, keep_going)
+    })?;
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    if let Some(signal) = signal {
+        return Err(with_finished_rows(py, signal, &keys, &finished.rows));
+    }
+    Ok((keys, travelling(&finished.rows)))
 }
 
 /// The table of a sweep over `keys` from the rows of all its shards (`sweep_runs`), in sweep
@@ -771,9 +855,21 @@ fn study_runs(
     fidelity: Option<&str>,
 ) -> PyResult<StudyRows> {
     let plan = study_plan(samples, seed, gun_scatter, fidelity)?;
-    let study = detached(py, || {
-        shpb_study::uq::study_shard_rows(&scene, &plan, jobs, false, shard, |_| {})
+    require_scene(&scene)?;
+    let ((study, _), signal) = interruptible(py, |keep_going| {
+        shpb_study::uq::study_shard_rows_until(
+            &scene,
+            &plan,
+            jobs,
+            false,
+            shard,
+            |_| {},
+            keep_going,
+        )
     })?;
+    if let Some(signal) = signal {
+        return Err(with_finished_rows(py, signal, &study.keys(), &study.rows));
+    }
     Ok(travelling(&study.rows))
 }
 

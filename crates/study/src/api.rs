@@ -755,6 +755,20 @@ pub fn sweep_shard_rows(
     (k, n): (usize, usize),
     jobs: usize,
 ) -> Result<(Vec<Axis>, Vec<RunSummary>)> {
+    let (axes, finished) = sweep_shard_rows_until(scene, set, (k, n), jobs, &|| true)?;
+    Ok((axes, finished.rows))
+}
+
+/// [`sweep_shard_rows`] that `keep_going` may stop (asked before each run and every 1 % of one,
+/// [`crate::sweep::run_until`]): the rows finished and whether it was stopped.
+pub fn sweep_shard_rows_until(
+    scene: &Path,
+    set: &[String],
+    (k, n): (usize, usize),
+    jobs: usize,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<(Vec<Axis>, crate::sweep::Finished<RunSummary>)> {
+    crate::sweep::check_jobs(jobs)?;
     crate::sweep::require_scene(scene)?;
     let (k, n) = crate::sweep::check_shard(k, n)?;
     let axes = crate::sweep::parse_axes(set)?;
@@ -763,7 +777,7 @@ pub fn sweep_shard_rows(
         .check(&crate::sweep::Limits::of_machine(&[]))?;
     let points = crate::sweep::shard_points(&axes, k, n);
     crate::sweep::check_points(scene, &axes, &points)?;
-    let rows = crate::sweep::run_points(scene, &axes, &points, jobs, |_| {})?;
+    let rows = crate::sweep::run_points_until(scene, &axes, &points, jobs, |_| {}, keep_going)?;
     Ok((axes, rows))
 }
 

@@ -323,8 +323,40 @@ pub const SUMMARY_COLUMNS: [(&str, &str); 5] = [
     ("time_to_equilibrium", "s"),
 ];
 
-/// A pool of `jobs` worker threads (`-j`; 0 counts as 1) for the runs of a sweep or a study.
+/// Worker threads `-j` may ask for per core of the machine: a run is CPU-bound, so more
+/// threads than cores only share them; 4 per core leaves room for runs that wait on their
+/// output, and refuses `-j 100000` (issue 42: it spawned hundreds of threads without a word).
+pub const MAX_JOBS_PER_CORE: usize = 4;
+
+/// The most worker threads `-j` may ask for on this machine: [`MAX_JOBS_PER_CORE`] × its
+/// cores (`std::thread::available_parallelism`, 1 where unknown).
+pub fn max_jobs() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get()) * MAX_JOBS_PER_CORE
+}
+
+/// `jobs` as a thread count (0 counts as 1), or an input error naming `-j` and the range when
+/// it is more than [`max_jobs`].
+pub fn check_jobs(jobs: usize) -> Result<usize> {
+    let most = max_jobs();
+    if jobs > most {
+        return Err(Error::Input {
+            file: "command line".into(),
+            key: "-j".into(),
+            problem: format!(
+                "{jobs} worker threads is more than {MAX_JOBS_PER_CORE} per core of this \
+                 machine's {} cores",
+                most / MAX_JOBS_PER_CORE
+            ),
+            allowed: format!("1 to {most} (0 counts as 1)"),
+        });
+    }
+    Ok(jobs.max(1))
+}
+
+/// A pool of `jobs` worker threads (`-j`; 0 counts as 1, at most [`max_jobs`]) for the runs of
+/// a sweep or a study.
 pub fn thread_pool(jobs: usize) -> Result<rayon::ThreadPool> {
+    let jobs = check_jobs(jobs)?;
     rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.max(1))
         .build()
@@ -407,6 +439,34 @@ pub fn summarise(index: usize, inputs: Vec<String>, out: &RunOutput) -> RunSumma
         }
         None => (f64::NAN, f64::NAN, f64::NAN),
     };
+    // Issue 42: a column a full test cannot give is NaN with the reason in the row's warnings
+    // (a kind without a reduction has none of the reduction's columns, documented in README).
+    let mut warnings = out.warnings.clone();
+    if out.reduction.is_some() {
+        for (value, column, why) in [
+            (
+                rate,
+                "peak_strain_rate",
+                "the reduction gave no strain rate (no specimen length)",
+            ),
+            (
+                eq,
+                "equilibrium_ratio_at_peak",
+                "the reduction found no peak back force",
+            ),
+            (
+                t_eq,
+                "time_to_equilibrium",
+                "the front and back forces never came within 5 % while the back force was \
+                 above 10 % of its peak",
+            ),
+        ] {
+            let named = format!("`{column}`");
+            if !value.is_finite() && !warnings.iter().any(|w| w.contains(&named)) {
+                warnings.push(format!("{named} is not available (NaN): {why}"));
+            }
+        }
+    }
     RunSummary {
         index,
         inputs,
@@ -415,7 +475,7 @@ pub fn summarise(index: usize, inputs: Vec<String>, out: &RunOutput) -> RunSumma
         peak_strain_rate_per_s: rate,
         equilibrium_ratio_at_peak: eq,
         time_to_equilibrium_s: t_eq,
-        warnings: out.warnings.clone(),
+        warnings,
     }
 }
 
@@ -453,25 +513,76 @@ pub fn run_points(
     threads: usize,
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Vec<RunSummary>> {
-    let pool = thread_pool(threads)?;
-    pool.install(|| {
-        points
+    run_points_until(scene, axes, points, threads, done, &|| true).map(|p| p.rows)
+}
+
+/// The rows of many runs that a caller may stop: those finished, in order, and whether the
+/// caller stopped the rest (`interrupted`: runs not started and runs stopped mid-way are
+/// missing from `rows`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finished<T> {
+    /// The finished rows, in order.
+    pub rows: Vec<T>,
+    /// True when `keep_going` returned false before every run finished.
+    pub interrupted: bool,
+}
+
+/// Runs `items` on `pool`, `run` giving each one's row; `keep_going` is asked before each run
+/// and passed to it (a run asks it every 1 % of its steps, `Params::run_with_progress`): once it
+/// returns false no run starts, the running ones stop with `Error::Cancelled`, and the rows
+/// finished so far come back with `interrupted` set. Any other error of a run is returned.
+pub fn run_until<I: Sync, T: Send>(
+    pool: &rayon::ThreadPool,
+    items: &[I],
+    keep_going: &(dyn Fn() -> bool + Sync),
+    run: impl Fn(&I, &mut dyn FnMut(f64) -> bool) -> Result<T> + Sync,
+) -> Result<Finished<T>> {
+    let results: Vec<Option<T>> = pool.install(|| {
+        items
             .par_iter()
-            .map(|p| {
-                let params = Params::from_file_overridden(scene, &overrides(axes, p))?;
-                // The scene's warnings first, as `shpb run` prints them (api::run_scene).
-                let mut out = params.run()?;
-                out.warnings.splice(0..0, params.warnings());
-                let inputs = axes
-                    .iter()
-                    .zip(&p.coords)
-                    .map(|(a, &c)| a.labels[c].clone())
-                    .collect();
-                let row = summarise(p.index, inputs, &out);
-                done(&row);
-                Ok(row)
+            .map(|item| {
+                if !keep_going() {
+                    return Ok(None);
+                }
+                match run(item, &mut |_| keep_going()) {
+                    Ok(row) => Ok(Some(row)),
+                    Err(Error::Interrupted { .. }) if !keep_going() => Ok(None),
+                    Err(e) => Err(e),
+                }
             })
             .collect::<Result<Vec<_>>>()
+    })?;
+    let interrupted = results.iter().any(Option::is_none);
+    Ok(Finished {
+        rows: results.into_iter().flatten().collect(),
+        interrupted,
+    })
+}
+
+/// [`run_points`] that `keep_going` may stop ([`run_until`]): the finished rows and whether it
+/// stopped the sweep (how `shpb.sweep` keeps its rows on Ctrl-C).
+pub fn run_points_until(
+    scene: &Path,
+    axes: &[Axis],
+    points: &[Point],
+    threads: usize,
+    done: impl Fn(&RunSummary) + Sync,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<Finished<RunSummary>> {
+    let pool = thread_pool(threads)?;
+    run_until(&pool, points, keep_going, |p, progress| {
+        let params = Params::from_file_overridden(scene, &overrides(axes, p))?;
+        // The scene's warnings first, as `shpb run` prints them (api::run_scene).
+        let mut out = params.run_with_progress(progress)?;
+        out.warnings.splice(0..0, params.warnings());
+        let inputs = axes
+            .iter()
+            .zip(&p.coords)
+            .map(|(a, &c)| a.labels[c].clone())
+            .collect();
+        let row = summarise(p.index, inputs, &out);
+        done(&row);
+        Ok(row)
     })
 }
 

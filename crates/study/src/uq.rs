@@ -6,7 +6,6 @@
 use crate::sweep::{RunSummary, SUMMARY_COLUMNS, input_si, summarise};
 use rand_xoshiro::Xoshiro256StarStar;
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
-use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::{Params, SceneParams};
@@ -581,50 +580,61 @@ pub fn study_shard_rows(
     plan: &StudyPlan,
     jobs: usize,
     keep_traces: bool,
-    (k, m): (usize, usize),
+    shard: (usize, usize),
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Study> {
+    study_shard_rows_until(scene, plan, jobs, keep_traces, shard, done, &|| true)
+        .map(|(study, _)| study)
+}
+
+/// [`study_shard_rows`] that `keep_going` may stop (`crate::sweep::run_until`): the study of the
+/// samples finished (its `rows` then miss the others) and whether it was stopped (how
+/// `shpb.study` keeps its rows on Ctrl-C).
+pub fn study_shard_rows_until(
+    scene: &Path,
+    plan: &StudyPlan,
+    jobs: usize,
+    keep_traces: bool,
+    (k, m): (usize, usize),
+    done: impl Fn(&RunSummary) + Sync,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<(Study, bool)> {
     let (k, m) = crate::sweep::check_shard(k, m)?;
     let n = plan.samples;
-    let (inputs, samples) = study_samples(scene, plan)?;
     let pool = crate::sweep::thread_pool(jobs)?;
+    let (inputs, samples) = study_samples(scene, plan)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
-    let results: Vec<(RunSummary, RunTraces)> = pool.install(|| {
-        indices
-            .into_par_iter()
-            .map(|i| {
-                let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
-                // Every warning of the run kept in its row, the scene's first.
-                let mut out = params.run()?;
-                out.warnings.splice(0..0, params.warnings());
-                let row = summarise(i, samples.labels[i].clone(), &out);
-                let traces = if keep_traces && i < MAX_TRACED_SAMPLES {
-                    RunTraces {
-                        back_force: out
-                            .reduction
-                            .as_ref()
-                            .map(|r| (r.time_s.clone(), r.force_back_n.clone())),
-                        transmitted_strain: out.time_s.as_ref().and_then(|t| {
-                            out.gauges
-                                .iter()
-                                .find(|g| g.name.contains("transmi"))
-                                .map(|g| (t.clone(), g.strain.clone()))
-                        }),
-                        force_approach: out
-                            .contact
-                            .as_ref()
-                            .map(|c| loading_branch(&c.displacement_m, &c.force_n, c.peak_index())),
-                    }
-                } else {
-                    RunTraces::default()
-                };
-                done(&row);
-                Ok((row, traces))
-            })
-            .collect::<Result<Vec<_>>>()
+    let finished = crate::sweep::run_until(&pool, &indices, keep_going, |&i, progress| {
+        let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
+        // Every warning of the run kept in its row, the scene's first.
+        let mut out = params.run_with_progress(progress)?;
+        out.warnings.splice(0..0, params.warnings());
+        let row = summarise(i, samples.labels[i].clone(), &out);
+        let traces = if keep_traces && i < MAX_TRACED_SAMPLES {
+            RunTraces {
+                back_force: out
+                    .reduction
+                    .as_ref()
+                    .map(|r| (r.time_s.clone(), r.force_back_n.clone())),
+                transmitted_strain: out.time_s.as_ref().and_then(|t| {
+                    out.gauges
+                        .iter()
+                        .find(|g| g.name.contains("transmi"))
+                        .map(|g| (t.clone(), g.strain.clone()))
+                }),
+                force_approach: out
+                    .contact
+                    .as_ref()
+                    .map(|c| loading_branch(&c.displacement_m, &c.force_n, c.peak_index())),
+            }
+        } else {
+            RunTraces::default()
+        };
+        done(&row);
+        Ok((row, traces))
     })?;
-    let (rows, traces): (Vec<_>, Vec<_>) = results.into_iter().unzip();
-    Ok(Study {
+    let (rows, traces): (Vec<_>, Vec<_>) = finished.rows.into_iter().unzip();
+    let study = Study {
         inputs,
         samples,
         rows,
@@ -635,7 +645,8 @@ pub fn study_shard_rows(
         },
         seed: plan.seed,
         fidelity: plan.fidelity,
-    })
+    };
+    Ok((study, finished.interrupted))
 }
 
 impl Study {

@@ -111,7 +111,13 @@ impl SetupNew {
             v.positive("--gain", g, 1e6, "")?;
         }
         if let Some(r) = self.sample_rate_hz {
-            v.positive("--sample-rate", r, 1e12, "Hz")?;
+            v.in_range(
+                "--sample-rate",
+                r,
+                shpb_input::gauges::MIN_SAMPLE_RATE_HZ,
+                1e12,
+                "Hz",
+            )?;
         }
         let kind = match self.bridge.as_deref() {
             None => None,

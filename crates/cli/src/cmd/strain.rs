@@ -59,7 +59,22 @@ pub fn strain(
         Ok((apparatus, rec))
     });
     let (apparatus, mut rec) = read?;
-    let n = read_as.baseline_samples.min(rec.time_s.len() / 2);
+    // Issue 42: a baseline longer than the record was cut to half of it without a word.
+    let half = rec.time_s.len() / 2;
+    if read_as.baseline_samples > half {
+        return Err(Error::Input {
+            file: record.display().to_string(),
+            key: "--baseline-samples".into(),
+            problem: format!(
+                "{} samples (900 unless given) is more than half of the record's {} samples: \
+                 the baseline would take in the pulse",
+                read_as.baseline_samples,
+                rec.time_s.len()
+            ),
+            allowed: format!("0 to {half} samples for this record"),
+        });
+    }
+    let n = read_as.baseline_samples;
     rec.incident_v = shpb_core::gauge::remove_baseline(&rec.incident_v, n);
     rec.transmission_v = shpb_core::gauge::remove_baseline(&rec.transmission_v, n);
     let mut gauges = Vec::new();

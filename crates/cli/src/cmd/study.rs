@@ -30,6 +30,7 @@ pub fn study(
     outputs: StudyOutputs,
     force: bool,
 ) -> Result<()> {
+    shpb_study::sweep::check_jobs(jobs)?;
     let out_plan = super::common::plan(
         force,
         &[

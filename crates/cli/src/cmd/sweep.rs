@@ -27,6 +27,7 @@ pub fn sweep(
         Checkpoint, Outputs, check_points, checkpoint_path, estimate, parse_axes, parse_shard,
         run_points, shard_points,
     };
+    shpb_study::sweep::check_jobs(jobs)?;
     let outputs = [output, csv, plot];
     // A resumed sweep owns the outputs it left; the other checks hold for it too.
     let out_plan = plan(

@@ -76,6 +76,100 @@ pub fn hertz_impact_duration(
         / speed_m_s
 }
 
+/// Smallest largest-approach a stepped impact may have, as a fraction of the scale of the
+/// bodies' positions (r1 + r2 for two spheres): double-precision positions resolve the approach
+/// δ = r1 + r2 − (x2 − x1) to about 2.2e-16 of that scale, so at 1e-6 of it δ* carries 10
+/// significant digits. Below, the round-off of δ feeds the force and the energy: a 1e-12 m/s
+/// collision of 6.35 mm spheres (δ* = 1.7 fm, 2000 ulps of 6.35 mm) came out with restitution
+/// 1.0046 (issue 42).
+pub const APPROACH_RESOLUTION_OF_POSITIONS: f64 = 1e-6;
+
+/// Closing speed at which the elastic Hertz impact reaches largest approach `approach_m`, the
+/// inverse of [`hertz_max_approach`]: v = √(16 E* √r δ*^{5/2} / (15 m)) (Johnson §11.4), m/s.
+pub fn hertz_speed_for_approach(
+    reduced_mass_kg: f64,
+    e_star_pa: f64,
+    radius_m: f64,
+    approach_m: f64,
+) -> f64 {
+    (16.0 * e_star_pa * radius_m.sqrt() * approach_m.powf(2.5) / (15.0 * reduced_mass_kg)).sqrt()
+}
+
+/// The closing speeds an impact may be stepped at (m/s, low and high): from the speed whose
+/// elastic Hertz approach is [`APPROACH_RESOLUTION_OF_POSITIONS`] of `position_scale_m` (below,
+/// round-off decides the restitution) to the speed whose Hertz approach reaches the smaller
+/// body radius `smallest_radius_m` (beyond, the spheres overlap by more than a radius: no
+/// contact law describes them; the approach of a yielding law is larger still, Hertz is its
+/// lower bound). `radius_m` and `e_star_pa` are the contact's effective radius and modulus.
+pub fn impact_speed_range(
+    reduced_mass_kg: f64,
+    e_star_pa: f64,
+    radius_m: f64,
+    smallest_radius_m: f64,
+    position_scale_m: f64,
+) -> (f64, f64) {
+    let v = |d: f64| hertz_speed_for_approach(reduced_mass_kg, e_star_pa, radius_m, d);
+    (
+        v(APPROACH_RESOLUTION_OF_POSITIONS * position_scale_m),
+        v(smallest_radius_m),
+    )
+}
+
+/// Refuses a closing speed outside [`impact_speed_range`] with an [`Error::Invalid`] of the
+/// quantity `closing speed` naming the range and why.
+pub fn check_impact_speed(
+    reduced_mass_kg: f64,
+    e_star_pa: f64,
+    radius_m: f64,
+    smallest_radius_m: f64,
+    position_scale_m: f64,
+    speed_m_s: f64,
+) -> Result<()> {
+    let (lo, hi) = impact_speed_range(
+        reduced_mass_kg,
+        e_star_pa,
+        radius_m,
+        smallest_radius_m,
+        position_scale_m,
+    );
+    let delta = hertz_max_approach(reduced_mass_kg, e_star_pa, radius_m, speed_m_s);
+    let allowed = || {
+        format!(
+            "a closing speed of {} for these spheres (their elastic Hertz approach from {:e} \
+             of the position scale {} up to the smaller radius {})",
+            crate::error::format_range(lo, hi, "m/s"),
+            APPROACH_RESOLUTION_OF_POSITIONS,
+            crate::error::format_si(position_scale_m, "m"),
+            crate::error::format_si(smallest_radius_m, "m"),
+        )
+    };
+    if speed_m_s < lo {
+        return Err(Error::invalid(
+            "closing speed",
+            format!(
+                "{}: its largest approach ({} by Hertz) is too small for double-precision \
+                 positions to resolve, so round-off would decide the restitution and energies",
+                crate::error::format_si(speed_m_s, "m/s"),
+                crate::error::format_si(delta, "m"),
+            ),
+            allowed(),
+        ));
+    }
+    if speed_m_s > hi {
+        return Err(Error::invalid(
+            "closing speed",
+            format!(
+                "{}: the spheres would overlap by more than the smaller radius ({} by elastic \
+                 Hertz, more with yielding), where no contact law holds",
+                crate::error::format_si(speed_m_s, "m/s"),
+                crate::error::format_si(delta, "m"),
+            ),
+            allowed(),
+        ));
+    }
+    Ok(())
+}
+
 /// Period 2π√(m/k) of the contact linearised at the Hertz tangent stiffness at force `force_n`, s.
 pub fn contact_period(reduced_mass_kg: f64, e_star_pa: f64, radius_m: f64, force_n: f64) -> f64 {
     let delta = (3.0 * force_n / (4.0 * e_star_pa * radius_m.sqrt())).powf(2.0 / 3.0);

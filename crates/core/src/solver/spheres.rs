@@ -140,6 +140,30 @@ impl FreeChainSetup {
             .collect()
     }
 
+    /// Refuses a striking speed outside [`super::impact_speed_range`] of the first contact
+    /// (striker–sphere 1 or sphere 1–sphere 2), the positions' scale being the chain's length.
+    pub fn check_impact_speed(&self) -> Result<()> {
+        let l = self.layout();
+        let spheres = &self.chain.spheres;
+        let smallest = match &self.striker {
+            Some(_) => spheres[0].radius_m,
+            None => spheres
+                .iter()
+                .take(2)
+                .map(|s| s.radius_m)
+                .fold(f64::INFINITY, f64::min),
+        };
+        let p = &l.contacts[0];
+        super::check_impact_speed(
+            reduced_mass_kg(l.masses_kg[0], l.masses_kg[1]),
+            p.e_star_pa,
+            p.radius_m,
+            smallest,
+            l.touch_distance_m.iter().sum(),
+            self.impact_speed_m_s(),
+        )
+    }
+
     /// Default time step: the stiffest contact's Hertz contact time over `steps_per_contact`
     /// (for two spheres exactly the `collision` scene's step).
     pub fn default_time_step(&self, steps_per_contact: f64) -> f64 {

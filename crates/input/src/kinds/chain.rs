@@ -203,6 +203,13 @@ fn parse(
             "a normal (not subnormal) positive number of m/s",
         ));
     }
+    // Issue 42: the first contact's striking speed within the resolvable, in-model range.
+    let speed_key = if setup.striker.is_some() {
+        "striker.velocity_m_s"
+    } else {
+        "velocity1_m_s"
+    };
+    setup.check_impact_speed().map_err(v.core(speed_key))?;
     let n = v.in_range(
         "steps_per_contact",
         f.steps_per_contact.unwrap_or(fidelity.dem_steps()),

@@ -93,6 +93,17 @@ fn parse(
             "velocity1_m_s - velocity2_m_s a normal (not subnormal) positive number of m/s",
         ));
     }
+    // Issue 42: a closing speed whose approach round-off decides (restitution 1.0046 at
+    // 1e-12 m/s) or that overlaps the spheres by more than a radius (9999 m/s) is refused.
+    solver::check_impact_speed(
+        pair.reduced_mass_kg(),
+        p.e_star_pa,
+        p.radius_m,
+        pair.sphere1.radius_m.min(pair.sphere2.radius_m),
+        pair.sphere1.radius_m + pair.sphere2.radius_m,
+        speed,
+    )
+    .map_err(v.core("velocity1_m_s"))?;
     let n = v.in_range(
         "steps_per_contact",
         f.steps_per_contact.unwrap_or(fidelity.dem_steps()),

@@ -99,6 +99,9 @@ fn default_time_column() -> String {
     "time_s".into()
 }
 
+/// The fewest time steps a force-driven run may take.
+pub const MIN_RUN_STEPS: f64 = 16.0;
+
 fn default_force_column() -> String {
     "force_N".into()
 }
@@ -150,6 +153,33 @@ fn parse(
         Some(_) => Some(table.compression_column("displacement_m", sign, &remedy)?),
         None => None,
     };
+    // Issue 42: the drive starts at t = 0, so rows before it were dropped without a word, and
+    // a force that is zero throughout ran to an all-zero summary.
+    // (A record that ends at or before 0 is refused below, naming its end.)
+    if let Some(row) = t.iter().position(|&x| x < 0.0)
+        && t.last().is_some_and(|&last| last > 0.0)
+    {
+        return Err(Error::Input {
+            file: csv_path.display().to_string(),
+            key: f.time_column.clone(),
+            problem: format!(
+                "{:e} s at data row {} is before the run's start t = 0: the drive would drop \
+                 every row before it",
+                t[row],
+                row + 1
+            ),
+            allowed: "times from 0 s (shift the time column so that the loading starts at 0)"
+                .into(),
+        });
+    }
+    if force.iter().all(|&x| x == 0.0) {
+        return Err(Error::Input {
+            file: csv_path.display().to_string(),
+            key: f.force_column.clone(),
+            problem: "every force is 0 N: nothing drives the spheres".into(),
+            allowed: "a force record with a non-zero loading, N".into(),
+        });
+    }
     let drive = ForceHistory {
         time_s: t,
         force_n: force,
@@ -195,6 +225,17 @@ fn parse(
     };
     // Times in µs under `time_s` are named as such, not as an end time the scene never gave.
     table.check_time_span(&f.time_column, &drive.time_s)?;
+    // Issue 42: an end time shorter than a few steps ran to a summary of nothing.
+    if end < MIN_RUN_STEPS * dt {
+        return Err(v.error(
+            "end_time_s",
+            format!(
+                "{end:e} s holds fewer than {MIN_RUN_STEPS} time steps of {dt:e} s, too few for \
+                 any result"
+            ),
+            format!("at least {:e} s", MIN_RUN_STEPS * dt),
+        ));
+    }
     if end / dt > 5e8 {
         return Err(v.error(
             "end_time_s",

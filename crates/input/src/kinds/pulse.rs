@@ -3,7 +3,7 @@
 //! bars: [`parse_bars`] with `is_test`.
 
 use super::{Key, LawKindToml, Parsed, Region2Toml, SceneKind, UnloadingToml};
-use crate::error::{Result, Validator};
+use crate::error::{Error, Result, Validator};
 use crate::setup::{ApparatusFile, ShaperOverride};
 use crate::specimen::SpecimenSpec;
 use crate::toml_file::parse_as;
@@ -11,6 +11,7 @@ use serde::Deserialize;
 use shpb_core::apparatus::{Apparatus, IncidentEnd, PulseOptions};
 use shpb_core::bar::Dispersion;
 use shpb_core::contact::{LawKind, LawSpec, Region2Form, Unloading};
+use shpb_core::error::format_si;
 use shpb_core::fidelity::Fidelity;
 use shpb_core::scene::SceneParams;
 use shpb_core::specimen::{CYLINDER_MIN_CELLS, Specimen, SphereSpecimen};
@@ -88,6 +89,10 @@ pub(super) const DISPERSION: Key = Key {
     default: "fidelity: none, none, pochhammer-chree (reference falls back to love-rod)",
     meaning: "bar theory: none (elementary), love-rod (lateral inertia, finite differences), rayleigh-love or pochhammer-chree (that relation carried by the travelling waves of a delay line: uniform bars a whole number of cells long)",
 };
+
+/// The fewest recorder samples and time steps a `pulse` or `shpb` run may hold (the reduction
+/// needs 16 samples of a record).
+pub const MIN_RUN_SAMPLES: f64 = 16.0;
 
 /// `end_time_s` (pulse and shpb).
 pub(super) const END_TIME: Key = Key {
@@ -380,6 +385,37 @@ pub(super) fn parse_bars(
         0.05,
         "m",
     )?;
+    // Issue 42: a bar shorter than one cell was reported as a time step over the stability
+    // limit of `cell_size_m`; it is the set-up's bar length (or the cell) that is wrong.
+    for (table, bar) in [
+        ("incident", &apparatus.incident),
+        ("transmission", &apparatus.transmission),
+        ("striker", &apparatus.striker),
+    ] {
+        // (A record-driven scene has no striker on its grid.)
+        if bar.length_m < cell && !(table == "striker" && drive.is_some()) {
+            return Err(Error::Input {
+                file: apparatus.source.clone(),
+                key: format!("{table}.length_m"),
+                problem: format!(
+                    "the {table} bar, {}, is shorter than one cell of the bars' grid ({} in \
+                     {file}{})",
+                    format_si(bar.length_m, "m"),
+                    format_si(cell, "m"),
+                    if f.cell_size_m.is_some() {
+                        ": its cell_size_m"
+                    } else {
+                        ": its fidelity's cell size"
+                    },
+                ),
+                allowed: format!(
+                    "a bar at least one cell long (at least {}), or a cell_size_m in {file} no \
+                     longer than the bar (1e-5 m at least)",
+                    format_si(cell, "m"),
+                ),
+            });
+        }
+    }
     if let (Some(c), Some(largest)) = (&cylinder, cylinder_cell)
         && c.cells_at(cell / c0) < CYLINDER_MIN_CELLS
     {
@@ -445,8 +481,30 @@ pub(super) fn parse_bars(
         &shpb_core::estimate::bar_run(&apparatus, &options, specimen.as_ref()),
         &crate::resources::Limits::of_machine()?,
     )?;
-    for spec in &apparatus.pulse_chain(&options, specimen.as_ref()).bodies {
+    let chain = apparatus.pulse_chain(&options, specimen.as_ref());
+    for spec in &chain.bodies {
         shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
+    }
+    // Issue 42: an end time shorter than a few samples ran to NaN summaries with exit 0.
+    let rate = apparatus
+        .gauges
+        .channels
+        .iter()
+        .map(|c| c.digitiser.sample_rate_hz)
+        .fold(0.0, f64::max);
+    let shortest = (MIN_RUN_SAMPLES / rate).max(MIN_RUN_SAMPLES * chain.dt_s);
+    if end_time_s < shortest {
+        return Err(v.error(
+            "end_time_s",
+            format!(
+                "{} holds fewer than {MIN_RUN_SAMPLES} samples of the recorders ({}) or time \
+                 steps ({}), too few for any result",
+                format_si(end_time_s, "s"),
+                format_si(rate, "Hz"),
+                format_si(chain.dt_s, "s"),
+            ),
+            format!("at least {} (and at most 0.1 s)", format_si(shortest, "s")),
+        ));
     }
     Ok((
         specimen,
