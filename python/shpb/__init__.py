@@ -418,19 +418,9 @@ def reduce(
     ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
-    record = os.fspath(record)
-    specimen_path = None if specimen is None else os.fspath(specimen)
-    with _missing_file_is_os_error(record, specimen_path):
-        return _reduce(record, bars, dispersion, tyas_pope, align, smooth, specimen_length_m,
-                       specimen_diameter_m, layout, balance_bound_s, specimen_path)
-
-
-def _reduce(record, bars, dispersion, tyas_pope, align, smooth, specimen_length_m,  # type: ignore[no-untyped-def]
-            specimen_diameter_m, layout, balance_bound_s, specimen) -> Run:
-    """The body of :func:`reduce`, its arguments checked."""
     return Run(
         _shpb.reduce(
-            record,
+            os.fspath(record),
             None if bars is None else os.fspath(bars),
             dispersion,
             bool(tyas_pope),
@@ -440,7 +430,7 @@ def _reduce(record, bars, dispersion, tyas_pope, align, smooth, specimen_length_
             specimen_diameter_m,
             None if layout is None else os.fspath(layout),
             _number("balance_bound_s", balance_bound_s, "a positive bound in seconds"),
-            specimen,
+            None if specimen is None else os.fspath(specimen),
         )
     )
 

@@ -732,7 +732,19 @@ fn usage_error(e: &clap::Error) -> i32 {
             2
         }
         _ => {
-            let text = e.render().to_string();
+            // Rust's parse errors name no range: say what a value of the option looks like.
+            let text = e
+                .render()
+                .to_string()
+                .replace(
+                    ": invalid float literal",
+                    ": not a number; allowed: a plain number in the option's SI unit, without \
+                     the unit (e.g. 0.019 for 19 mm; see the option's --help)",
+                )
+                .replace(
+                    ": invalid digit found in string",
+                    ": not a whole number; allowed: a whole number (see the option's --help)",
+                );
             let text = text.strip_prefix("error: ").unwrap_or(&text);
             eprint!("shpb: error: {text}");
             if !text.ends_with('\n') {

@@ -91,7 +91,6 @@ impl SceneFile for Params {
     /// reach into tables); the stored scene text is the modified TOML.
     fn from_file_overridden(path: &Path, overrides: &[(String, toml::Value)]) -> Result<Params> {
         let file = path.display().to_string();
-        not_a_scene(path, &file)?;
         let original = crate::files::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let text = if overrides.is_empty() {
             original.clone()
@@ -103,18 +102,23 @@ impl SceneFile for Params {
             .map(Path::to_path_buf)
             .unwrap_or_else(|| PathBuf::from("."));
         Params::from_toml(&text, &file, &base).map_err(|e| match e {
-            Error::Parse { .. } if !overrides.is_empty() => {
-                blame_override(&original, &file, &base, overrides).unwrap_or(e)
-            }
+            Error::Parse { .. } => not_a_scene(path, &file)
+                .or_else(|| {
+                    (!overrides.is_empty())
+                        .then(|| blame_override(&original, &file, &base, overrides))
+                        .flatten()
+                })
+                .unwrap_or(e),
             e => e,
         })
     }
 }
 
-/// Refuses a file that is plainly not a scene by its extension (a record, a spreadsheet, or an
-/// `.h5` that is not HDF5, since a run file would have been read as one): the TOML parser's
-/// message about its first line would mislead.
-fn not_a_scene(path: &Path, file: &str) -> Result<()> {
+/// For a file that does not parse as TOML and is plainly not a scene by its extension (a record,
+/// a spreadsheet, or an `.h5` that is not HDF5, since a run file would have been read as one), the
+/// error that says so: the TOML parser's message about its first line would mislead. (A TOML
+/// scene under another name is read as any scene.)
+fn not_a_scene(path: &Path, file: &str) -> Option<Error> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -124,12 +128,12 @@ fn not_a_scene(path: &Path, file: &str) -> Result<()> {
         "csv" | "txt" | "tsv" | "dat" | "lvm" | "xls" | "xlsx" => {
             format!("a .{ext} file is a record, not a scene")
         }
-        "h5" | "hdf5" if crate::files::is_file(path) => {
+        "h5" | "hdf5" => {
             "not an HDF5 file (no HDF5 signature), so not a run file of `shpb run -o`".into()
         }
-        _ => return Ok(()),
+        _ => return None,
     };
-    Err(Error::Input {
+    Some(Error::Input {
         file: file.to_string(),
         key: "kind".into(),
         problem: what,
