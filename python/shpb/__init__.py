@@ -130,7 +130,9 @@ class Run:
     def save(self, path: PathLike, force: bool = False) -> None:
         """Writes the run file ``shpb run -o PATH`` writes (with ``/provenance``), or for a
         reduction the file of ``shpb reduce -o PATH``; a run read by :func:`load` is copied.
-        An existing file is refused unless ``force``."""
+        An existing file is refused unless ``force``; the path is checked as the command line
+        checks an output (never an input, even with ``force``; ``-`` is not standard output
+        here), and the file is written under a temporary name, then moved into place."""
         self._data.save(os.fspath(path), force)
 
     def plot(self, path: Optional[PathLike] = None):

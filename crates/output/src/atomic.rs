@@ -3,8 +3,10 @@
 //! `--force` the move is a hard link (which fails if the name exists, so of two runs writing
 //! the same file at once exactly one succeeds) followed by removing the temporary name.
 //!
-//! The temporary files of writes in progress are registered, so that a process stopped by a
-//! signal removes them ([`remove_temporaries`]) instead of leaving `.tmp-*` files behind.
+//! The temporary files of writes in progress (`.shpb-tmp-<pid>-…`, created with `O_EXCL`) are
+//! registered, so that a process stopped by a signal removes them ([`remove_temporaries`])
+//! instead of leaving them behind. Inside an output plan ([`crate::plan`]) the moves wait until
+//! every output of the command is complete and are then made together (`commit`).
 
 use shpb_input::{Error, Result};
 use std::path::{Path, PathBuf};
