@@ -507,8 +507,19 @@ fn polarity(c: &Channel<'_>, file: &str) -> Result<()> {
     } else {
         0
     };
-    let nb = c.baseline_samples.min(n / 2);
-    let eps = crate::gauge::remove_baseline(&moving_average(v, half), nb);
+    let smoothed = moving_average(v, half);
+    let mut nb = c.baseline_samples.min(n / 2);
+    let mut eps = crate::gauge::remove_baseline(&smoothed, nb);
+    // A baseline that reaches into the pulse (a short pre-trigger) is cut to half the samples
+    // before the pulse's first half-peak crossing, as the reduction re-takes it before the foot.
+    let largest = eps.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    if let Some(k) = eps.iter().position(|e| e.abs() >= 0.5 * largest)
+        && k < nb
+        && k >= 4
+    {
+        nb = k / 2;
+        eps = crate::gauge::remove_baseline(&smoothed, nb);
+    }
     super::baseline::check_polarity(&eps, nb, c.time_s, c.name, file)
 }
 
