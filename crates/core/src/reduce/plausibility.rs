@@ -135,6 +135,20 @@ pub fn check_channels(channels: &[Channel<'_>], file: &str) -> Result<()> {
     Ok(())
 }
 
+/// Runs the channel checks of [`CHECKS`] called `names` only, in the registry's order: what a
+/// command that converts a record without reducing it needs (`shpb strain`: the record's time
+/// unit and scale, a clipped pulse; a short or pulse-less record converts as well as any).
+pub fn check_channels_named(channels: &[Channel<'_>], file: &str, names: &[&str]) -> Result<()> {
+    for check in CHECKS.iter().filter(|c| names.contains(&c.name)) {
+        if let Stage::Channel(f) = check.stage {
+            for c in channels {
+                f(c, file)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs every reduction check of [`CHECKS`] on a reduction of `file` whose specimen is `size`.
 pub fn check_reduction(reduction: &Reduction, size: SpecimenSize, file: &str) -> Result<()> {
     for check in CHECKS {
