@@ -331,11 +331,9 @@ pub fn reduce_record_file(
 ) -> Result<Reduction> {
     let rec = RawRecord::read(record)?;
     let input = record_strains(&rec, apparatus, options.baseline_samples)?;
-    reduce_named(
-        &input,
-        &ReductionSetup::from_apparatus(apparatus)?,
-        options,
-        &record.display().to_string(),
-    )
-    .map_err(Error::from)
+    let setup = ReductionSetup::from_apparatus(apparatus)?;
+    let name = record.display().to_string();
+    // Checked for plausibility first, as every record read (shpb_core::reduce::plausibility).
+    shpb_core::reduce::plausibility::check_input(&input, &setup, options, &name)?;
+    reduce_named(&input, &setup, options, &name).map_err(Error::from)
 }

@@ -96,19 +96,23 @@ pub fn strain(
     }
     // The converted record checked for plausibility as `shpb reduce` checks it (dead, clipped,
     // beyond the bars' elastic limit, inverted), before anything is written.
-    let input = shpb_core::reduce::ReductionInput {
-        time_s: rec.time_s.clone(),
-        incident_strain: gauges[0].strain.clone(),
-        transmission_strain: gauges[1].strain.clone(),
+    // The converted record checked for plausibility as far as a conversion needs: its time
+    // unit, its scale against the bars' elastic limit, a clipped pulse (a record need not hold
+    // whole pulses to be converted).
+    let channel = |k: usize| shpb_core::reduce::plausibility::Channel {
+        name: if k == 0 { "incident" } else { "transmission" },
+        time_s: &rec.time_s,
+        strain: &gauges[k].strain,
+        volts: false,
+        youngs_modulus_pa: Some(apparatus.material.youngs_modulus_pa),
+        baseline_samples: n,
+        smoothing_window_s: shpb_core::reduce::DEFAULT_SMOOTHING_S,
+        pulse_due_s: None,
     };
-    shpb_core::reduce::plausibility::check_input(
-        &input,
-        &shpb_core::reduce::ReductionSetup::from_apparatus(&apparatus)?,
-        &shpb_core::reduce::ReductionOptions {
-            baseline_samples: n,
-            ..Default::default()
-        },
+    shpb_core::reduce::plausibility::check_channels_named(
+        &[channel(0), channel(1)],
         &record.display().to_string(),
+        &["time-span", "clipped", "elastic-limit"],
     )?;
     let out = RunOutput {
         contact: None,

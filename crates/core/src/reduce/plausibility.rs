@@ -135,6 +135,20 @@ pub fn check_channels(channels: &[Channel<'_>], file: &str) -> Result<()> {
     Ok(())
 }
 
+/// Runs the channel checks of [`CHECKS`] called `names` only, in the registry's order: what a
+/// command that converts a record without reducing it needs (`shpb strain`: the record's time
+/// unit and scale, a clipped pulse; a short or pulse-less record converts as well as any).
+pub fn check_channels_named(channels: &[Channel<'_>], file: &str, names: &[&str]) -> Result<()> {
+    for check in CHECKS.iter().filter(|c| names.contains(&c.name)) {
+        if let Stage::Channel(f) = check.stage {
+            for c in channels {
+                f(c, file)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Runs every reduction check of [`CHECKS`] on a reduction of `file` whose specimen is `size`.
 pub fn check_reduction(reduction: &Reduction, size: SpecimenSize, file: &str) -> Result<()> {
     for check in CHECKS {
@@ -507,8 +521,19 @@ fn polarity(c: &Channel<'_>, file: &str) -> Result<()> {
     } else {
         0
     };
-    let nb = c.baseline_samples.min(n / 2);
-    let eps = crate::gauge::remove_baseline(&moving_average(v, half), nb);
+    let smoothed = moving_average(v, half);
+    let mut nb = c.baseline_samples.min(n / 2);
+    let mut eps = crate::gauge::remove_baseline(&smoothed, nb);
+    // A baseline that reaches into the pulse (a short pre-trigger) is cut to half the samples
+    // before the pulse's first half-peak crossing, as the reduction re-takes it before the foot.
+    let largest = eps.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    if let Some(k) = eps.iter().position(|e| e.abs() >= 0.5 * largest)
+        && k < nb
+        && k >= 4
+    {
+        nb = k / 2;
+        eps = crate::gauge::remove_baseline(&smoothed, nb);
+    }
     super::baseline::check_polarity(&eps, nb, c.time_s, c.name, file)
 }
 
