@@ -444,7 +444,29 @@ fn collision_time_step_at_0_99_runs_and_at_1_01_is_refused() {
         Params::from_toml(&text, "dt-limit.toml", Path::new("."))
     };
     let out = scene(0.99 * limit).unwrap().run().unwrap();
-    summary_finite(&out, "0.99 of the limit");
+    // At 0.99 of the limit the elastic impact takes a handful of steps and its stepped
+    // restitution comes out above 1 (the integrator's energy error, bounded below): issue 42
+    // reports it as not available with a warning saying so, never as a number above 1; every
+    // other summary is finite.
+    let e = out
+        .summary
+        .iter()
+        .find(|s| s.key == "restitution")
+        .unwrap()
+        .value;
+    assert!(
+        e <= 1.0 + shpb::scene::RESTITUTION_ROUND_OFF
+            || (e.is_nan()
+                && out
+                    .warnings
+                    .iter()
+                    .any(|w| w.contains("`restitution` is not available (NaN)"))),
+        "restitution {e}: {:?}",
+        out.warnings
+    );
+    let mut others = out.clone();
+    others.summary.retain(|s| s.key != "restitution");
+    summary_finite(&others, "0.99 of the limit");
     // The elastic law isolates the scheme: any energy change is the integrator's.
     let law = LawKind::Hertz.build(pair.contact_properties());
     let tc = hertz_tc(&pair, speed);

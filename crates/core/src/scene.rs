@@ -1200,7 +1200,7 @@ pub const RESTITUTION_ROUND_OFF: f64 = 1e-6;
 /// A restitution as reported: NaN with a warning (pushed on `warnings`) when it is above 1 by
 /// more than [`RESTITUTION_ROUND_OFF`] or negative, which no passive contact can give.
 fn physical_restitution(e: f64, what: &str, warnings: &mut Vec<String>) -> f64 {
-    if e > 1.0 + RESTITUTION_ROUND_OFF || e < 0.0 {
+    if !(0.0..=1.0 + RESTITUTION_ROUND_OFF).contains(&e) {
         warnings.push(format!(
             "`restitution` is not available (NaN): the stepped restitution {what}came out as \
              {e}, outside 0 to 1 where a passive contact keeps it (the time step or the \

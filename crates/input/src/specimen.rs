@@ -169,7 +169,7 @@ pub fn resolve_pair(
             return Err(v.error(
                 key,
                 format!("cannot read {}: no such file", path.display()),
-                "a readable pair .toml file, relative to the scene file's directory",
+                "a readable pair or material .toml file, relative to the scene file's directory",
             ));
         }
         // A material file (no [sphere1]/[sphere2] table) is the paper's 6.35 mm pair of it, as
