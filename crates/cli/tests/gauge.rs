@@ -619,7 +619,7 @@ fn gauge_file_errors_name_file_key_and_allowed_range() {
     let msg = toml_error(&second("adc_range_v = 0.1", "adc_range_v = 0.0"));
     assert_names(&msg, &["channel[1].adc_range_v", "greater than 0"]);
     let msg = toml_error(&second("sample_rate_hz = 10e6", "sample_rate_hz = -1.0"));
-    assert_names(&msg, &["channel[1].sample_rate_hz", "greater than 0"]);
+    assert_names(&msg, &["channel[1].sample_rate_hz", "100 kHz to 1 THz"]);
     let msg = toml_error(&second("seed = 3", "seed = -3"));
     assert_names(&msg, &["channel[1].seed", "0 to"]);
     let msg = toml_error(&format!("{good}\n{good}"));

@@ -546,25 +546,29 @@ fn study_draw(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Sample
 /// naming its value).
 fn study_samples(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Samples)> {
     let (inputs, samples) = study_draw(scene, plan)?;
+    let keys: Vec<&str> = inputs.iter().map(|input| input.key.as_str()).collect();
     for (i, o) in samples.overrides.iter().enumerate() {
+        // A drawn value of the wrong type (a number where the key takes a quantity with its
+        // unit): name the inputs and the sample, not the line of a scene text nobody wrote nor
+        // a command line that did not set it.
+        let drawn = |reason: &str| Error::Input {
+            file: scene.display().to_string(),
+            key: keys.join(", "),
+            problem: format!(
+                "sample {i} ({}) is not a value the scene takes: {reason}",
+                samples.labels[i].join(", ")
+            ),
+            allowed: "a distribution in the key's own form: with its unit where the key takes \
+                      one (pressure = { mean = \"12.5psi\", sd = \"0.6psi\" })"
+                .into(),
+        };
         Params::from_file_overridden(scene, o).map_err(|e| match e {
-            // A drawn value of the wrong type (a number where the key takes a quantity with its
-            // unit): name the inputs and the sample, not the line of a scene text nobody wrote.
-            Error::Parse { message, .. } => Error::Input {
-                file: scene.display().to_string(),
-                key: inputs
-                    .iter()
-                    .map(|input| input.key.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                problem: format!(
-                    "sample {i} ({}) is not a value the scene takes: {message}",
-                    samples.labels[i].join(", ")
-                ),
-                allowed: "a distribution in the key's own form: with its unit where the key \
-                          takes one (pressure = { mean = \"12.5psi\", sd = \"0.6psi\" })"
-                    .into(),
-            },
+            Error::Parse { message, .. } => drawn(&message),
+            Error::Input { key, problem, .. } if keys.contains(&key.as_str()) => drawn(
+                problem
+                    .split_once(" on the command line: ")
+                    .map_or(problem.as_str(), |(_, reason)| reason),
+            ),
             other => other,
         })?;
     }

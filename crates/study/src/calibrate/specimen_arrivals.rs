@@ -2,11 +2,8 @@
 //! no shot has the bars pressed together, the transmitted foot includes the specimen's transit,
 //! which only the shot's virtual test knows. Each shot naming its test (`scene`) is run on the
 //! set-up calibrated so far ([`super::model_scatter::simulate`]); the simulated transmitted delay
-//! moves one for one with d_T/c0, so
-//!
-//!     d_T = d_T,0 + c0 · mean(measured − simulated transmitted delay),
-//!
-//! with 1-sigma c0 · sd/√n (standard error of the mean over the n shots). Like the other
+//! moves one for one with d_T/c0, so d_T = d_T,0 + c0 · mean(measured − simulated transmitted
+//! delay), with 1-sigma c0 · sd/√n (standard error of the mean over the n shots). Like the other
 //! effective distances it absorbs any offset between the feet of the recorded and the simulated
 //! pulse shapes; it runs after the gun and the shaper, whose pulse shape it dates.
 
