@@ -135,9 +135,20 @@ class Run:
         here), and the file is written under a temporary name, then moved into place."""
         self._data.save(os.fspath(path), force)
 
-    def plot(self, path: Optional[PathLike] = None):
+    def plot(self, path: Optional[PathLike] = None, force: bool = False):
         """The figure of ``shpb run --plot``, drawn with matplotlib: force–displacement, and for
-        bar tests the gauge signals and the reduced forces. Returns the matplotlib figure."""
+        bar tests the gauge signals and the reduced forces. Returns the matplotlib figure. With
+        ``path`` the figure is saved there as the command line writes an output: an existing
+        file is refused (``FileExistsError``) unless ``force``, before anything is drawn, and the
+        file is written under a temporary name, then moved into place."""
+        if path is not None:
+            path = os.fspath(path)
+            if os.path.isdir(path):
+                raise IsADirectoryError(errno.EISDIR, f"{path}: a directory, not a file", path)
+            if os.path.lexists(path) and not force:
+                raise FileExistsError(
+                    errno.EEXIST, f"{path}: output file exists; pass force=True to overwrite it", path
+                )
         try:
             import matplotlib.pyplot as plt
         except ImportError as e:  # pragma: no cover - depends on the environment
@@ -173,7 +184,19 @@ class Run:
                 ax.legend()
         fig.tight_layout()
         if path is not None:
-            fig.savefig(os.fspath(path))
+            import tempfile
+
+            folder = os.path.dirname(os.path.abspath(path))
+            fmt = os.path.splitext(path)[1][1:] or "png"
+            fd, tmp = tempfile.mkstemp(prefix=".shpb-tmp-", suffix="." + fmt, dir=folder)
+            os.close(fd)
+            try:
+                fig.savefig(tmp, format=fmt)
+                os.replace(tmp, path)
+            except BaseException:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+                raise
         return fig
 
     def _repr_html_(self) -> str:

@@ -619,6 +619,24 @@ def test_plot_draws_the_three_panels_or_says_what_is_missing(tmp_path):
     fig = r.plot(tmp_path / "run.png")
     assert len(fig.axes) == 3
     assert (tmp_path / "run.png").stat().st_size > 0
+    # An existing figure is kept unless force=True, and nothing but the figure is left.
+    (tmp_path / "run.png").write_bytes(b"old")
+    with pytest.raises(FileExistsError, match="pass force=True"):
+        r.plot(tmp_path / "run.png")
+    assert (tmp_path / "run.png").read_bytes() == b"old"
+    r.plot(tmp_path / "run.png", force=True)
+    assert (tmp_path / "run.png").read_bytes() != b"old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.png"]
+
+
+def test_plot_refuses_an_existing_file_before_drawing(tmp_path):
+    """`Run.plot(path)` keeps an existing file unless force, whether or not matplotlib is there
+    (the check comes first, as the command line's does)."""
+    r = shpb.run("scenes/collision-ss440c-5ms.toml", fidelity="fast")
+    (tmp_path / "old.png").write_bytes(b"old")
+    with pytest.raises(FileExistsError, match="output file exists"):
+        r.plot(tmp_path / "old.png")
+    assert (tmp_path / "old.png").read_bytes() == b"old"
 
 
 def test_a_run_shows_its_summary_as_a_table_in_jupyter():

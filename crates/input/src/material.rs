@@ -207,6 +207,14 @@ pub fn resolve_with_johnson_cook(
 ) -> Result<(Material, Option<toml::Value>)> {
     match material_source(reference, base_dir, v, key)? {
         Some((text, file)) => parse(&text, &file),
+        None if base_dir.join(reference).is_dir() => Err(v.error(
+            key,
+            format!(
+                "{} is a directory, not a material file",
+                base_dir.join(reference).display()
+            ),
+            format!("{} or a path to a material .toml file", builtin_names()),
+        )),
         None => Err(v.error(
             key,
             format!("unknown material `{reference}`"),

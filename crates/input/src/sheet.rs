@@ -193,6 +193,18 @@ pub fn auto_layout(
             .flatten()
     });
     let Some((time_column, factor)) = time else {
+        // A scene or set-up given where a record goes: its first line is `key = value`.
+        if header.len() == 1 && toml::from_str::<toml::Table>(&header[0]).is_ok() {
+            return Err(Error::Input {
+                file: file.to_string(),
+                key: "record".into(),
+                problem: format!(
+                    "this is TOML (`{}`: a scene or a set-up?), not a gauge record",
+                    header[0].trim()
+                ),
+                allowed: LAYOUT_HINT.to_string(),
+            });
+        }
         return Err(fail(
             "time",
             "no time column named with its unit (`Time/s`, `/ms`, `/us`, `/µs`)".into(),

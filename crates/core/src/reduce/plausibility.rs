@@ -167,9 +167,31 @@ pub fn check_input(
     options: &super::ReductionOptions,
     file: &str,
 ) -> Result<()> {
+    // A moving average that spans a large part of the record flattens every pulse in it: the
+    // record must hold at least ten of its windows.
+    let n = input.time_s.len();
+    let span = if n >= 2 {
+        input.time_s[n - 1] - input.time_s[0]
+    } else {
+        0.0
+    };
+    if span > 0.0 && options.smoothing_window_s > 0.1 * span {
+        return Err(input_err(
+            file,
+            "smoothing_window_s",
+            format!(
+                "a moving average {} wide over a record {} long flattens every pulse in it",
+                format_si(options.smoothing_window_s, "s"),
+                format_si(span, "s")
+            ),
+            format!(
+                "0 (off) or a width of at most a tenth of the record, {} (the default is 2 µs)",
+                format_si(0.1 * span, "s")
+            ),
+        ));
+    }
     // The incident foot (the reduction's rule, on the smoothed and debiased channel) and the
     // set-up's delays say when the reflected and transmitted pulses reach their gauges.
-    let n = input.time_s.len();
     let foot_s = (n >= 2)
         .then(|| {
             let dt = (input.time_s[n - 1] - input.time_s[0]) / (n - 1) as f64;

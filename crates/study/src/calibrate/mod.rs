@@ -109,6 +109,8 @@ impl ShotData {
 
 /// What every calibration gets: the base set-up and the shots.
 pub struct Data {
+    /// The shots manifest, as named (messages name it).
+    pub source: String,
     /// The base set-up (`--bars`).
     pub base: Apparatus,
     /// The manifest's `fitted_on`.
@@ -155,6 +157,7 @@ impl Data {
             .to_string();
         let base_texts = setup_file::read_base(std::path::Path::new(&source)).ok();
         Ok(Data {
+            source: manifest.source.clone(),
             base,
             fitted_on: manifest.fitted_on.clone(),
             shots,
@@ -248,7 +251,7 @@ pub fn calibrate(data: &Data, progress: &mut dyn FnMut(&str)) -> Result<Calibrat
             .find(|n| !CALIBRATIONS.iter().any(|c| c.name() == n.as_str()))
     {
         return Err(Error::Input {
-            file: "shots manifest".into(),
+            file: data.source.clone(),
             key: "calibrate".into(),
             problem: format!("unknown calibration `{bad}`"),
             allowed: calibration_names(),
@@ -284,7 +287,7 @@ pub fn calibrate(data: &Data, progress: &mut dyn FnMut(&str)) -> Result<Calibrat
     }
     if constants.is_empty() {
         return Err(Error::Input {
-            file: "shots manifest".into(),
+            file: data.source.clone(),
             key: "shot".into(),
             problem: format!(
                 "no calibration can run on these shots: {}",

@@ -265,6 +265,7 @@ fn read_cache(path: &Path) -> Result<Vec<FoldFit>, String> {
 fn fit_fold(all: &Data, held: usize, variant: (&str, &[&str])) -> FoldFit {
     let number = SAMPLES[held].number;
     let data = Data {
+        source: all.source.clone(),
         base: all.base.clone(),
         fitted_on: format!("2013-05-22 incident records, samples 1-8 without sample {number}"),
         shots: all
