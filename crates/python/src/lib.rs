@@ -153,11 +153,18 @@ fn with_finished_rows(
     signal
 }
 
-/// FileNotFoundError (errno ENOENT) for a scene that is not a file, with the message of
-/// `shpb sweep` (python/README: a missing scene file is a `FileNotFoundError`).
+/// FileNotFoundError (errno ENOENT) for a scene that is not a file, IsADirectoryError (EISDIR) for
+/// a directory, with the message of `shpb sweep` (python/README: a missing scene file is a
+/// `FileNotFoundError`).
 fn require_scene(scene: &Path) -> PyResult<()> {
     match shpb_study::sweep::require_scene(scene) {
         Ok(()) => Ok(()),
+        // A directory is an IsADirectoryError (errno EISDIR), as `shpb.run` raises it.
+        Err(e) if scene.is_dir() => Err(pyo3::exceptions::PyIsADirectoryError::new_err((
+            21,
+            e.to_string(),
+            scene.display().to_string(),
+        ))),
         Err(e) => Err(pyo3::exceptions::PyFileNotFoundError::new_err((
             2,
             e.to_string(),
