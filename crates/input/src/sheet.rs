@@ -194,7 +194,10 @@ pub fn auto_layout(
     });
     let Some((time_column, factor)) = time else {
         // A scene or set-up given where a record goes: its first line is `key = value`.
-        if header.len() == 1 && toml::from_str::<toml::Table>(&header[0]).is_ok() {
+        if header.len() == 1
+            && header[0].contains('=')
+            && toml::from_str::<toml::Table>(&header[0]).is_ok()
+        {
             return Err(Error::Input {
                 file: file.to_string(),
                 key: "record".into(),

@@ -168,7 +168,11 @@ pub fn resolve_pair(
         if !crate::files::is_file(&path) {
             return Err(v.error(
                 key,
-                format!("cannot read {}: no such file", path.display()),
+                format!(
+                    "cannot read {}: {}",
+                    path.display(),
+                    crate::files::not_a_file(&path)
+                ),
                 "a readable pair or material .toml file, relative to the scene file's directory",
             ));
         }

@@ -73,16 +73,7 @@ fn detached<T: Send>(
     let result = py.allow_threads(|| std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
     match result {
         Ok(r) => r.map_err(py_err),
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown panic".into());
-            Err(PyRuntimeError::new_err(format!(
-                "shpb: internal error (please report it): {what}"
-            )))
-        }
+        Err(panic) => Err(internal_error(panic)),
     }
 }
 
@@ -120,16 +111,7 @@ fn interruptible<T: Send>(
     });
     match joined.and_then(|r| r) {
         Ok(r) => Ok((r.map_err(py_err)?, signal)),
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown panic".into());
-            Err(PyRuntimeError::new_err(format!(
-                "shpb: internal error (please report it): {what}"
-            )))
-        }
+        Err(panic) => Err(internal_error(panic)),
     }
 }
 
@@ -151,6 +133,16 @@ fn with_finished_rows(
     }
     let _ = value.setattr("finished", rows.len());
     signal
+}
+
+/// A panic caught in a run as a Python RuntimeError naming it (never a crash of the interpreter).
+fn internal_error(panic: Box<dyn std::any::Any + Send>) -> PyErr {
+    let what = panic
+        .downcast_ref::<String>()
+        .cloned()
+        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+        .unwrap_or_else(|| "unknown panic".into());
+    PyRuntimeError::new_err(format!("shpb: internal error (please report it): {what}"))
 }
 
 /// FileNotFoundError (errno ENOENT) for a scene that is not a file, IsADirectoryError (EISDIR) for

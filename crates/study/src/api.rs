@@ -623,7 +623,15 @@ pub fn reduce_record_with(
     let name = record.display().to_string();
     // The record checked for plausibility before it is reduced, and what the reduction made of
     // it against the specimen (shpb_core::reduce::plausibility).
-    shpb_core::reduce::plausibility::check_input(&input, &setup, &options, &name)?;
+    shpb_core::reduce::plausibility::check_input(&input, &setup, &options, &name).map_err(|e| {
+        match e {
+            // A check on a reduction option names its flag.
+            shpb_core::Error::Invalid { ref quantity, .. } if quantity == "smoothing_window_s" => {
+                flag_err(e)
+            }
+            other => other.into(),
+        }
+    })?;
     let reduction = shpb_core::reduce::reduce_named(&input, &setup, &options, &name)?;
     shpb_core::reduce::plausibility::check_reduction(
         &reduction,
