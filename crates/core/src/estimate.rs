@@ -199,12 +199,7 @@ pub fn bar_run(
         .map_or(0.0, |k| (steps / k as f64).floor());
     let snapshot_bytes = snapshots * (snapshot_points * F64 + bars * 32.0 + F64) * 1.25;
     // The records digitised at the channels' rate, their post-processing and the reduction.
-    let rate = apparatus
-        .gauges
-        .channels
-        .iter()
-        .map(|c| c.digitiser.sample_rate_hz)
-        .fold(0.0, f64::max);
+    let rate = apparatus.gauges.max_sample_rate_hz();
     let digitised = (options.end_time_s * rate).floor();
     let post = digitised * F64 * (DIGITISED_SERIES + 3.0 * gauges);
     let reduction = if specimen.is_some() {

@@ -332,6 +332,15 @@ impl GaugeSetup {
     pub fn channel(&self, name: &str) -> Option<&GaugeChannel> {
         self.channels.iter().find(|c| c.name == name)
     }
+
+    /// The fastest channel's sample rate, Hz (0 without channels): what sets how many samples
+    /// a run records.
+    pub fn max_sample_rate_hz(&self) -> f64 {
+        self.channels
+            .iter()
+            .map(|c| c.digitiser.sample_rate_hz)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// A raw two-channel gauge record in the authors' CSV format (`# ` comments, header

@@ -486,12 +486,7 @@ pub(super) fn parse_bars(
         shpb_core::solver::Body::new(spec, cell / c0).map_err(v.core("cell_size_m"))?;
     }
     // Issue 42: an end time shorter than a few samples ran to NaN summaries with exit 0.
-    let rate = apparatus
-        .gauges
-        .channels
-        .iter()
-        .map(|c| c.digitiser.sample_rate_hz)
-        .fold(0.0, f64::max);
+    let rate = apparatus.gauges.max_sample_rate_hz();
     let shortest = (MIN_RUN_SAMPLES / rate).max(MIN_RUN_SAMPLES * chain.dt_s);
     if end_time_s < shortest {
         return Err(v.error(
