@@ -117,13 +117,18 @@ pub fn with_value(text: &str, file: &str, key: &str, value: f64) -> Result<Strin
     })
 }
 
+/// The built-in set-up's name when `apparatus_source` (`Apparatus::source`) is one
+/// (`built-in set-up `authors``), else None (a set-up file's path).
+pub fn builtin_setup_name(apparatus_source: &str) -> Option<&str> {
+    apparatus_source
+        .strip_prefix("built-in set-up `")
+        .and_then(|s| s.strip_suffix('`'))
+}
+
 /// The name under which a set-up's text is among a run's inputs (`shpb_input::files`): its path
 /// as read, or `built-in:<name>` for a built-in set-up (`Apparatus::source` of either).
 pub fn input_name(apparatus_source: &str) -> String {
-    match apparatus_source
-        .strip_prefix("built-in set-up `")
-        .and_then(|s| s.strip_suffix('`'))
-    {
+    match builtin_setup_name(apparatus_source) {
         Some(name) => format!("built-in:{name}"),
         None => apparatus_source.to_string(),
     }

@@ -149,13 +149,10 @@ impl Data {
                 arrivals,
             });
         }
-        let source = base
-            .source
-            .strip_prefix("built-in set-up `")
-            .and_then(|s| s.strip_suffix('`'))
-            .unwrap_or(&base.source)
-            .to_string();
-        let base_texts = setup_file::read_base(std::path::Path::new(&source)).ok();
+        // A built-in set-up is read again by its name, a file by its path.
+        let source =
+            shpb_input::uncertainty::builtin_setup_name(&base.source).unwrap_or(&base.source);
+        let base_texts = setup_file::read_base(std::path::Path::new(source)).ok();
         Ok(Data {
             source: manifest.source.clone(),
             base,
