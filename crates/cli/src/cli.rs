@@ -179,7 +179,8 @@ pub struct Jobs {
         short = 'j',
         long = "jobs",
         default_value_t = 1,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        value_parser = whole_number::<usize>("1 up to 4 worker threads per core of the machine")
     )]
     pub jobs: usize,
 }
@@ -731,6 +732,14 @@ fn usage_error(e: &clap::Error) -> i32 {
             );
             2
         }
+        ErrorKind::InvalidUtf8 => {
+            // clap names neither the argument nor the option: name both.
+            eprintln!(
+                "shpb: error: {}",
+                invalid_utf8_argument(std::env::args_os())
+            );
+            2
+        }
         _ => {
             // Rust's parse errors name no range: say what a value of the option looks like.
             let text = e
@@ -753,6 +762,29 @@ fn usage_error(e: &clap::Error) -> i32 {
             2
         }
     }
+}
+
+/// The message for a command line with an argument that is not UTF-8: which argument, after
+/// which option, shown lossily, and what is allowed (file names of scenes, records and outputs
+/// may be any bytes; values and names of built-ins are text).
+fn invalid_utf8_argument(args: impl Iterator<Item = std::ffi::OsString>) -> String {
+    let args: Vec<std::ffi::OsString> = args.collect();
+    let Some(i) = args.iter().position(|a| a.to_str().is_none()) else {
+        return "an argument is not valid UTF-8; allowed: UTF-8 text".to_string();
+    };
+    let shown = args[i].to_string_lossy();
+    let option = args[..i]
+        .iter()
+        .rev()
+        .take(1)
+        .filter_map(|a| a.to_str())
+        .find(|a| a.starts_with('-'))
+        .map(|o| format!(" (the value of `{o}`)"))
+        .unwrap_or_default();
+    format!(
+        "argument {i} `{shown}`{option} is not valid UTF-8; allowed: UTF-8 text for option \
+         values, names and keys (file names of scenes, records and outputs may be any bytes)"
+    )
 }
 
 /// Runs one parsed command.

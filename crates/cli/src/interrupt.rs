@@ -61,7 +61,7 @@ pub fn install() {
 /// Removes the temporary files, says what stopped and exits with 128 + `signal`.
 fn stop(signal: libc::c_int) -> ! {
     // Held until exit: no write is renamed into place after its temporary file is gone.
-    let _writes = shpb_output::atomic::remove_temporaries();
+    let writes = shpb_output::atomic::remove_temporaries();
     let name = if signal == libc::SIGTERM {
         "SIGTERM"
     } else {
@@ -81,6 +81,11 @@ fn stop(signal: libc::c_int) -> ! {
     match message {
         Some(m) => eprintln!("{start}shpb: stopped by {name}; {m}"),
         None => eprintln!("{start}shpb: stopped by {name}"),
+    }
+    // A writer on another thread may have created its temporary file again since the first
+    // removal (it had the name before the lock was taken): removed once more, last thing.
+    for tmp in writes.iter() {
+        let _ = std::fs::remove_file(tmp);
     }
     // `_exit`, not `exit`: the exit handlers (the HDF5 library's among them) must not run while
     // another thread may be inside the library. Lines on stdout are flushed as they are printed.

@@ -34,7 +34,7 @@ pub mod waves;
 pub mod windows;
 
 pub use align::{Alignment, AlignmentReport};
-pub use baseline::record_strains;
+pub use baseline::{beyond_digitiser_range, record_strains};
 pub use correction::{
     BANCROFT_FIT, BANCROFT_FIT_POISSON_RATIO, DispersionCorrection, TYAS_POPE_CUTOFF_FA_OVER_C0,
     bancroft_phase_velocity_m_s, bancroft_velocity_ratio, dispersion_delay_s, dispersion_shift,

@@ -482,6 +482,42 @@ pub fn assemble(channels: &[(Role, ChannelFile)]) -> Result<RawRecord> {
             ));
         }
     }
+    // A gauge read from several files is the mean of them: a clipped file among them would be
+    // hidden by the others (a peak rounded instead of flat), a dead one would halve the pulse.
+    // So each file of such a gauge is checked alone first: clipped always, dead when another
+    // file of the gauge is alive (issue 42; the mean record is checked as a whole later).
+    use shpb_core::reduce::plausibility::{Channel, check_channels_named};
+    let alone = |role: Role, c: &ChannelFile, check: &str| {
+        let channel = Channel {
+            name: role.name(),
+            time_s: &c.time_s,
+            strain: &c.value_v,
+            volts: true,
+            youngs_modulus_pa: None,
+            baseline_samples: 0,
+            smoothing_window_s: 0.0,
+            pulse_due_s: None,
+        };
+        check_channels_named(&[channel], &c.source, &[check])
+    };
+    for (role, _) in Role::ALL {
+        let of: Vec<&ChannelFile> = channels
+            .iter()
+            .filter(|(r, _)| *r == role)
+            .map(|(_, c)| c)
+            .collect();
+        if of.len() < 2 {
+            continue;
+        }
+        for c in &of {
+            alone(role, c, "clipped")?;
+        }
+        if of.iter().any(|c| alone(role, c, "dead-channel").is_ok()) {
+            for c in &of {
+                alone(role, c, "dead-channel")?;
+            }
+        }
+    }
     let mean = |role: Role| -> Vec<f64> {
         let of: Vec<&ChannelFile> = channels
             .iter()
@@ -606,6 +642,61 @@ mod tests {
             e.contains("late.csv") && e.contains("Horizontal Offset"),
             "{e}"
         );
+    }
+
+    /// A pulse of `n` samples with a little alternating noise, its top cut at `rail` V.
+    fn pulse_file(name: &str, n: usize, rail: f64) -> ChannelFile {
+        let dt = 1e-7;
+        let value_v: Vec<f64> = (0..n)
+            .map(|k| {
+                let x = (k as f64 - n as f64 / 2.0) / (n as f64 / 10.0);
+                let noise = if k % 2 == 0 { 1e-4 } else { -1e-4 };
+                ((-x * x).exp() + noise).min(rail)
+            })
+            .collect();
+        ChannelFile {
+            source: name.into(),
+            sample_interval_s: dt,
+            trigger_point: None,
+            trigger_time_s: None,
+            horizontal_offset_s: 0.0,
+            time_s: (0..n).map(|k| k as f64 * dt).collect(),
+            value_v,
+        }
+    }
+
+    #[test]
+    fn a_clipped_or_dead_file_among_averaged_files_is_named() {
+        // Averaged with an unclipped opposite gauge, the flat top sits at half height, not at
+        // the mean channel's extreme: only the file alone shows it.
+        let good = pulse_file("ch1.csv", 400, 2.0);
+        let clipped = pulse_file("ch2.csv", 400, 0.6);
+        let other = pulse_file("ch3.csv", 400, 2.0);
+        let e = assemble(&[
+            (Role::Incident, good.clone()),
+            (Role::Incident, clipped),
+            (Role::Transmission, other.clone()),
+        ])
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("ch2.csv") && e.contains("clipped"), "{e}");
+        let mut dead = good.clone();
+        dead.source = "dead.csv".into();
+        dead.value_v.iter_mut().for_each(|v| *v = 0.0);
+        let e = assemble(&[
+            (Role::Incident, good.clone()),
+            (Role::Incident, dead),
+            (Role::Transmission, other.clone()),
+        ])
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("dead.csv") && e.contains("dead"), "{e}");
+        assemble(&[
+            (Role::Incident, good.clone()),
+            (Role::Incident, good),
+            (Role::Transmission, other),
+        ])
+        .unwrap();
     }
 
     #[test]

@@ -23,10 +23,12 @@ fn temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
 /// Removes the temporary file of every write in progress and returns a guard that keeps any
 /// write from being moved into place (or a new one from starting) while it is held: what a
 /// process stopped by SIGINT/SIGTERM calls just before it exits, so that it leaves neither a
-/// temporary file nor a half-finished output.
+/// temporary file nor a half-finished output. The guard still lists the names removed: a writer
+/// on another thread (the HDF5 library's create, say) may make its file again after the
+/// removal, so the caller removes them once more just before it exits.
 pub fn remove_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
-    let mut held = temporaries();
-    for tmp in held.drain(..) {
+    let held = temporaries();
+    for tmp in held.iter() {
         let _ = std::fs::remove_file(tmp);
     }
     held

@@ -181,6 +181,16 @@ pub fn parse_target(spec: &str) -> Result<Target> {
             "a non-zero value (the tolerance is relative to it)",
         ));
     }
+    // A ratio of magnitudes and a time from the start cannot be negative: refused here, before
+    // any run, instead of bracketed and found unreachable (issue 42).
+    let name = SUMMARY_COLUMNS[quantity].0;
+    if value_si < 0.0 && matches!(name, "equilibrium_ratio_at_peak" | "time_to_equilibrium") {
+        return Err(crate::api::input_err(
+            "--target",
+            format!("`{spec}`: {name} cannot be negative"),
+            "a positive value",
+        ));
+    }
     Ok(Target {
         quantity,
         value_si,

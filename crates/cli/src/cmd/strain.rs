@@ -74,6 +74,14 @@ pub fn strain(
             allowed: format!("0 to {half} samples for this record"),
         });
     }
+    for (name, volts) in [
+        ("incident", &rec.incident_v),
+        ("transmission", &rec.transmission_v),
+    ] {
+        if let Some(ch) = apparatus.gauges.channel(name) {
+            shpb_core::reduce::beyond_digitiser_range(ch, volts, &apparatus.source)?;
+        }
+    }
     let n = read_as.baseline_samples;
     rec.incident_v = shpb_core::gauge::remove_baseline(&rec.incident_v, n);
     rec.transmission_v = shpb_core::gauge::remove_baseline(&rec.transmission_v, n);
@@ -94,8 +102,6 @@ pub fn strain(
             voltage_v: volts.clone(),
         });
     }
-    // The converted record checked for plausibility as `shpb reduce` checks it (dead, clipped,
-    // beyond the bars' elastic limit, inverted), before anything is written.
     // The converted record checked for plausibility as far as a conversion needs: its time
     // unit, its scale against the bars' elastic limit, a clipped pulse (a record need not hold
     // whole pulses to be converted).

@@ -5,7 +5,7 @@
 use super::{ReductionInput, ReductionOptions, channel, input_err, quality};
 use crate::apparatus::Apparatus;
 use crate::error::Result;
-use crate::gauge::RawRecord;
+use crate::gauge::{GaugeChannel, RawRecord};
 use crate::numeric::moving_average;
 
 /// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
@@ -162,11 +162,45 @@ pub fn record_strains(
             ));
         }
     }
+    for (c, v) in [(inc, &record.incident_v), (tra, &record.transmission_v)] {
+        beyond_digitiser_range(c, v, &apparatus.source)?;
+    }
     Ok(ReductionInput {
         time_s: record.time_s.clone(),
         incident_strain: inc.strains_from_voltages(&debias(&record.incident_v, n)),
         transmission_strain: tra.strains_from_voltages(&debias(&record.transmission_v, n)),
     })
+}
+
+/// Refuses a recorded voltage beyond the full scale ±`range_v` of the channel's digitiser (one
+/// quantisation step of margin): no sample of that digitiser can read it, so the record is not
+/// in this channel's volts (millivolts, another set-up's gauges, a strain file read as volts).
+pub fn beyond_digitiser_range(c: &GaugeChannel, v: &[f64], source: &str) -> Result<()> {
+    let d = &c.digitiser;
+    let limit = d.range_v + d.quantisation_step_v();
+    let Some((k, &x)) = v
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.is_finite())
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+    else {
+        return Ok(());
+    };
+    if x.abs() <= limit {
+        return Ok(());
+    }
+    Err(crate::error::Named::new(source.to_string()).error(
+        "adc_range_v",
+        format!(
+            "the {} record reaches {x} V (sample {k}), beyond the ±{} V full scale of the \
+             channel's digitiser: no sample of it can read that, so the record is not in this \
+             channel's volts",
+            c.name, d.range_v
+        ),
+        "a record in volts within the channel's digitiser range (`adc_range_v`): check the \
+         record's unit (mV is 1000 times V), that the set-up's gauges are the ones it was \
+         taken with, and the gauge file's `adc_range_v`",
+    ))
 }
 
 /// The two strain records after the first stage: smoothed, baselines removed, polarity checked
@@ -254,5 +288,43 @@ mod tests {
         let mut pulse = noise.clone();
         pulse[1500] = 1e-3;
         assert_eq!(first_pulse(&pulse, 900), Some((1500, 1e-3)));
+    }
+
+    #[test]
+    fn volts_beyond_the_digitiser_full_scale_are_refused() {
+        use crate::gauge::{Bridge, BridgeKind, Digitiser};
+        // The authors' channel: 12 bits over ±0.11166 V.
+        let c = GaugeChannel {
+            name: "incident".into(),
+            bar: "incident".into(),
+            distance_from_specimen_m: 0.644525,
+            bridge: Bridge {
+                kind: BridgeKind::FullPoisson,
+                gauge_factor: 2.12,
+                excitation_v: 15.0,
+                poisson_ratio: 0.31,
+                strain_per_volt: 0.0,
+            },
+            amplifier_gain: 2.0,
+            polarity: 1.0,
+            digitiser: Digitiser {
+                sample_rate_hz: 10e6,
+                bits: 12,
+                range_v: 0.11166,
+                noise_rms_v: 1.57e-4,
+                seed: 1,
+            },
+        };
+        // A sample at the last code of full scale is a reading; a pulse in mV under a volts
+        // header (19.6 V for 19.6 mV) is not.
+        let q = c.digitiser.quantisation_step_v();
+        assert!(beyond_digitiser_range(&c, &[0.0, -0.11166, 0.11166 - q], "s.toml").is_ok());
+        let e = beyond_digitiser_range(&c, &[0.0, 19.63, f64::NAN], "s.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("19.63") && e.contains("±0.11166 V") && e.contains("adc_range_v"),
+            "{e}"
+        );
     }
 }
