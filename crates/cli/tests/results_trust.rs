@@ -214,6 +214,36 @@ fn the_other_kinds_estimate_the_samples_they_keep() {
     }
 }
 
+/// A bar run's output estimate against the HDF5 file it writes (`shpb run -o`), over the pulse,
+/// sphere and cylinder scenes shipped. Stated tolerance: the estimate bounds the file (it is
+/// compared with the free disk before a run, issue 42) and is at most 1.5 times it (the
+/// reduction's series are counted at the record's length, the window is shorter).
+#[test]
+fn a_bar_run_s_output_estimate_bounds_its_file() {
+    for file in [
+        "pulse-10psi.toml",
+        "shpb-ss440c-10psi.toml",
+        "shpb-cylinder-copper.toml",
+    ] {
+        let dir = TempDir::new().unwrap();
+        let e = Params::from_file(&scene(file)).unwrap().estimate();
+        let s = scene(file).display().to_string();
+        let out = shpb(dir.path(), &["run", s.as_str(), "-q", "-o", "r.h5"]);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let size = std::fs::metadata(dir.path().join("r.h5")).unwrap().len() as f64;
+        println!(
+            "{file}: estimate {:.0} B, file {size:.0} B, ratio {:.3}",
+            e.output_bytes,
+            e.output_bytes / size
+        );
+        assert!(e.output_bytes >= size, "{file}: estimate below the file");
+        assert!(
+            e.output_bytes <= 1.5 * size,
+            "{file}: estimate over 1.5 times the file"
+        );
+    }
+}
+
 /// A collision of 2e6 steps per Hertz contact time: its memory estimate against the data the
 /// run keeps (its contact series, 5 numbers a step). Stated tolerance: the estimate bounds it
 /// and is at most 10 times it (3 contact times where ≈ 1 is taken, times 3 for a series that
