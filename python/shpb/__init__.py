@@ -22,6 +22,7 @@ import errno
 import functools
 import html
 import os
+import time
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -535,7 +536,15 @@ def sweep(
     if client is None:
         keys, rows = _interruptible(_sweep_shard, path, specs, int(jobs), 1, 1)
     else:
-        parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+        try:
+            parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+        except KeyboardInterrupt as e:
+            done = getattr(e, "parts", [])
+            if done:
+                rows = [r for _, part in done for r in part]
+                e.table = Table(_shpb.sweep_table(done[0][0], rows, True))
+                e.finished = len(rows)
+            raise
         keys = parts[0][0]
         rows = [r for _, part in parts for r in part]
     return Table(_shpb.sweep_table(keys, rows))
@@ -610,7 +619,12 @@ def study(
     if client is None:
         rows = _interruptible(_study_shard, *args, 1, 1)
     else:
-        rows = [r for part in _on_cluster(client, _study_shard, shards, *args) for r in part]
+        try:
+            parts = _on_cluster(client, _study_shard, shards, *args)
+        except KeyboardInterrupt as e:
+            e.finished = sum(len(p) for p in getattr(e, "parts", []))
+            raise
+        rows = [r for part in parts for r in part]
     return Study(
         _shpb.study_table(path, int(samples), int(seed), bool(gun_scatter), rows, fidelity)
     )
@@ -659,4 +673,15 @@ def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List
     if n < 1:
         raise InputError(f"shards: {shards} (allowed: a whole number ≥ 1)")
     futures = [client.submit(fn, *args, k, n, pure=False) for k in range(1, n + 1)]
+    try:
+        # Polled, not a blocking gather: Ctrl-C is seen within 20 ms, not when a shard ends.
+        while not all(f.done() for f in futures):
+            time.sleep(0.02)
+    except KeyboardInterrupt as e:
+        # The shards not finished are cancelled (a shard already running on a worker runs to
+        # its end there: Dask cannot stop a running task); the finished ones are kept, in
+        # shard order, as ``e.parts``.
+        client.cancel([f for f in futures if not f.done()])
+        e.parts = [f.result() for f in futures if f.done() and f.status == "finished"]
+        raise
     return list(client.gather(futures))

@@ -60,7 +60,7 @@ def sweep_runs(
     scene: str, set: Sequence[str], jobs: int = 1, shard: Tuple[int, int] = (1, 1)
 ) -> Tuple[List[str], Rows]: ...
 def sweep_table(
-    keys: List[str], rows: Rows
+    keys: List[str], rows: Rows, partial: bool = False
 ) -> Tuple[
     List[str],
     List[List[str]],

@@ -782,12 +782,16 @@ fn sweep_runs(
 }
 
 /// The table of a sweep over `keys` from the rows of all its shards (`sweep_runs`), in sweep
-/// order; an input error unless they hold every run exactly once.
+/// order; an input error unless they hold every run exactly once (`partial`: the rows of the
+/// shards that finished before a Ctrl-C, each run at most once).
 #[pyfunction]
-fn sweep_table(keys: Vec<String>, rows: StudyRows) -> PyResult<SweepTable> {
+#[pyo3(signature = (keys, rows, partial = false))]
+fn sweep_table(keys: Vec<String>, rows: StudyRows, partial: bool) -> PyResult<SweepTable> {
     let mut rows = arrived(rows);
     rows.sort_by_key(|r| r.index);
-    if rows.iter().enumerate().any(|(i, r)| r.index != i) {
+    let exactly_once = rows.iter().enumerate().all(|(i, r)| r.index == i);
+    let at_most_once = rows.windows(2).all(|w| w[0].index < w[1].index);
+    if !(if partial { at_most_once } else { exactly_once }) {
         return Err(input_error(
             "shards",
             format!(
