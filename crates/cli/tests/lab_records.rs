@@ -555,8 +555,8 @@ fn the_batch_report_of_yaos_records_shows_each_records_windows_and_verdict() {
             let reason = &row[col("verdict_reason")];
             let verdict = &row[col("equilibrium_verdict")];
             assert!(
-                reason.starts_with("geometric alignment placed the windows")
-                    && reason.contains("with a delay given by hand")
+                reason.starts_with("the windows were set by hand, reflected +")
+                    && reason.contains("(geometric alignment would give +")
                     && reason.contains("R = |F_front − F_back|/F_3wave averages")
                     && reason.contains("against the 0.05 criterion"),
                 "{reason}"

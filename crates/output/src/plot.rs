@@ -1217,86 +1217,6 @@ pub fn loglog_plot(
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tick_labels_read_as_a_person_writes_them() {
-        assert_eq!(tick(0.1 + 0.2), "0.3");
-        assert_eq!(tick(-0.0), "0");
-        assert_eq!(tick(250.0), "250");
-        assert_eq!(tick(1.5e-7), "0.00000015");
-        assert_eq!(tick(123456.0), "123456");
-        assert_eq!(three_digits(12.3456), "12.3");
-        assert_eq!(three_digits(0.045678), "0.0457");
-        assert_eq!(three_digits(1234.5), "1230");
-        assert_eq!(three_digits(-7.0), "-7");
-    }
-
-    #[test]
-    fn a_polyline_is_cut_where_it_turns_back() {
-        let px = |p: &(f64, f64)| (p.0 as i32, p.1 as i32);
-        // Up, a right-angle turn (kept), a repeated pixel (skipped), then back down.
-        let pts = [
-            (0.0, 0.0),
-            (10.0, 0.0),
-            (10.0, 10.0),
-            (10.2, 10.4),
-            (9.0, 0.0),
-        ];
-        let runs = unreversed_runs(&pts, px);
-        assert_eq!(
-            runs,
-            vec![
-                vec![(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
-                vec![(10.0, 10.0), (9.0, 0.0)]
-            ]
-        );
-        assert_eq!(unreversed_runs(&[], px), Vec::<Vec<(f64, f64)>>::new());
-    }
-
-    #[test]
-    fn the_x_t_diagram_has_a_colour_bar_from_compression_to_tension() {
-        let dir = tempfile::TempDir::new().unwrap();
-        let path = dir.path().join("xt.png");
-        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.01).collect();
-        let t: Vec<f64> = (1..=40).map(|k| k as f64 * 1e-6).collect();
-        let rows: Vec<Vec<f64>> = t
-            .iter()
-            .map(|&tk| {
-                x.iter()
-                    .map(|&xi| 1e8 * ((xi - 3e4 * tk) * 20.0).sin())
-                    .collect()
-            })
-            .collect();
-        let field = Field {
-            x_m: &x,
-            time_s: &t,
-            stress_pa: &rows,
-        };
-        let panel = || {
-            let axes = Axes {
-                title: "t",
-                x_label: "x",
-                y_label: "y",
-                x_scale: 1.0,
-                y_scale: 1.0,
-            };
-            (axes, vec![curve("c", &x, &x)])
-        };
-        let panels = [panel(), panel()];
-        test_figure(&path, false, &panels, &[field]).unwrap();
-        let img = image::open(&path).unwrap().to_rgb8();
-        // The colour bar sits in the last 130 px of the bottom panel: its column holds
-        // saturated blue (compression) and saturated red (tension).
-        let (w, h) = img.dimensions();
-        let column: Vec<[u8; 3]> = (620..h).map(|y| img.get_pixel(w - 60, y).0).collect();
-        assert!(column.iter().any(|p| p[2] == 255 && p[0] < 40), "no blue");
-        assert!(column.iter().any(|p| p[0] == 255 && p[2] < 40), "no red");
-    }
-}
-
 /// The balance residual a reduction's verdict weighs, signed: (F_front − F_back) / F_3wave with
 /// the equilibrium ratio's floor (docs/physics.md §7.7), shown within ±1.
 pub fn balance_residual(r: &shpb_core::reduce::Reduction) -> Vec<f64> {
@@ -1447,4 +1367,84 @@ pub fn window_panels<'a>(
             },
         ),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels_read_as_a_person_writes_them() {
+        assert_eq!(tick(0.1 + 0.2), "0.3");
+        assert_eq!(tick(-0.0), "0");
+        assert_eq!(tick(250.0), "250");
+        assert_eq!(tick(1.5e-7), "0.00000015");
+        assert_eq!(tick(123456.0), "123456");
+        assert_eq!(three_digits(12.3456), "12.3");
+        assert_eq!(three_digits(0.045678), "0.0457");
+        assert_eq!(three_digits(1234.5), "1230");
+        assert_eq!(three_digits(-7.0), "-7");
+    }
+
+    #[test]
+    fn a_polyline_is_cut_where_it_turns_back() {
+        let px = |p: &(f64, f64)| (p.0 as i32, p.1 as i32);
+        // Up, a right-angle turn (kept), a repeated pixel (skipped), then back down.
+        let pts = [
+            (0.0, 0.0),
+            (10.0, 0.0),
+            (10.0, 10.0),
+            (10.2, 10.4),
+            (9.0, 0.0),
+        ];
+        let runs = unreversed_runs(&pts, px);
+        assert_eq!(
+            runs,
+            vec![
+                vec![(0.0, 0.0), (10.0, 0.0), (10.0, 10.0)],
+                vec![(10.0, 10.0), (9.0, 0.0)]
+            ]
+        );
+        assert_eq!(unreversed_runs(&[], px), Vec::<Vec<(f64, f64)>>::new());
+    }
+
+    #[test]
+    fn the_x_t_diagram_has_a_colour_bar_from_compression_to_tension() {
+        let dir = tempfile::TempDir::new().unwrap();
+        let path = dir.path().join("xt.png");
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 0.01).collect();
+        let t: Vec<f64> = (1..=40).map(|k| k as f64 * 1e-6).collect();
+        let rows: Vec<Vec<f64>> = t
+            .iter()
+            .map(|&tk| {
+                x.iter()
+                    .map(|&xi| 1e8 * ((xi - 3e4 * tk) * 20.0).sin())
+                    .collect()
+            })
+            .collect();
+        let field = Field {
+            x_m: &x,
+            time_s: &t,
+            stress_pa: &rows,
+        };
+        let panel = || {
+            let axes = Axes {
+                title: "t",
+                x_label: "x",
+                y_label: "y",
+                x_scale: 1.0,
+                y_scale: 1.0,
+            };
+            (axes, vec![curve("c", &x, &x)])
+        };
+        let panels = [panel(), panel()];
+        test_figure(&path, false, &panels, &[field]).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        // The colour bar sits in the last 130 px of the bottom panel: its column holds
+        // saturated blue (compression) and saturated red (tension).
+        let (w, h) = img.dimensions();
+        let column: Vec<[u8; 3]> = (620..h).map(|y| img.get_pixel(w - 60, y).0).collect();
+        assert!(column.iter().any(|p| p[2] == 255 && p[0] < 40), "no blue");
+        assert!(column.iter().any(|p| p[0] == 255 && p[2] < 40), "no red");
+    }
 }

@@ -306,7 +306,8 @@ pub fn verdict_reason(r: &super::Reduction) -> String {
             .map_or(dt, |m| m - a.geometric_transmitted_delay_s),
         _ => 0.0,
     };
-    let by_hand = (dr - strategy_r).abs() > 0.05e-6 || (dt - strategy_t).abs() > 0.05e-6;
+    // A delay given by hand differs from the strategy's by more than rounding (1 ns).
+    let by_hand = (dr - strategy_r).abs() > 1e-9 || (dt - strategy_t).abs() > 1e-9;
     let alignment = match a.strategy {
         super::Alignment::Geometric => format!(
             "geometric alignment placed the windows by the stated gauge distances (reflected +{}, \
@@ -333,7 +334,15 @@ pub fn verdict_reason(r: &super::Reduction) -> String {
         ),
     };
     let alignment = if by_hand {
-        format!("{alignment}, with a delay given by hand")
+        format!(
+            "the windows were set by hand, reflected +{} and transmitted +{} after the incident \
+             foot ({} alignment would give +{} and +{})",
+            us(w.reflected_delay_s),
+            us(w.transmitted_delay_s),
+            a.strategy.name(),
+            us(a.geometric_reflected_delay_s + strategy_r),
+            us(a.geometric_transmitted_delay_s + strategy_t)
+        )
     } else {
         alignment
     };
