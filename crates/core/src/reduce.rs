@@ -41,6 +41,7 @@ pub use correction::{
     dispersion_shift_exact,
 };
 pub use options::{DEFAULT_BALANCE_BOUND_S, MAX_BALANCE_BOUND_S, ReductionOptions};
+pub use quality::{EquilibriumDetail, equilibrium_detail, verdict_reason};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
 pub use specimen::{PAPER_SPHERE_RADII_M, ReducedSpecimen};
 pub use waves::{ImpliedIncident, implied_incident};
@@ -189,6 +190,21 @@ pub struct Reduction {
     pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
+    /// The two gauge records the windows were cut from, conditioned (smoothed, debiased) on the
+    /// record's clock: what `--plot` places the windows on.
+    pub record: RecordTrace,
+}
+
+/// The gauge strains a reduction cut its windows from, on the record's clock (docs/physics.md
+/// §7.3, "Windows" 1–3: smoothed and debiased as the first stage leaves them).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RecordTrace {
+    /// Sample times, s (the record's clock).
+    pub time_s: Vec<f64>,
+    /// Incident-gauge strain (incident and reflected pulses), tension positive.
+    pub incident_strain: Vec<f64>,
+    /// Transmission-gauge strain, tension positive.
+    pub transmission_strain: Vec<f64>,
 }
 
 /// The arrivals of a record's pulses by the rule of the reduction's measured delays
@@ -359,7 +375,12 @@ pub fn reduce_named(
     let strain_rate_per_s = options
         .specimen_radii_m
         .map(|radii| specimen::sphere_strain_rate(&waves.faces.approach_velocity_m_s, radii));
-    Ok(Reduction::assemble(
+    let record = RecordTrace {
+        time_s: input.time_s.clone(),
+        incident_strain: strains.incident.clone(),
+        transmission_strain: strains.transmission.clone(),
+    };
+    let reduction = Reduction::assemble(
         strains.dt,
         setup,
         options,
@@ -368,7 +389,11 @@ pub fn reduce_named(
         quality,
         strain_rate_per_s,
         warnings,
-    ))
+    );
+    Ok(Reduction {
+        record,
+        ..reduction
+    })
 }
 
 impl Reduction {
@@ -428,6 +453,7 @@ impl Reduction {
             approach_velocity_m_s: f.approach_velocity_m_s,
             strain_rate_per_s,
             equilibrium_ratio: f.equilibrium_ratio,
+            record: RecordTrace::default(),
         }
     }
 }

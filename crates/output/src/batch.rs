@@ -3,9 +3,11 @@
 
 use crate::atomic::write_text_atomically;
 use crate::plot::{
-    Axes, Curve, Measure, curve, panels_figure, strain_rate_panel, stress_strain_panel,
+    Axes, Curve, Marks, Measure, Span, balance_residual, curve, marked_panels_figure,
+    strain_rate_panel, stress_strain_panel, window_panels,
 };
-use shpb_core::reduce::{BarProperties, Reduction, WaveMetrics, wave_metrics};
+use plotters::style::RGBColor;
+use shpb_core::reduce::{BarProperties, Reduction, WaveMetrics, verdict_reason, wave_metrics};
 use shpb_core::reduce_cylinder::CylinderReduction;
 use shpb_input::Result;
 use std::fmt::Write as _;
@@ -78,7 +80,7 @@ fn num(v: Option<f64>) -> String {
 }
 
 /// Column names of the batch summary (SI units in the names).
-pub const SUMMARY_COLUMNS: [&str; 40] = [
+pub const SUMMARY_COLUMNS: [&str; 41] = [
     "record",
     "status",
     "alignment",
@@ -119,6 +121,7 @@ pub const SUMMARY_COLUMNS: [&str; 40] = [
     "peak_stress_three_wave_Pa",
     "strain_at_peak_stress_three_wave",
     "mean_strain_rate_per_s",
+    "verdict_reason",
 ];
 
 /// A cylinder record's summary values (docs/physics.md §7.8, engineering, compression positive):
@@ -194,6 +197,7 @@ pub fn summary_csv(records: &[BatchRecord]) -> String {
                 row.push(num(a.balance_paths_m.map(|p| p.0)));
                 row.push(num(a.balance_paths_m.map(|p| p.1)));
                 row.extend(cylinder_columns(b.cylinder).map(num));
+                row.push(csv_field(&verdict_reason(r)));
             }
         }
         text.push_str(&row.join(","));
@@ -226,6 +230,16 @@ pub fn report_markdown(command: &str, records: &[BatchRecord]) -> String {
          |F_front − F_back| / F_3wave, judged over the loading span (25 % of the 3-wave peak to \
          the peak) against 0.05 (Ravichandran & Subhash 1994): *equilibrium* if every sample \
          passes, *marginal* if the mean does, else *not in equilibrium*.\n\n",
+    );
+    md.push_str(
+        "Each record's figure shows, top, the incident and transmission gauges' records \
+         (smoothed and debiased, on the record's clock) with the baseline span and the windows \
+         the reduction cut (dashed: the geometric start, where the alignment moved a window); \
+         then the waves at the faces and the face forces with the loading span; then the \
+         balance residual (F_front − F_back)/F_3wave with the ±0.05 equilibrium band and the \
+         loading span the verdict judges, and what the specimen makes of the waves. Under each \
+         figure one sentence says which alignment placed the windows and why the verdict \
+         follows (also the summary's `verdict_reason` column).\n\n",
     );
     md.push_str(
         "| record | peak back force (kN) | peak front force (kN) | δ at peak (µm) | strain rate at peak (1/s) | equilibrium at peak | mean / max over loading | verdict | alignment |\n\
@@ -272,6 +286,7 @@ pub fn report_markdown(command: &str, records: &[BatchRecord]) -> String {
         if let Some(f) = &b.figure {
             let _ = writeln!(md, "![{}]({})\n", b.record, f);
         }
+        let _ = writeln!(md, "**Verdict.** {}\n", capitalised(&verdict_reason(r)));
         let a = &r.alignment;
         let us = |v: Option<f64>| cell(v, 1e6, 2);
         let _ = writeln!(
@@ -322,6 +337,20 @@ pub fn report_markdown(command: &str, records: &[BatchRecord]) -> String {
             }
             md.push('\n');
         }
+        if b.cylinder.is_some() {
+            let [one, two, three, strain, rate] = cylinder_columns(b.cylinder);
+            let _ = writeln!(
+                md,
+                "Cylinder (engineering, compression positive): peak stress {} MPa (1-wave), {} \
+                 MPa (2-wave), {} MPa (3-wave); 3-wave strain at its peak stress {}; mean strain \
+                 rate {} 1/s.\n",
+                cell(one, 1e-6, 1),
+                cell(two, 1e-6, 1),
+                cell(three, 1e-6, 1),
+                cell(strain, 1.0, 4),
+                cell(rate, 1.0, 0)
+            );
+        }
         let q = &r.quality;
         let _ = writeln!(
             md,
@@ -355,13 +384,12 @@ pub fn write_report(
     write_text_atomically(path, force, &report_markdown(command, records))
 }
 
-/// The three panels every reduction figure starts with: waves at the faces, the 1/2/3-wave
-/// forces, the equilibrium ratio (`ratio`, capped at 1).
+/// The two panels of the waves at the faces and the 1/2/3-wave forces, the forces with the
+/// loading span the equilibrium verdict judges.
 fn face_panels<'a>(
     waves_title: &'a str,
     r: &'a Reduction,
-    ratio: &'a [f64],
-) -> Vec<(Axes<'a>, Vec<Curve<'a>>)> {
+) -> Vec<(Axes<'a>, Vec<Curve<'a>>, Marks)> {
     vec![
         (
             Axes {
@@ -376,6 +404,7 @@ fn face_panels<'a>(
                 curve("reflected", &r.time_s, &r.reflected_strain),
                 curve("transmitted", &r.time_s, &r.transmitted_strain),
             ],
+            Marks::default(),
         ),
         (
             Axes {
@@ -390,22 +419,20 @@ fn face_panels<'a>(
                 curve("back (1-wave)", &r.time_s, &r.force_back_n),
                 curve("3-wave", &r.time_s, &r.force_3wave_n),
             ],
-        ),
-        (
-            Axes {
-                title: "equilibrium |F_front − F_back| / F_3wave (shown up to 1)",
-                x_label: "time at the faces (µs)",
-                y_label: "equilibrium ratio",
-                x_scale: 1e6,
-                y_scale: 1.0,
+            Marks {
+                spans: vec![Span {
+                    label: "loading span (verdict)".into(),
+                    from_to: r.quality.loading_span_s,
+                    colour: RGBColor(150, 60, 170),
+                }],
+                ..Marks::default()
             },
-            vec![curve("equilibrium ratio", &r.time_s, ratio)],
         ),
     ]
 }
 
 /// The force–approach panel of spheres.
-fn force_approach_panel(r: &Reduction) -> (Axes<'_>, Vec<Curve<'_>>) {
+fn force_approach_panel(r: &Reduction) -> (Axes<'_>, Vec<Curve<'_>>, Marks) {
     (
         Axes {
             title: "force against sphere approach",
@@ -418,24 +445,19 @@ fn force_approach_panel(r: &Reduction) -> (Axes<'_>, Vec<Curve<'_>>) {
             curve("back", &r.displacement_m, &r.force_back_n),
             curve("front", &r.displacement_m, &r.force_front_n),
         ],
+        Marks::default(),
     )
 }
 
-/// The figure of one reduction: the three waves at the faces, the 1-, 2- and 3-wave forces, the
-/// equilibrium ratio (shown up to 1), and force against sphere approach.
-pub fn reduction_figure(path: &Path, force: bool, title: &str, r: &Reduction) -> Result<()> {
-    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
-    let waves_title = format!("{title}: waves at the faces");
-    let mut panels = face_panels(&waves_title, r, &ratio);
-    panels.push(force_approach_panel(r));
-    panels_figure(path, force, 2, &panels)
-}
-
-/// The figure of `shpb reduce --plot` (atomic; an existing file is kept unless `force`): the
-/// panels of [`reduction_figure`], then what the specimen makes of the waves (docs/physics.md
-/// §7.3, §7.8). Spheres: force against approach and, when their radii are known, the global
-/// strain rate δ̇/Σrᵢ; a cylinder: its 1/2/3-wave engineering stress against strain and strain
-/// rate against time, compression positive.
+/// The figure of one reduction, of `shpb reduce --plot` and of each record of `--report`
+/// (atomic; an existing file is kept unless `force`), two panels across: the windows on the
+/// incident and transmission gauges' records with their baseline span
+/// ([`window_panels`]), the three waves at the faces and the 1/2/3-wave forces, the balance
+/// residual (F_front − F_back)/F_3wave with the ±0.05 band and the loading span the verdict
+/// judges, then what the specimen makes of the waves (docs/physics.md §7.3, §7.6–§7.8). Spheres:
+/// force against approach and, when their radii are known, the global strain rate δ̇/Σrᵢ; a
+/// cylinder: its 1/2/3-wave engineering stress against strain and strain rate against time,
+/// compression positive.
 pub fn record_figure(
     path: &Path,
     force: bool,
@@ -443,9 +465,14 @@ pub fn record_figure(
     r: &Reduction,
     cylinder: Option<&CylinderReduction>,
 ) -> Result<()> {
-    let ratio: Vec<f64> = r.equilibrium_ratio.iter().map(|v| v.min(1.0)).collect();
+    let residual = balance_residual(r);
     let waves_title = format!("{title}: waves at the faces");
-    let mut panels = face_panels(&waves_title, r, &ratio);
+    let mut windows = window_panels(r, &residual).into_iter();
+    let mut panels = Vec::new();
+    panels.extend(windows.by_ref().take(2));
+    panels.extend(face_panels(&waves_title, r));
+    panels.extend(windows);
+    let plain = |(axes, curves)| (axes, curves, Marks::default());
     match cylinder {
         Some(c) => {
             let analyses = [
@@ -453,20 +480,20 @@ pub fn record_figure(
                 ("2-wave", &c.two_wave),
                 ("3-wave", &c.three_wave),
             ];
-            panels.push(stress_strain_panel(
+            panels.push(plain(stress_strain_panel(
                 Measure::Engineering,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &a.strain, &a.stress_pa))
                     .collect(),
-            ));
-            panels.push(strain_rate_panel(
+            )));
+            panels.push(plain(strain_rate_panel(
                 Measure::Engineering,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &r.time_s, &a.strain_rate_per_s))
                     .collect(),
-            ));
+            )));
         }
         None => {
             panels.push(force_approach_panel(r));
@@ -480,11 +507,19 @@ pub fn record_figure(
                         y_scale: 1.0,
                     },
                     vec![curve("strain rate", &r.time_s, rate)],
+                    Marks::default(),
                 ));
             }
         }
     }
-    panels_figure(path, force, 2, &panels)
+    marked_panels_figure(path, force, 2, &panels)
+}
+
+/// `s` with its first letter upper-case (a sentence's start).
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map_or_else(String::new, |f| f.to_uppercase().chain(c).collect())
 }
 
 /// The last component of a record's path (the table's record column).

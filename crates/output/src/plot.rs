@@ -100,9 +100,50 @@ fn range(curves: &[Curve], axes: &Axes) -> (f64, f64, f64, f64) {
     (xmin, xmax * 1.03, ymin - 0.02 * (ymax - ymin), ymax * 1.08)
 }
 
+/// A shaded stretch of a panel's x axis (a window, a baseline, a span the verdict weighs), in
+/// the curves' units (before the panel's `x_scale`).
+pub struct Span {
+    /// Legend label.
+    pub label: String,
+    /// Start and end, in the curves' x units.
+    pub from_to: (f64, f64),
+    /// Fill colour (drawn translucent).
+    pub colour: RGBColor,
+}
+
+/// What a panel marks besides its curves: shaded x spans, dashed vertical lines (label, x in the
+/// curves' units, colour) and a shaded horizontal band (label, low, high in the curves' y units).
+#[derive(Default)]
+pub struct Marks {
+    /// Shaded x spans, drawn under the curves.
+    pub spans: Vec<Span>,
+    /// Dashed vertical lines.
+    pub lines: Vec<(String, f64, RGBColor)>,
+    /// A shaded horizontal band (e.g. a tolerance).
+    pub band: Option<(String, f64, f64)>,
+}
+
 /// Draws line curves with axes and a legend into one panel.
 fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()> {
+    draw_xy_marked(area, path, axes, curves, &Marks::default())
+}
+
+/// [`draw_xy`] with the spans, lines and band of `marks` under the curves.
+fn draw_xy_marked(
+    area: &Area,
+    path: &Path,
+    axes: &Axes,
+    curves: &[Curve],
+    marks: &Marks,
+) -> Result<()> {
     let (xmin, xmax, ymin, ymax) = range(curves, axes);
+    let (ymin, ymax) = match &marks.band {
+        Some((_, lo, hi)) => (
+            ymin.min(lo * axes.y_scale * 1.5),
+            ymax.max(hi * axes.y_scale * 1.5),
+        ),
+        None => (ymin, ymax),
+    };
     let mut chart = ChartBuilder::on(area)
         .caption(axes.title, ("sans-serif", 24))
         .margin(15)
@@ -119,6 +160,49 @@ fn draw_xy(area: &Area, path: &Path, axes: &Axes, curves: &[Curve]) -> Result<()
         .label_style(("sans-serif", 17))
         .draw()
         .map_err(perr(path))?;
+    let clip = |x: f64| (x * axes.x_scale).clamp(xmin, xmax);
+    for s in &marks.spans {
+        let fill = s.colour.mix(0.2).filled();
+        let colour = s.colour;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(clip(s.from_to.0), ymin), (clip(s.from_to.1), ymax)],
+                fill,
+            )))
+            .map_err(perr(path))?
+            .label(s.label.clone())
+            .legend(move |(x, y)| {
+                Rectangle::new([(x, y - 6), (x + 20, y + 6)], colour.mix(0.35).filled())
+            });
+    }
+    if let Some((label, lo, hi)) = &marks.band {
+        let green = RGBColor(40, 150, 60);
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(xmin, lo * axes.y_scale), (xmax, hi * axes.y_scale)],
+                green.mix(0.25).filled(),
+            )))
+            .map_err(perr(path))?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                Rectangle::new([(x, y - 6), (x + 20, y + 6)], green.mix(0.4).filled())
+            });
+    }
+    for (label, x, colour) in &marks.lines {
+        let colour = *colour;
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(clip(*x), ymin), (clip(*x), ymax)],
+                6,
+                4,
+                colour.stroke_width(2),
+            ))
+            .map_err(perr(path))?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+    }
     for (i, c) in curves.iter().enumerate() {
         let pts: Vec<(f64, f64)> =
             c.x.iter()
@@ -356,6 +440,27 @@ pub fn test_figure(
             "x–t (Lagrange) diagram of the bar stress",
             fields,
         )?;
+        root.present().map_err(perr(path))
+    })
+}
+
+/// A grid of x–y panels with their [`Marks`] (`columns` across, row by row), 800 × 600 pixels
+/// each, in one PNG.
+pub fn marked_panels_figure(
+    path: &Path,
+    force: bool,
+    columns: usize,
+    panels: &[(Axes, Vec<Curve>, Marks)],
+) -> Result<()> {
+    let columns = columns.max(1);
+    let rows = panels.len().div_ceil(columns).max(1);
+    write_atomically(path, force, |tmp| {
+        let root =
+            BitMapBackend::new(tmp, (800 * columns as u32, 600 * rows as u32)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        for (area, (axes, curves, marks)) in root.split_evenly((rows, columns)).iter().zip(panels) {
+            draw_xy_marked(area, path, axes, curves, marks)?;
+        }
         root.present().map_err(perr(path))
     })
 }
@@ -1110,6 +1215,158 @@ pub fn loglog_plot(
             .map_err(|e| perr(&e))?;
         root.present().map_err(|e| perr(&e))
     })
+}
+
+/// The balance residual a reduction's verdict weighs, signed: (F_front − F_back) / F_3wave with
+/// the equilibrium ratio's floor (docs/physics.md §7.7), shown within ±1.
+pub fn balance_residual(r: &shpb_core::reduce::Reduction) -> Vec<f64> {
+    r.equilibrium_ratio
+        .iter()
+        .zip(r.force_front_n.iter().zip(&r.force_back_n))
+        .map(|(q, (f, b))| (q * (f - b).signum()).clamp(-1.0, 1.0))
+        .collect()
+}
+
+/// Colours of the windows on the records: baseline, incident, reflected, transmitted, loading.
+const WINDOW_COLOURS: [RGBColor; 5] = [
+    RGBColor(120, 120, 120),
+    RGBColor(230, 140, 20),
+    RGBColor(30, 90, 200),
+    RGBColor(40, 150, 60),
+    RGBColor(150, 60, 170),
+];
+
+/// The panels that let a person check a reduction's windows (docs/physics.md §7.3, §7.6–§7.7):
+/// the incident gauge's record with the baseline span and the incident and reflected windows,
+/// the transmission gauge's with the baseline span and the transmitted window (the geometric
+/// starts dashed where the alignment moved a window), and the balance residual
+/// (`residual`, from [`balance_residual`]) with the ±0.05 equilibrium band and the loading span
+/// the verdict judges.
+pub fn window_panels<'a>(
+    r: &'a shpb_core::reduce::Reduction,
+    residual: &'a [f64],
+) -> Vec<(Axes<'static>, Vec<Curve<'a>>, Marks)> {
+    let rec = &r.record;
+    let w = &r.windows;
+    let t0 = rec.time_s.first().copied().unwrap_or(0.0);
+    let dt = if rec.time_s.len() > 1 {
+        rec.time_s[1] - t0
+    } else {
+        1.0
+    };
+    let ts = w.incident_start_s;
+    let span = |delay: f64| (ts + delay, ts + delay + w.duration_s);
+    // The records from their start (the baseline) to a tenth of the shown time past the last
+    // window's end.
+    let last_end = ts + w.reflected_delay_s.max(w.transmitted_delay_s) + w.duration_s;
+    let shown_end = last_end + 0.1 * (last_end - t0);
+    let n = rec
+        .time_s
+        .iter()
+        .take_while(|&&t| t <= shown_end)
+        .count()
+        .max(2)
+        .min(rec.time_s.len());
+    let baseline = || Span {
+        label: format!("baseline ({} samples)", w.baseline_samples),
+        from_to: (t0, t0 + w.baseline_samples.saturating_sub(1) as f64 * dt),
+        colour: WINDOW_COLOURS[0],
+    };
+    let window = |label: &str, delay: f64, colour: RGBColor| Span {
+        label: format!("{label} window"),
+        from_to: span(delay),
+        colour,
+    };
+    let geometric_line = |label: &str, used: f64, geometric: f64| {
+        ((used - geometric).abs() > 0.5 * dt).then(|| {
+            (
+                format!("geometric {label} start"),
+                ts + geometric,
+                RGBColor(0, 0, 0),
+            )
+        })
+    };
+    let record_axes = |title: &'static str| Axes {
+        title,
+        x_label: "time on the record's clock (µs)",
+        y_label: "gauge strain (µε), tension positive",
+        x_scale: 1e6,
+        y_scale: 1e6,
+    };
+    let loading = Span {
+        label: "loading span (verdict)".into(),
+        from_to: r.quality.loading_span_s,
+        colour: WINDOW_COLOURS[4],
+    };
+    vec![
+        (
+            record_axes("incident gauge: baseline, incident and reflected windows"),
+            vec![curve(
+                "incident gauge",
+                &rec.time_s[..n],
+                &rec.incident_strain[..n],
+            )],
+            Marks {
+                spans: vec![
+                    baseline(),
+                    window("incident", 0.0, WINDOW_COLOURS[1]),
+                    window("reflected", w.reflected_delay_s, WINDOW_COLOURS[2]),
+                ],
+                lines: geometric_line(
+                    "reflected",
+                    w.reflected_delay_s,
+                    r.alignment.geometric_reflected_delay_s,
+                )
+                .into_iter()
+                .collect(),
+                band: None,
+            },
+        ),
+        (
+            record_axes("transmission gauge: baseline and transmitted window"),
+            vec![curve(
+                "transmission gauge",
+                &rec.time_s[..n],
+                &rec.transmission_strain[..n],
+            )],
+            Marks {
+                spans: vec![
+                    baseline(),
+                    window("transmitted", w.transmitted_delay_s, WINDOW_COLOURS[3]),
+                ],
+                lines: geometric_line(
+                    "transmitted",
+                    w.transmitted_delay_s,
+                    r.alignment.geometric_transmitted_delay_s,
+                )
+                .into_iter()
+                .collect(),
+                band: None,
+            },
+        ),
+        (
+            Axes {
+                title: "balance residual (F_front − F_back) / F_3wave (within ±1)",
+                x_label: "time at the faces (µs)",
+                y_label: "residual",
+                x_scale: 1e6,
+                y_scale: 1.0,
+            },
+            vec![curve("residual", &r.time_s, residual)],
+            Marks {
+                spans: vec![loading],
+                lines: Vec::new(),
+                band: Some((
+                    format!(
+                        "equilibrium band ±{}",
+                        shpb_core::reduce::quality::EQUILIBRIUM_TOLERANCE
+                    ),
+                    -shpb_core::reduce::quality::EQUILIBRIUM_TOLERANCE,
+                    shpb_core::reduce::quality::EQUILIBRIUM_TOLERANCE,
+                )),
+            },
+        ),
+    ]
 }
 
 #[cfg(test)]

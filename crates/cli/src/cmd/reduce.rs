@@ -3,9 +3,7 @@
 use super::common::{DEFAULT_BARS, finite, plan, report, require_bars, warn, write_all};
 use shpb_core::reduce::{DispersionCorrection, Reduction, ReductionSetup};
 use shpb_input::{Error, Result};
-use shpb_output::batch::{
-    BatchRecord, record_figure, reduction_figure, write_report, write_summary,
-};
+use shpb_output::batch::{BatchRecord, record_figure, write_report, write_summary};
 use shpb_output::reduction::{write_reduction_csv_with, write_reduction_hdf5_with};
 use shpb_study::api::{RecordOptions, Reduced, reduce_record_with};
 use std::path::{Path, PathBuf};
@@ -179,7 +177,13 @@ pub fn reduce_command(
         for (k, (record, result)) in records.iter().zip(&reduced).enumerate() {
             let figure = match (result, figures.get(k)) {
                 (Ok(r), Some(path)) => {
-                    reduction_figure(path, o.force, &stem(record), &r.reduction)?;
+                    record_figure(
+                        path,
+                        o.force,
+                        &stem(record),
+                        &r.reduction,
+                        r.cylinder.as_ref(),
+                    )?;
                     path.file_name().map(|n| n.to_string_lossy().into_owned())
                 }
                 _ => None,
@@ -354,6 +358,10 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
             c.mean_strain_rate_per_s
         ));
     }
+    text.push_str(&format!(
+        "verdict: {}\n",
+        shpb_core::reduce::verdict_reason(r)
+    ));
     text
 }
 
@@ -402,6 +410,7 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
         "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),
         "equilibrium_ratio_at_peak": finite(r.equilibrium_ratio_at_peak),
         "warnings": r.warnings,
+        "verdict_reason": shpb_core::reduce::verdict_reason(r),
     });
     if let (Some((r1, r2)), Some(rate)) = (reduced.specimen.radii_m(), &r.strain_rate_per_s) {
         json["spheres"] = serde_json::json!({

@@ -224,6 +224,171 @@ pub(crate) fn assess(
     }
 }
 
+/// How the equilibrium ratio behaved over the loading span of a reduction: the numbers
+/// [`verdict_reason`] states beside the verdict (docs/physics.md §7.7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EquilibriumDetail {
+    /// Largest equilibrium ratio over the loading span and its time on the faces' axis, s.
+    pub max_at_s: f64,
+    /// Share of the loading span's samples whose ratio exceeds [`EQUILIBRIUM_TOLERANCE`].
+    pub share_above: f64,
+    /// Time from which the ratio stays within the tolerance up to the peak, s (None when the
+    /// last sample of the span is above it).
+    pub settled_from_s: Option<f64>,
+    /// F_front / F_back at the peak back force.
+    pub front_over_back_at_peak: f64,
+    /// Mean ratio over the first and the second half of the loading span (by time).
+    pub half_means: (f64, f64),
+}
+
+/// [`EquilibriumDetail`] of a reduction: where over its loading span (the span of
+/// [`Quality::loading_span_s`]) the ratio |F_front − F_back| / F_3wave exceeds the tolerance.
+pub fn equilibrium_detail(r: &super::Reduction) -> EquilibriumDetail {
+    let (ka, kb) = rising_span(&r.force_3wave_n, 0.25);
+    let span = &r.equilibrium_ratio[ka..=kb];
+    let k_max = ka + crate::numeric::argmax(span);
+    let above = span.iter().filter(|&&v| v > EQUILIBRIUM_TOLERANCE).count();
+    let settled_from = (ka..=kb)
+        .rev()
+        .take_while(|&k| r.equilibrium_ratio[k] <= EQUILIBRIUM_TOLERANCE)
+        .last();
+    let mid = (span.len() / 2).max(1).min(span.len());
+    let mean = |v: &[f64]| {
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
+    };
+    EquilibriumDetail {
+        half_means: (mean(&span[..mid]), mean(&span[mid..])),
+        max_at_s: r.time_s[k_max],
+        share_above: above as f64 / span.len() as f64,
+        settled_from_s: settled_from.map(|k| r.time_s[k]),
+        front_over_back_at_peak: r.force_front_n[r.peak_index] / r.force_back_n[r.peak_index],
+    }
+}
+
+/// One sentence saying which alignment placed a reduction's windows and why its equilibrium
+/// verdict follows (docs/physics.md §7.6–§7.7): the strategy and its delays against the gauge
+/// distances' (with the balance search's bound), then the criterion (R = |F_front − F_back| /
+/// F_3wave over the loading span, 25 % of the 3-wave peak to the peak, against 0.05, Ravichandran
+/// & Subhash 1994), the measured mean and maximum, where R exceeds 0.05, and F_front/F_back at
+/// the peak back force.
+pub fn verdict_reason(r: &super::Reduction) -> String {
+    let a = &r.alignment;
+    let w = &r.windows;
+    let us = |s: f64| format!("{:.1} µs", s * 1e6);
+    let moved = |name: &str, shift_s: f64| {
+        if shift_s.abs() < 0.05e-6 {
+            format!("the {name} window on the geometric delay")
+        } else {
+            format!(
+                "the {name} window {} {} than the geometric delay",
+                us(shift_s.abs()),
+                if shift_s < 0.0 { "earlier" } else { "later" }
+            )
+        }
+    };
+    let dr = w.reflected_delay_s - a.geometric_reflected_delay_s;
+    let dt = w.transmitted_delay_s - a.geometric_transmitted_delay_s;
+    let strategy_r = match (a.strategy, a.balance_shift_s) {
+        (super::Alignment::Balance, Some((sr, _))) => sr,
+        (super::Alignment::Foot, _) => a
+            .measured_reflected_delay_s
+            .map_or(dr, |m| m - a.geometric_reflected_delay_s),
+        _ => 0.0,
+    };
+    let strategy_t = match (a.strategy, a.balance_shift_s) {
+        (super::Alignment::Balance, Some((_, st))) => st,
+        (super::Alignment::Foot, _) => a
+            .measured_transmitted_delay_s
+            .map_or(dt, |m| m - a.geometric_transmitted_delay_s),
+        _ => 0.0,
+    };
+    // A delay given by hand differs from the strategy's by more than rounding (1 ns).
+    let by_hand = (dr - strategy_r).abs() > 1e-9 || (dt - strategy_t).abs() > 1e-9;
+    let alignment = match a.strategy {
+        super::Alignment::Geometric => format!(
+            "geometric alignment placed the windows by the stated gauge distances (reflected +{}, \
+             transmitted +{} after the incident foot)",
+            us(w.reflected_delay_s),
+            us(w.transmitted_delay_s)
+        ),
+        super::Alignment::Foot => format!(
+            "foot alignment put {} and {} (on the record's pulse feet)",
+            moved("reflected", dr),
+            moved("transmitted", dt)
+        ),
+        super::Alignment::Balance => format!(
+            "balance alignment moved {} and {} (bound ±{}{}), where F_front and F_back over the \
+             incident pulse agree best",
+            moved("reflected", dr),
+            moved("transmitted", dt),
+            us(a.balance_bound_s),
+            if a.at_bound {
+                "; a shift stopped at the bound, so the balance may lie beyond it"
+            } else {
+                ""
+            }
+        ),
+    };
+    let alignment = if by_hand {
+        format!(
+            "the windows were set by hand, reflected +{} and transmitted +{} after the incident \
+             foot ({} alignment would give +{} and +{})",
+            us(w.reflected_delay_s),
+            us(w.transmitted_delay_s),
+            a.strategy.name(),
+            us(a.geometric_reflected_delay_s + strategy_r),
+            us(a.geometric_transmitted_delay_s + strategy_t)
+        )
+    } else {
+        alignment
+    };
+    let q = &r.quality;
+    let d = equilibrium_detail(r);
+    let tol = EQUILIBRIUM_TOLERANCE;
+    let where_above = if d.share_above == 0.0 {
+        "never above it".to_string()
+    } else {
+        format!(
+            "above it on {:.0} % of the span{}",
+            100.0 * d.share_above,
+            match d.settled_from_s {
+                Some(t) if t > q.loading_span_s.0 => format!(", within it for good from {}", us(t)),
+                Some(_) => String::new(),
+                None => " and still above it at the peak".to_string(),
+            }
+        )
+    };
+    let conclusion = match q.verdict {
+        EquilibriumVerdict::Equilibrium => {
+            format!("every sample is within {tol}, so the specimen is in equilibrium")
+        }
+        EquilibriumVerdict::Marginal => {
+            format!("the mean is within {tol} but not every sample, so the verdict is marginal")
+        }
+        EquilibriumVerdict::NotInEquilibrium => {
+            format!("the mean exceeds {tol}, so the specimen is not in equilibrium")
+        }
+    };
+    format!(
+        "{alignment}; over the loading ({}–{}, 25 % of the 3-wave peak to the peak) R = \
+         |F_front − F_back|/F_3wave averages {:.3} ({:.3} over the span's first half, {:.3} over \
+         its second) and reaches {:.3} at {} against the {tol} criterion, {where_above}, and \
+         F_front/F_back at the peak back force is {:.3}: {conclusion}.",
+        us(q.loading_span_s.0),
+        us(q.loading_span_s.1),
+        q.equilibrium_mean,
+        d.half_means.0,
+        d.half_means.1,
+        q.equilibrium_max,
+        us(d.max_at_s),
+        d.front_over_back_at_peak,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,6 +447,126 @@ mod tests {
         let cut: Vec<f64> = strain[..500].to_vec();
         let m = wave_metrics(&time_s[..500], &cut, &bar, true).unwrap();
         assert!(m.duration_10_s.is_nan() && m.rise_10_90_s > 0.0);
+    }
+
+    /// A balanced test on the authors' bars (no dispersion): an incident sin² pulse −4e-4,
+    /// its reflection +3e-4 and a transmitted pulse −1e-4 (so F_front = F_back at every instant),
+    /// the transmitted one arriving `late_s` after the gauge distances' delay (a clock offset).
+    fn balanced_record(
+        late_s: f64,
+    ) -> (crate::reduce::ReductionInput, crate::reduce::ReductionSetup) {
+        let bar = crate::reduce::authors_bar();
+        let setup = crate::reduce::ReductionSetup {
+            incident_bar: bar,
+            transmission_bar: bar,
+            incident_gauge_m: 0.644525,
+            transmission_gauge_m: 0.3683,
+            transmission_absorbing: true,
+        };
+        let c0 = bar.wave_speed_m_s;
+        let pulse = |t: f64| {
+            let x = t / 120e-6;
+            if (0.0..=1.0).contains(&x) {
+                (std::f64::consts::PI * x).sin().powi(2)
+            } else {
+                0.0
+            }
+        };
+        let (t_i, d_r, d_t) = (100e-6, 2.0 * 0.644525 / c0, (0.644525 + 0.3683) / c0);
+        let time_s: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-7).collect();
+        let incident_strain = time_s
+            .iter()
+            .map(|&t| -4e-4 * pulse(t - t_i) + 3e-4 * pulse(t - t_i - d_r))
+            .collect();
+        let transmission_strain = time_s
+            .iter()
+            .map(|&t| -1e-4 * pulse(t - t_i - d_t - late_s))
+            .collect();
+        let input = crate::reduce::ReductionInput {
+            time_s,
+            incident_strain,
+            transmission_strain,
+        };
+        (input, setup)
+    }
+
+    fn reduce_with(late_s: f64, alignment: crate::reduce::Alignment) -> crate::reduce::Reduction {
+        let (input, setup) = balanced_record(late_s);
+        let options = crate::reduce::ReductionOptions {
+            dispersion: crate::reduce::DispersionCorrection::None,
+            smoothing_window_s: 0.0,
+            alignment,
+            ..crate::reduce::ReductionOptions::default()
+        };
+        crate::reduce::reduce(&input, &setup, &options).unwrap()
+    }
+
+    /// The sentence names the alignment and the shift it made, and the criterion, the measured
+    /// mean and maximum and the verdict it reads from them: on a balanced test the geometric
+    /// windows give equilibrium; with the transmitted pulse 10 µs late they do not, and the
+    /// balance search moves the transmitted window 10.0 µs later (its exact shift, in samples
+    /// of 0.1 µs) and finds the balance again.
+    #[test]
+    fn the_verdict_reason_names_the_alignment_the_criterion_and_the_numbers() {
+        let r = reduce_with(0.0, crate::reduce::Alignment::Geometric);
+        assert_eq!(r.quality.verdict, EquilibriumVerdict::Equilibrium);
+        let s = verdict_reason(&r);
+        assert!(
+            s.starts_with("geometric alignment placed the windows by the stated gauge distances"),
+            "{s}"
+        );
+        assert!(
+            s.contains("against the 0.05 criterion, never above it"),
+            "{s}"
+        );
+        assert!(s.contains("so the specimen is in equilibrium."), "{s}");
+        let d = equilibrium_detail(&r);
+        assert!((d.front_over_back_at_peak - 1.0).abs() < 1e-3, "{d:?}");
+
+        let late = reduce_with(10e-6, crate::reduce::Alignment::Geometric);
+        assert_eq!(late.quality.verdict, EquilibriumVerdict::NotInEquilibrium);
+        let s = verdict_reason(&late);
+        assert!(
+            s.contains(&format!("averages {:.3}", late.quality.equilibrium_mean)),
+            "{s}"
+        );
+        assert!(
+            s.contains("the mean exceeds 0.05, so the specimen is not in equilibrium."),
+            "{s}"
+        );
+        // Two sin² pulses of 120 µs, the back one 10 µs behind the front one: over the span
+        // from 25 % of their mean's peak to the peak, R averages 0.349, exceeds 0.05 on 91 % of
+        // it and stays within 0.05 only over the last 3.7 µs before the peak (computed from the
+        // two sin² pulses directly; the 2 % foot and the sampling move these by < 1 %).
+        let d = equilibrium_detail(&late);
+        assert!(
+            (late.quality.equilibrium_mean / 0.349 - 1.0).abs() < 0.02,
+            "{d:?}"
+        );
+        assert!((d.share_above - 0.91).abs() < 0.01, "{d:?}");
+        let settled = d.settled_from_s.unwrap();
+        assert!(
+            (late.quality.loading_span_s.1 - settled - 3.7e-6).abs() < 0.3e-6,
+            "{d:?}"
+        );
+        assert!(
+            s.contains(&format!(
+                "above it on {:.0} % of the span, within it for good from",
+                100.0 * d.share_above
+            )),
+            "{s}"
+        );
+
+        let balanced = reduce_with(10e-6, crate::reduce::Alignment::Balance);
+        let s = verdict_reason(&balanced);
+        assert!(
+            s.starts_with(
+                "balance alignment moved the reflected window on the geometric delay and the \
+                 transmitted window 10.0 µs later than the geometric delay (bound ±60.0 µs)"
+            ),
+            "{s}"
+        );
+        assert!(s.contains("so the specimen is in equilibrium."), "{s}");
     }
 
     #[test]
