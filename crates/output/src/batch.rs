@@ -367,7 +367,12 @@ fn face_panels<'a>(
             Axes {
                 title: waves_title,
                 x_label: "time at the faces (µs)",
-                y_label: "bar strain (µε), tension positive",
+                // A tension reduction reads the strains turned (docs/physics.md §7.8.1).
+                y_label: if r.tension {
+                    "bar strain (µε), gauges' sign turned (tension test)"
+                } else {
+                    "bar strain (µε), tension positive"
+                },
                 x_scale: 1e6,
                 y_scale: 1e6,
             },
@@ -381,7 +386,11 @@ fn face_panels<'a>(
             Axes {
                 title: "face forces",
                 x_label: "time at the faces (µs)",
-                y_label: "force, compression positive (kN)",
+                y_label: if r.tension {
+                    "force, tension positive (kN)"
+                } else {
+                    "force, compression positive (kN)"
+                },
                 x_scale: 1e6,
                 y_scale: 1e-3,
             },
@@ -455,6 +464,7 @@ pub fn record_figure(
             ];
             panels.push(stress_strain_panel(
                 Measure::Engineering,
+                c.tension,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &a.strain, &a.stress_pa))
@@ -462,6 +472,7 @@ pub fn record_figure(
             ));
             panels.push(strain_rate_panel(
                 Measure::Engineering,
+                c.tension,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &r.time_s, &a.strain_rate_per_s))
