@@ -204,3 +204,54 @@ fn a_tension_run_plots_its_true_and_reduced_stress_strain_and_rate() {
         );
     }
 }
+
+/// With the authors' copper shaper on the flange (`bars = "authors"`) the tension bar's incident
+/// wave is the pressure bar's with its sign turned, bit for bit, until the specimen's reflection
+/// reaches the incident gauge (the flange is the shaped striker mirrored, docs/physics.md §6.13);
+/// the ledger closes in tension to 1e-9 with the shaper's work in it.
+#[test]
+fn a_shaped_tension_pulse_is_the_shaped_compression_pulse_turned() {
+    let text = |loading: &str| {
+        scene("12.5psi", loading, "length_m").replace("authors-20cm-striker", "authors")
+    };
+    let params = Params::from_toml(&text("tension"), "copper.toml", &repo()).unwrap();
+    let shpb::scene::SceneParams::Pulse {
+        apparatus, options, ..
+    } = &params.params
+    else {
+        panic!("a bar scene")
+    };
+    assert!(options.shaper.is_some(), "the authors' set-up has a shaper");
+    let d = apparatus
+        .gauges
+        .channel("incident")
+        .unwrap()
+        .distance_from_specimen_m;
+    let c0 = apparatus.material.wave_speed_m_s();
+    let pulled = params.run().unwrap();
+    let pushed = run(&text("compression"));
+    let trace = |out: &RunOutput| {
+        out.gauges
+            .iter()
+            .find(|g| g.name == "incident")
+            .unwrap()
+            .strain
+            .clone()
+    };
+    let (t, p, q) = (
+        pulled.time_s.clone().unwrap(),
+        trace(&pulled),
+        trace(&pushed),
+    );
+    let foot = p.iter().position(|&e| e > 1e-6).unwrap();
+    let before = t
+        .iter()
+        .position(|&x| x >= t[foot] + 2.0 * d / c0 - 5e-6)
+        .unwrap();
+    let turned: Vec<f64> = q[..before].iter().map(|e| -e).collect();
+    assert_eq!(p[..before], turned[..]);
+    let ledger = summary(&pulled, "energy_balance_max_relative_error");
+    println!("shaped tension: ledger {ledger:.1e}, compared {before} samples");
+    assert!(ledger < 1e-9, "{ledger:e}");
+    assert!(summary(&pulled, "reduced_peak_stress") > 0.0);
+}
