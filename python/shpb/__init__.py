@@ -423,6 +423,7 @@ def reduce(
     layout: Optional[PathLike] = None,
     balance_bound_s: float = 60e-6,
     specimen: Optional[PathLike] = None,
+    tension: bool = False,
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -441,7 +442,10 @@ def reduce(
     each window shift, s (``--balance-bound``). ``specimen``: a specimen file (``--specimen``),
     a ``[specimen]`` table as in a scene: spheres of any diameter (the strain rate over their
     radii, δ̇/Σrᵢ) or ``shape = "cylinder"`` (its 1/2/3-wave curves); not with
-    ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own."""
+    ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own.
+    ``tension``: a tension test (``--tension``, docs/physics.md §7.8.1): forces, stresses and
+    strains tension positive, a cylinder specimen needed (a run file of a tension scene is
+    reduced in tension without it)."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -457,6 +461,7 @@ def reduce(
             None if layout is None else os.fspath(layout),
             _number("balance_bound_s", balance_bound_s, "a positive bound in seconds"),
             None if specimen is None else os.fspath(specimen),
+            bool(tension),
         )
     )
 

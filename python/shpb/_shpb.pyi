@@ -53,6 +53,9 @@ def reduce(
     specimen_length_m: Optional[float] = None,
     specimen_diameter_m: Optional[float] = None,
     layout: Optional[str] = None,
+    balance_bound_s: float = 60e-6,
+    specimen: Optional[str] = None,
+    tension: bool = False,
 ) -> RunData: ...
 Rows = List[Tuple[int, List[str], Tuple[float, float, float, float, float], List[str]]]
 

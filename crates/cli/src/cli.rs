@@ -576,6 +576,11 @@ pub enum Command {
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
+        /// A tension test (split Hopkinson tension bar, docs/physics.md §7.8.1): the incident
+        /// pulse tensile, forces, stresses and strains reported tension positive; needs a
+        /// cylinder specimen [default: a run file's own loading].
+        #[arg(long)]
+        tension: bool,
     },
     /// Convert a raw gauge record (the authors' CSV: time_s, incident_V, transmission_V) to bar strain.
     Strain {
@@ -1033,6 +1038,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             plot,
             force,
             channel,
+            tension,
         } => {
             let channels = (!channel.is_empty())
                 .then(|| shpb_input::channel_file::ChannelSet::from_specs(&channel, "--channel"))
@@ -1094,6 +1100,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                         .map(shpb_input::specimen_file::SpecimenFile::read)
                         .transpose()?,
                     channels,
+                    tension,
                 },
             )
         }

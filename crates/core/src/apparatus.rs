@@ -203,6 +203,9 @@ pub struct PulseOptions {
     /// A measured incident wave driving the incident bar's impact end in place of gun, striker
     /// and shaper (docs/physics.md §6.10); None: the striker.
     pub incident_drive: Option<IncidentDrive>,
+    /// Compression (a pressure bar) or tension (a tension bar: the striker on the flange, the
+    /// specimen bonded; docs/physics.md §6.13). Default compression.
+    pub loading: crate::loading::Loading,
 }
 
 /// A prescribed incident wave (docs/physics.md §6.10): the compressive stress the incident gauge
@@ -313,9 +316,11 @@ impl Apparatus {
                 EndCondition::Free,
                 dispersion,
             ));
-            joints.push(match shaper {
-                Some(s) => Joint::Shaper(s),
-                None => Joint::Butt,
+            // A tension bar: the striker tube on the flange, mirrored (docs/physics.md §6.13).
+            joints.push(match (o.loading, shaper) {
+                (crate::loading::Loading::Tension, s) => Joint::Flange(s),
+                (_, Some(s)) => Joint::Shaper(s),
+                (_, None) => Joint::Butt,
             });
         }
         let incident_index = bars.len();
@@ -386,7 +391,7 @@ impl Apparatus {
             // The specimen brings its own bodies and joints (docs/physics.md §6.9, §8).
             let sphere_masses = match specimen {
                 Some(sp) if end == IncidentEnd::Specimen => {
-                    join_specimen(sp, &mut bodies, &mut joints)
+                    join_specimen(sp, o.loading, &mut bodies, &mut joints)
                 }
                 _ => {
                     joints.push(Joint::Butt);
@@ -402,6 +407,15 @@ impl Apparatus {
                 }
             }
             joints.extend(tail_joints);
+            // A tension bar's specimen is threaded or bonded to its bars and inserts: every
+            // butt joint after the striker's holds in tension too (docs/physics.md §6.13).
+            if o.loading.is_tension() {
+                for j in joints.iter_mut().skip(usize::from(!driven)) {
+                    if *j == Joint::Butt {
+                        *j = Joint::Bonded;
+                    }
+                }
+            }
             transmission_index = bodies.len() - 1;
             chain_bodies = Some(bodies);
         }
@@ -428,7 +442,12 @@ impl Apparatus {
         ChainSetup {
             bodies: chain_bodies.unwrap_or_else(|| bars.into_iter().map(Into::into).collect()),
             joints,
-            striker_velocity_m_s: if driven { 0.0 } else { o.striker_velocity_m_s },
+            // The mirrored tube of a tension bar moves away from the incident bar (§6.13).
+            striker_velocity_m_s: if driven {
+                0.0
+            } else {
+                o.loading.sign() * o.striker_velocity_m_s
+            },
             dt_s: dt,
             end_time_s: o.end_time_s,
             gauges,
@@ -553,6 +572,7 @@ impl Apparatus {
                 snapshot_interval_s: None,
                 reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
                 incident_drive: None,
+                loading: crate::loading::Loading::Compression,
             },
             None,
         );
@@ -581,9 +601,11 @@ impl Apparatus {
 
 /// Puts a specimen into a bar chain after the last of `bodies` (the incident bar or its insert)
 /// and before the transmission side; returns the masses to add to the end nodes of bodies, as
-/// (body index, right end, mass in kg).
+/// (body index, right end, mass in kg). In tension a cylinder is bonded to both bars
+/// (docs/physics.md §6.13).
 fn join_specimen(
     specimen: &crate::specimen::Specimen,
+    loading: crate::loading::Loading,
     bodies: &mut Vec<crate::solver::BodySpec>,
     joints: &mut Vec<crate::solver::Joint>,
 ) -> Vec<(usize, bool, f64)> {
@@ -620,8 +642,12 @@ fn join_specimen(
         // §6.12).
         Specimen::Cylinder(c) => {
             bodies.push(BodySpec::Cylinder(c.clone()));
-            joints.push(Joint::Butt);
-            joints.push(Joint::Butt);
+            let face = match loading {
+                crate::loading::Loading::Compression => Joint::Butt,
+                crate::loading::Loading::Tension => Joint::Bonded,
+            };
+            joints.push(face);
+            joints.push(face);
             Vec::new()
         }
     }

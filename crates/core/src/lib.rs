@@ -20,6 +20,7 @@ pub mod fidelity;
 mod fixtures;
 pub mod flow;
 pub mod gauge;
+pub mod loading;
 pub mod material;
 pub mod numeric;
 pub mod reduce;

@@ -127,6 +127,23 @@ pub struct ReductionInput {
     pub transmission_strain: Vec<f64>,
 }
 
+impl ReductionInput {
+    /// The records in the loading's sense in which the compression stages read them
+    /// (docs/physics.md §7.8.1): a tension test's strains turned, s ε with s = −1; a compression
+    /// test's unchanged (borrowed).
+    pub fn in_loading_sense(&self, tension: bool) -> std::borrow::Cow<'_, ReductionInput> {
+        if !tension {
+            return std::borrow::Cow::Borrowed(self);
+        }
+        let turn = |v: &[f64]| v.iter().map(|x| -x).collect();
+        std::borrow::Cow::Owned(ReductionInput {
+            time_s: self.time_s.clone(),
+            incident_strain: turn(&self.incident_strain),
+            transmission_strain: turn(&self.transmission_strain),
+        })
+    }
+}
+
 /// Result of a reduction, on the common time axis of the specimen faces.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reduction {
@@ -190,6 +207,9 @@ pub struct Reduction {
     pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
+    /// A tension reduction (docs/physics.md §7.8.1): every series is in the loading's sense, the
+    /// face strains −ε of the gauges', forces, δ (the elongation) and stresses tension positive.
+    pub tension: bool,
     /// The two gauge records the windows were cut from, conditioned (smoothed, debiased) on the
     /// record's clock: what `--plot` places the windows on.
     pub record: RecordTrace,
@@ -347,6 +367,8 @@ pub fn reduce_named(
     file: &str,
 ) -> Result<Reduction> {
     options.validate()?;
+    // A tension test is reduced in its loading's sense: its records turned (§7.8.1).
+    let input = &*input.in_loading_sense(options.tension);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
     let corrections = correction::FaceCorrections::new(setup, options)?;
@@ -440,6 +462,7 @@ impl Reduction {
             dispersion: options.dispersion,
             tyas_pope: options.tyas_pope,
             warnings,
+            tension: options.tension,
             time_s,
             incident_strain: waves.incident,
             reflected_strain: waves.reflected,

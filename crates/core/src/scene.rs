@@ -576,7 +576,10 @@ fn run_pulse(
     if let Some(rec) = spheres_rec.as_mut() {
         recorders.push(rec);
     }
-    let r = crate::solver::simulate_chain_with(&chain, &mut recorders)?;
+    let mut r = crate::solver::simulate_chain_with(&chain, &mut recorders)?;
+    // A tension test reports its specimen tension positive (docs/physics.md §6.13).
+    let loading = options.loading;
+    r.specimen = r.specimen.map(|s| s.in_loading_sense(loading));
     let e = apparatus.material.youngs_modulus_pa;
     let driven = options.incident_drive.is_some();
     let mut summary = if driven {
@@ -624,10 +627,12 @@ fn run_pulse(
         let n = (options.end_time_s * ch.digitiser.sample_rate_hz).floor() as usize;
         let (t, v) = ch.record(&r.time_s, &r.strain[k], 0.0, n);
         let strain = resample(&r.time_s, &r.strain[k], &t);
-        if let Some(m) = crate::gauge::pulse_metrics(&t, &strain, true) {
+        // The pulse of the loading's sign, its stress in the loading's sense (tension positive
+        // in a tension test).
+        if let Some(m) = crate::gauge::pulse_metrics(&t, &strain, !loading.is_tension()) {
             summary.push(item(
                 &format!("{}_peak_stress", probe.name),
-                -e * m.peak,
+                -loading.sign() * e * m.peak,
                 "Pa",
             ));
             summary.push(item(
@@ -962,6 +967,7 @@ fn reduce_simulated_records(
         },
         specimen_radii_m: specimen_radii,
         smoothing_window_s: options.reduction_smoothing_s,
+        tension: options.loading.is_tension(),
         ..Default::default()
     };
     crate::reduce::reduce(

@@ -38,10 +38,25 @@ pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<Cyli
             ));
         }
     }
-    let (Some(length), Some(diameter), Some(material)) =
-        (spec.length_m, spec.diameter_m, &spec.material)
-    else {
-        let key = match (spec.length_m, spec.diameter_m) {
+    // A tension specimen's gauge length is its length under the lab's name (one of the two).
+    if let (Some(_), Some(_)) = (spec.length_m, spec.gauge_length_m) {
+        return Err(v.error(
+            "gauge_length_m",
+            "given with length_m: both name the specimen's length",
+            "one of length_m or gauge_length_m (the same length, m)",
+        ));
+    }
+    let length_key = if spec.gauge_length_m.is_some() {
+        "gauge_length_m"
+    } else {
+        "length_m"
+    };
+    let (Some(length), Some(diameter), Some(material)) = (
+        spec.length_m.or(spec.gauge_length_m),
+        spec.diameter_m,
+        &spec.material,
+    ) else {
+        let key = match (spec.length_m.or(spec.gauge_length_m), spec.diameter_m) {
             (None, _) => "length_m",
             (_, None) => "diameter_m",
             _ => "material",
@@ -164,7 +179,7 @@ pub fn build(spec: &SpecimenSpec, base_dir: &Path, v: &Validator) -> Result<Cyli
     };
     let c = CylinderSpecimen {
         material: elastic,
-        length_m: v.positive("length_m", length, 0.1, "m")?,
+        length_m: v.positive(length_key, length, 0.1, "m")?,
         diameter_m: v.positive("diameter_m", diameter, 0.1, "m")?,
         flow,
         radial_inertia: spec.radial_inertia.unwrap_or(false),

@@ -55,6 +55,9 @@ pub struct SpecimenSpec {
     pub shape: Option<String>,
     /// Length of a cylinder along the bar axis, m.
     pub length_m: Option<f64>,
+    /// A tension specimen's gauge length, m: the same length as `length_m` under the name a
+    /// tension-bar lab gives it (one of the two; docs/physics.md §6.13).
+    pub gauge_length_m: Option<f64>,
     /// Diameter of the `count` spheres, m.
     pub diameter_m: Option<f64>,
     /// One table per sphere of a chain, sphere 1 first.
@@ -102,7 +105,7 @@ pub const MAX_GAP_M: f64 = 1e-3;
 pub const MAX_PRELOAD_N: f64 = 1e4;
 
 /// What a cylindrical specimen is given as, for messages.
-pub const CYLINDER_FORM: &str = "shape = \"cylinder\" with length_m and diameter_m (each greater than 0, at most 0.1 m) and material (a built-in name such as \"al2017\", a material .toml, or a table { density_kg_m3, youngs_modulus_pa, poisson_ratio })";
+pub const CYLINDER_FORM: &str = "shape = \"cylinder\" with length_m (or a tension specimen's gauge_length_m) and diameter_m (each greater than 0, at most 0.1 m) and material (a built-in name such as \"al2017\", a material .toml, or a table { density_kg_m3, youngs_modulus_pa, poisson_ratio })";
 
 /// Most spheres a chain may have.
 pub const MAX_CHAIN_SPHERES: i64 = 100_000;
@@ -270,6 +273,7 @@ impl SpecimenSpec {
         }
         for (key, given) in [
             ("length_m", self.length_m.is_some()),
+            ("gauge_length_m", self.gauge_length_m.is_some()),
             ("model", self.model.is_some()),
             ("johnson_cook", self.johnson_cook.is_some()),
             ("flow_curve", self.flow_curve.is_some()),

@@ -155,6 +155,12 @@ fn every_repository_scene_parses_with_the_values_of_its_file() {
                 if let Some(cell) = float(t, "cell_size_m") {
                     assert_eq!(options.cell_size_m, cell);
                 }
+                assert_eq!(
+                    options.loading.name(),
+                    string(t, "loading").unwrap_or("compression"),
+                    "{}",
+                    path.display()
+                );
             }
         }
     }

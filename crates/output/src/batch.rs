@@ -395,7 +395,12 @@ fn face_panels<'a>(
             Axes {
                 title: waves_title,
                 x_label: "time at the faces (µs)",
-                y_label: "bar strain (µε), tension positive",
+                // A tension reduction reads the strains turned (docs/physics.md §7.8.1).
+                y_label: if r.tension {
+                    "bar strain (µε), gauges' sign turned (tension test)"
+                } else {
+                    "bar strain (µε), tension positive"
+                },
                 x_scale: 1e6,
                 y_scale: 1e6,
             },
@@ -410,7 +415,11 @@ fn face_panels<'a>(
             Axes {
                 title: "face forces",
                 x_label: "time at the faces (µs)",
-                y_label: "force, compression positive (kN)",
+                y_label: if r.tension {
+                    "force, tension positive (kN)"
+                } else {
+                    "force, compression positive (kN)"
+                },
                 x_scale: 1e6,
                 y_scale: 1e-3,
             },
@@ -482,6 +491,7 @@ pub fn record_figure(
             ];
             panels.push(plain(stress_strain_panel(
                 Measure::Engineering,
+                c.tension,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &a.strain, &a.stress_pa))
@@ -489,6 +499,7 @@ pub fn record_figure(
             )));
             panels.push(plain(strain_rate_panel(
                 Measure::Engineering,
+                c.tension,
                 analyses
                     .iter()
                     .map(|(name, a)| curve(name, &r.time_s, &a.strain_rate_per_s))

@@ -720,15 +720,20 @@ pub fn plot_run(path: &Path, force: bool, params: &Params, out: &RunOutput) -> R
     if let Some(chain) = &out.chain {
         return chain_figure(path, force, &title, chain);
     }
-    if let SceneParams::Pulse { apparatus, .. } = &params.params {
+    if let SceneParams::Pulse {
+        apparatus, options, ..
+    } = &params.params
+    {
         if let Some(contact) = &out.contact {
             let panel = force_approach_panel(contact, out.reduction.as_ref());
             return plot_test(path, force, &title, apparatus, out, vec![panel]);
         }
         if let Some(specimen) = &out.specimen {
             let cylinder = out.cylinder_reduction.as_ref();
-            let reduced_rate = cylinder.map_or_else(Vec::new, |c| true_strain_rate(&c.one_wave));
-            let panels = cylinder_test_panels(specimen, cylinder, &reduced_rate);
+            let tension = options.loading.is_tension();
+            let reduced_rate =
+                cylinder.map_or_else(Vec::new, |c| true_strain_rate(&c.one_wave, tension));
+            let panels = cylinder_test_panels(specimen, cylinder, &reduced_rate, tension);
             return plot_test(path, force, &title, apparatus, out, panels);
         }
     }
@@ -929,21 +934,33 @@ pub(crate) enum Measure {
 }
 
 /// A cylinder's stress–strain panel: `curves` of stress (Pa) against strain, drawn in MPa
-/// against %, compression positive.
+/// against %, compression positive (tension positive for a tension test, `tension`,
+/// docs/physics.md §7.8.1).
 pub(crate) fn stress_strain_panel(
     measure: Measure,
+    tension: bool,
     curves: Vec<Curve<'_>>,
 ) -> (Axes<'_>, Vec<Curve<'_>>) {
-    let (title, x_label, y_label) = match measure {
-        Measure::Engineering => (
+    let (title, x_label, y_label) = match (measure, tension) {
+        (Measure::Engineering, false) => (
             "cylinder: engineering stress against strain",
             "engineering strain (%), compression positive",
             "engineering stress (MPa), compression positive",
         ),
-        Measure::True => (
+        (Measure::Engineering, true) => (
+            "cylinder: engineering stress against strain",
+            "engineering strain (%), tension positive",
+            "engineering stress (MPa), tension positive",
+        ),
+        (Measure::True, false) => (
             "cylinder: true stress against true strain",
             "true strain (%), compression positive",
             "true stress (MPa), compression positive",
+        ),
+        (Measure::True, true) => (
+            "cylinder: true stress against true strain",
+            "true strain (%), tension positive",
+            "true stress (MPa), tension positive",
         ),
     };
     let axes = Axes {
@@ -956,26 +973,41 @@ pub(crate) fn stress_strain_panel(
     (axes, curves)
 }
 
-/// A cylinder's strain-rate panel, compression positive: the engineering rate against the time
-/// at the faces (µs; `curves` against the reduction's time in s), or the true rate against the
-/// true strain (%; `curves` against the true strain, which needs no common clock between the
-/// specimen and the reduction).
+/// A cylinder's strain-rate panel, compression positive (tension positive for a tension test):
+/// the engineering rate against the time at the faces (µs; `curves` against the reduction's
+/// time in s), or the true rate against the true strain (%; `curves` against the true strain,
+/// which needs no common clock between the specimen and the reduction).
 pub(crate) fn strain_rate_panel(
     measure: Measure,
+    tension: bool,
     curves: Vec<Curve<'_>>,
 ) -> (Axes<'_>, Vec<Curve<'_>>) {
-    let axes = match measure {
-        Measure::Engineering => Axes {
+    let axes = match (measure, tension) {
+        (Measure::Engineering, false) => Axes {
             title: "cylinder: engineering strain rate",
             x_label: "time at the faces (µs)",
             y_label: "strain rate (1/s), compression positive",
             x_scale: 1e6,
             y_scale: 1.0,
         },
-        Measure::True => Axes {
+        (Measure::Engineering, true) => Axes {
+            title: "cylinder: engineering strain rate",
+            x_label: "time at the faces (µs)",
+            y_label: "strain rate (1/s), tension positive",
+            x_scale: 1e6,
+            y_scale: 1.0,
+        },
+        (Measure::True, false) => Axes {
             title: "cylinder: true strain rate against true strain",
             x_label: "true strain (%), compression positive",
             y_label: "true strain rate (1/s), compression positive",
+            x_scale: 1e2,
+            y_scale: 1.0,
+        },
+        (Measure::True, true) => Axes {
+            title: "cylinder: true strain rate against true strain",
+            x_label: "true strain (%), tension positive",
+            y_label: "true strain rate (1/s), tension positive",
             x_scale: 1e2,
             y_scale: 1.0,
         },
@@ -983,12 +1015,19 @@ pub(crate) fn strain_rate_panel(
     (axes, curves)
 }
 
-/// The true strain rate of a reduced analysis, d/dt[−ln(1 − ε)] = ε̇/(1 − ε), 1/s.
-pub(crate) fn true_strain_rate(a: &WaveAnalysis) -> Vec<f64> {
+/// The true strain rate of a reduced analysis, d/dt[−ln(1 − ε)] = ε̇/(1 − ε), 1/s; in tension
+/// (`tension`, docs/physics.md §7.8.1) d/dt[ln(1 + ε)] = ε̇/(1 + ε).
+pub(crate) fn true_strain_rate(a: &WaveAnalysis, tension: bool) -> Vec<f64> {
     a.strain_rate_per_s
         .iter()
         .zip(&a.strain)
-        .map(|(rate, e)| rate / (1.0 - e))
+        .map(|(rate, e)| {
+            if tension {
+                rate / (1.0 + e)
+            } else {
+                rate / (1.0 - e)
+            }
+        })
         .collect()
 }
 
@@ -999,6 +1038,7 @@ fn cylinder_test_panels<'a>(
     s: &'a SpecimenSeries,
     c: Option<&'a CylinderReduction>,
     reduced_rate: &'a [f64],
+    tension: bool,
 ) -> Vec<(Axes<'a>, Vec<Curve<'a>>)> {
     let own = "true (specimen, simulation)";
     let mut stress = vec![curve(own, &s.true_strain, &s.face_stress_pa)];
@@ -1028,8 +1068,8 @@ fn cylinder_test_panels<'a>(
         });
     }
     vec![
-        stress_strain_panel(Measure::True, stress),
-        strain_rate_panel(Measure::True, rate),
+        stress_strain_panel(Measure::True, tension, stress),
+        strain_rate_panel(Measure::True, tension, rate),
     ]
 }
 

@@ -208,7 +208,8 @@ pub fn analysis_columns(
 }
 
 /// Writes `cylinder/` under the reduction group `g`: the geometry as attributes and
-/// `<analysis>/<series>` of [`cylinder_analyses`] (compression positive, docs/physics.md §7.8).
+/// `<analysis>/<series>` of [`cylinder_analyses`] (compression positive, docs/physics.md §7.8;
+/// tension positive for a tension test, §7.8.1).
 pub fn write_cylinder_group(g: &hdf5::Group, c: &CylinderReduction, path: &Path) -> Result<()> {
     let cg = g.create_group("cylinder").map_err(h5err(path))?;
     for (key, value) in [
@@ -224,7 +225,11 @@ pub fn write_cylinder_group(g: &hdf5::Group, c: &CylinderReduction, path: &Path)
     string_attr(
         &cg,
         "sign",
-        "compression positive (stress, strain, strain rate); docs/physics.md §7.8",
+        if c.tension {
+            "tension positive (stress, strain, strain rate): a tension test; docs/physics.md §7.8.1"
+        } else {
+            "compression positive (stress, strain, strain rate); docs/physics.md §7.8"
+        },
         path,
     )?;
     for (group, a) in cylinder_analyses(c) {

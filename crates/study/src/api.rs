@@ -378,6 +378,9 @@ pub struct RecordOptions {
     /// A record kept one file per channel (`--channel ROLE=FILE`); the record argument is then
     /// its name ([`shpb_input::channel_file::ChannelSet::name`]).
     pub channels: Option<shpb_input::channel_file::ChannelSet>,
+    /// A tension test (`--tension`, docs/physics.md §7.8.1): forces, stresses and strains tension
+    /// positive; a cylinder specimen needed. A run file of a tension scene is one without it.
+    pub tension: bool,
 }
 
 impl RecordOptions {
@@ -425,6 +428,9 @@ impl RecordOptions {
         if let Some(set) = &self.channels {
             c.push_str(&set.command_flags());
         }
+        if self.tension {
+            c.push_str(" --tension");
+        }
         c
     }
 }
@@ -442,6 +448,7 @@ impl Default for RecordOptions {
             layout: None,
             specimen: None,
             channels: None,
+            tension: false,
         }
     }
 }
@@ -456,6 +463,7 @@ fn reduce_flag(quantity: &str) -> &str {
         "window.reflected_delay_s" => "--reflected-delay",
         "window.transmitted_delay_s" => "--transmitted-delay",
         "window.duration_s" => "--duration",
+        "tension" => "--tension",
         other => other,
     }
 }
@@ -499,6 +507,7 @@ pub fn reduce_record_with(
 ) -> Result<Reduced> {
     // The options are checked once, by the core; its errors are reported as the flags.
     let mut options = ReductionOptions {
+        tension: choices.tension,
         dispersion: choices.dispersion,
         tyas_pope: choices.tyas_pope,
         alignment: choices.alignment,
@@ -565,8 +574,10 @@ pub fn reduce_record_with(
     }
     let run = if hdf5_input { run_setup(record)? } else { None };
     let own_set_up = run.is_some();
+    // A run file of a tension scene is reduced as a tension test (docs/physics.md §7.8.1).
+    let run_tension = run.as_ref().is_some_and(|r| r.2);
     let (apparatus, run_specimen) = match run {
-        Some((run_apparatus, run_specimen)) => {
+        Some((run_apparatus, run_specimen, _)) => {
             if let Some(flag) = bars_flag {
                 let (given, _) = load_record_apparatus(flag)?;
                 if ReductionSetup::from_apparatus(&given)?
@@ -606,6 +617,14 @@ pub fn reduce_record_with(
         (None, None) => run_specimen,
     };
     options.specimen_radii_m = specimen.radii_m();
+    options.tension = choices.tension || run_tension;
+    if options.tension && specimen.cylinder().is_none() {
+        return Err(input_err(
+            "--tension",
+            "a tension test reduced for spheres, which carry no tension",
+            "--tension with a cylinder: --specimen FILE.toml (shape = \"cylinder\", length_m or gauge_length_m, diameter_m) or --specimen-length L --specimen-diameter D",
+        ));
+    }
     let input = match &choices.channels {
         // A record kept one file per oscilloscope channel (`--channel ROLE=FILE`).
         Some(set) => {
@@ -705,7 +724,7 @@ pub fn record_input(
 /// The set-up and specimen a run file was simulated with (its spheres' radii or its cylinder;
 /// the paper's spheres for a pulse run), from the scene and inputs stored in its `/provenance`
 /// (None for a file without a stored bar scene, e.g. `shpb strain`'s).
-fn run_setup(record: &Path) -> Result<Option<(Apparatus, ReducedSpecimen)>> {
+fn run_setup(record: &Path) -> Result<Option<(Apparatus, ReducedSpecimen, bool)>> {
     let Ok(stored) = shpb_output::provenance::read_provenance(record) else {
         return Ok(None);
     };
@@ -716,12 +735,15 @@ fn run_setup(record: &Path) -> Result<Option<(Apparatus, ReducedSpecimen)>> {
     let (params, _) = load_scene(Scene::File(record), None, &[], String::new())?;
     Ok(match params.params {
         // A chain specimen's strain rate is δ̇/Σ rᵢ, as the run's own reduction took it.
-        SceneParams::Pulse { apparatus, .. } => Some((
+        SceneParams::Pulse {
+            apparatus, options, ..
+        } => Some((
             *apparatus,
             params
                 .specimen
                 .as_ref()
                 .map_or_else(ReducedSpecimen::default, ReducedSpecimen::of),
+            options.loading.is_tension(),
         )),
         _ => None,
     })

@@ -349,9 +349,10 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
     }
     if let Some(c) = cylinder {
         text.push_str(&format!(
-            "cylinder {:.3} mm × {:.3} mm (1-wave, compression positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
+            "cylinder {:.3} mm × {:.3} mm (1-wave, {} positive): peak stress {:.2} MPa at t = {:.2} µs; strain at peak {:.4e}; mean strain rate {:.1} 1/s\n",
             c.geometry.length_m * 1e3,
             c.geometry.diameter_m * 1e3,
+            if c.tension { "tension" } else { "compression" },
             c.peak_stress_pa * 1e-6,
             c.peak_time_s * 1e6,
             c.strain_at_peak,
@@ -405,6 +406,7 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
         "dispersion_corrected": r.dispersion_corrected,
         "dispersion": r.dispersion.name(),
         "tyas_pope": r.tyas_pope,
+        "loading": if r.tension { "tension" } else { "compression" },
         "peak_back_force_N": finite(r.peak_back_force_n),
         "peak_back_force_time_s": finite(r.peak_back_force_time_s),
         "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),

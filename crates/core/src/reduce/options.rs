@@ -41,6 +41,9 @@ pub struct ReductionOptions {
     pub alignment: Alignment,
     /// Bound of the balance search on each shift, s (default [`DEFAULT_BALANCE_BOUND_S`]).
     pub balance_bound_s: f64,
+    /// A tension test (split Hopkinson tension bar; default false): the records are read in the
+    /// loading's sense, every force, stress and strain tension positive (docs/physics.md §7.8.1).
+    pub tension: bool,
 }
 
 impl Default for ReductionOptions {
@@ -56,6 +59,7 @@ impl Default for ReductionOptions {
             smoothing_window_s: DEFAULT_SMOOTHING_S,
             alignment: Alignment::Geometric,
             balance_bound_s: DEFAULT_BALANCE_BOUND_S,
+            tension: false,
         }
     }
 }
@@ -118,6 +122,14 @@ impl ReductionOptions {
                 "specimen_radii_m",
                 format!("({r1}, {r2}) m"),
                 "two positive radii",
+            ));
+        }
+        if o.tension && o.specimen_radii_m.is_some() {
+            return Err(input_err(
+                file,
+                "tension",
+                "a tension reduction of spheres: spheres in contact carry no tension",
+                "tension with a cylinder specimen (or none), or spheres in compression",
             ));
         }
         if let Some(w) = o.window {

@@ -167,6 +167,8 @@ pub fn check_input(
     options: &super::ReductionOptions,
     file: &str,
 ) -> Result<()> {
+    // A tension test's records are checked in its loading's sense, as they are reduced (§7.10).
+    let input = &*input.in_loading_sense(options.tension);
     // A moving average that spans a large part of the record flattens every pulse in it: the
     // record must hold at least ten of its windows.
     let n = input.time_s.len();

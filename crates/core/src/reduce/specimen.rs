@@ -136,21 +136,51 @@ pub struct WaveAnalysis {
 
 impl WaveAnalysis {
     /// Builds the analysis from stress and strain rate (ε by the trapezoidal rule, or the given
-    /// strain) and adds the true quantities σ(1 − ε), −ln(1 − ε) (docs/physics.md §7.8).
-    fn new(stress_pa: Vec<f64>, strain_rate_per_s: Vec<f64>, strain: Vec<f64>) -> Result<Self> {
-        if let Some(&e) = strain.iter().find(|e| !(e.is_finite() && **e < 1.0)) {
-            return Err(Error::invalid(
-                "specimen strain",
-                format!("engineering strain {e} reached 1 (the specimen would be flat)"),
-                "engineering strains below 1: check --specimen-length",
-            ));
+    /// strain) and adds the true quantities at constant volume (docs/physics.md §7.8, §7.8.1): in
+    /// compression σ(1 − ε) and −ln(1 − ε); in tension (`tension`, ε the elongation over L_s,
+    /// tension positive) σ(1 + ε) and ln(1 + ε), A = A₀L₀/L with L = L₀(1 + ε).
+    fn new(
+        stress_pa: Vec<f64>,
+        strain_rate_per_s: Vec<f64>,
+        strain: Vec<f64>,
+        tension: bool,
+    ) -> Result<Self> {
+        let stretch = |e: f64| if tension { 1.0 + e } else { 1.0 - e };
+        if let Some(&e) = strain
+            .iter()
+            .find(|e| !(e.is_finite() && stretch(**e) > 0.0))
+        {
+            return Err(if tension {
+                Error::invalid(
+                    "specimen strain",
+                    format!(
+                        "engineering strain {e} reached −1 (the specimen would have no length)"
+                    ),
+                    "engineering strains above −1: check --specimen-length and --tension",
+                )
+            } else {
+                Error::invalid(
+                    "specimen strain",
+                    format!("engineering strain {e} reached 1 (the specimen would be flat)"),
+                    "engineering strains below 1: check --specimen-length",
+                )
+            });
         }
         let true_stress_pa = stress_pa
             .iter()
             .zip(&strain)
-            .map(|(s, e)| s * (1.0 - e))
+            .map(|(s, &e)| s * stretch(e))
             .collect();
-        let true_strain = strain.iter().map(|e| -(1.0 - e).ln()).collect();
+        let true_strain = strain
+            .iter()
+            .map(|&e| {
+                if tension {
+                    stretch(e).ln()
+                } else {
+                    -stretch(e).ln()
+                }
+            })
+            .collect();
         Ok(WaveAnalysis {
             stress_pa,
             strain,
@@ -181,6 +211,8 @@ pub struct CylinderReduction {
     /// Mean 1-wave strain rate from the first sample at 10 % of the peak stress to the peak,
     /// Δε/Δt, 1/s.
     pub mean_strain_rate_per_s: f64,
+    /// A tension test's reduction: every quantity tension positive (docs/physics.md §7.8.1).
+    pub tension: bool,
 }
 
 /// The 1-, 2- and 3-wave stress, strain and strain rate of a cylinder of geometry `g` from the
@@ -214,9 +246,10 @@ pub fn reduce_cylinder(
     let strain_1 = cumulative_trapezoid(&rate_1, dt);
     let rate_3: Vec<f64> = r.approach_velocity_m_s.iter().map(|v| v / l).collect();
     let strain_3: Vec<f64> = r.displacement_m.iter().map(|d| d / l).collect();
-    let one_wave = WaveAnalysis::new(sigma_1, rate_1.clone(), strain_1.clone())?;
-    let two_wave = WaveAnalysis::new(sigma_2, rate_1, strain_1)?;
-    let three_wave = WaveAnalysis::new(sigma_3, rate_3, strain_3)?;
+    let t = r.tension;
+    let one_wave = WaveAnalysis::new(sigma_1, rate_1.clone(), strain_1.clone(), t)?;
+    let two_wave = WaveAnalysis::new(sigma_2, rate_1, strain_1, t)?;
+    let three_wave = WaveAnalysis::new(sigma_3, rate_3, strain_3, t)?;
     let k = argmax(&one_wave.stress_pa);
     let peak = one_wave.stress_pa[k];
     let k10 = one_wave.stress_pa[..=k]
@@ -237,6 +270,7 @@ pub fn reduce_cylinder(
         one_wave,
         two_wave,
         three_wave,
+        tension: r.tension,
     })
 }
 
@@ -395,6 +429,7 @@ mod tests {
             tyas_pope: false,
             warnings: vec![],
             record: crate::reduce::RecordTrace::default(),
+            tension: false,
         }
     }
 

@@ -778,6 +778,25 @@ pub struct SpecimenSeries {
 }
 
 impl SpecimenSeries {
+    /// The series in the loading's sense (docs/physics.md §6.13): in tension the stresses, the
+    /// true strain and its rate turned (tension positive: σ = F/A with A = A₀L₀/L, ε = ln(L/L₀));
+    /// in compression unchanged. Plastic strain, temperature and work carry no sign.
+    pub fn in_loading_sense(mut self, loading: crate::loading::Loading) -> SpecimenSeries {
+        if loading.is_tension() {
+            for v in [
+                &mut self.face_stress_pa,
+                &mut self.element_stress_pa,
+                &mut self.friction_stress_pa,
+                &mut self.inertia_stress_pa,
+                &mut self.true_strain,
+                &mut self.true_strain_rate_per_s,
+            ] {
+                v.iter_mut().for_each(|x| *x = -*x);
+            }
+        }
+        self
+    }
+
     /// Appends one sample at `time_s`.
     pub fn push(&mut self, time_s: f64, s: &SpecimenSample) {
         self.time_s.push(time_s);

@@ -14,7 +14,12 @@
 //! * a **sphere contact** is solved the same way with a contact law ([`Contact`]) at the Newmark
 //!   average approach and the centred approach rate (the law's memory is committed once a step),
 //!   by bisection until the crossing bisection would find is isolated, then the Illinois method
-//!   (its crossing of F = law(F) need not be unique where the rate changes sign).
+//!   (its crossing of F = law(F) need not be unique where the rate changes sign);
+//! * a **bonded joint** (a tension specimen threaded or glued to a bar) never opens: the two end
+//!   nodes move as one full node in tension as in compression (docs/physics.md §6.13);
+//! * a **flange** is the tension bar's loading joint (docs/physics.md §6.13): the striker tube on
+//!   the incident bar's flange mirrored through the flange, a butt joint (or shaper) that
+//!   carries tension only, F(c) = −F_butt(−c).
 
 use super::body::Body;
 use crate::contact::{Contact, ContactEval, LawSpec};
@@ -38,6 +43,12 @@ pub enum Joint {
         /// How the pair sits before the test (a gap, or a static preload).
         seating: Seating,
     },
+    /// A joint that carries tension and compression and never opens (a tension specimen bonded
+    /// or threaded to its bars; docs/physics.md §6.13).
+    Bonded,
+    /// The tension bar's striker on the incident bar's flange, mirrored (docs/physics.md §6.13):
+    /// a butt joint, or the shaper on the flange, that pulls and never pushes.
+    Flange(Option<PulseShaper>),
 }
 
 /// State of a joint: its law, memory and the work it has taken.
@@ -113,13 +124,24 @@ impl JointState {
         self.work_j
     }
 
-    /// The joint force for a prediction without committing the memory (≥ 0, compressive), N.
+    /// The joint force for a prediction without committing the memory (compression positive;
+    /// ≥ 0 but for a bonded joint or a flange, which pull), N.
     pub fn trial_force_n(&self, p: &JointPrediction, dt_s: f64) -> f64 {
         match self.joint {
             Joint::Butt => {
                 // Closed joint: force that makes both ends move together (closure rate 0), if
                 // compressive (0 when the joint stays open: the ends would not meet within the step).
-                ((p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)).max(0.0)
+                closed_force_n(p, dt_s).max(0.0)
+            }
+            Joint::Bonded => closed_force_n(p, dt_s),
+            Joint::Flange(None) => closed_force_n(p, dt_s).min(0.0),
+            Joint::Flange(Some(s)) => {
+                // The shaper's law on the mirrored closure, its force turned: F = −F_s(−c).
+                let m = p.mirrored();
+                let shaper = self.shaper;
+                -solve_force_illinois(|f| {
+                    s.force_n(&mut shaper.clone(), m.average_closure_m(f, dt_s), dt_s)
+                })
             }
             Joint::Shaper(s) => {
                 let shaper = self.shaper;
@@ -149,12 +171,19 @@ impl JointState {
             Joint::Shaper(s) => {
                 s.force_n(&mut self.shaper, p.average_closure_m(f, dt_s), dt_s);
             }
+            Joint::Flange(Some(s)) => {
+                s.force_n(
+                    &mut self.shaper,
+                    p.mirrored().average_closure_m(-f, dt_s),
+                    dt_s,
+                );
+            }
             Joint::Spheres { .. } => {
                 let law = self.law.as_mut().expect("sphere joints carry their law");
                 self.approach_m = p.average_closure_m(f, dt_s) + self.closure_offset_m;
                 self.contact = law.evaluate(self.approach_m, p.closure_rate_m_s(f, dt_s));
             }
-            Joint::Butt => {}
+            Joint::Butt | Joint::Bonded | Joint::Flange(None) => {}
         }
         self.work_j += f * 0.5 * (p.next_closure_m(f, dt_s) - p.previous_closure_m);
         self.force_n = f;
@@ -175,7 +204,23 @@ pub struct JointPrediction {
     pub compliance: f64,
 }
 
+/// Force that keeps a joint closed over the step (closure rate 0): (c + Δt ċ_free)/(Δt κ), N.
+fn closed_force_n(p: &JointPrediction, dt_s: f64) -> f64 {
+    (p.closure_m + dt_s * p.free_rate_m_s) / (dt_s * p.compliance)
+}
+
 impl JointPrediction {
+    /// The prediction seen through a mirror (closures and rates turned, compliance kept): its
+    /// closure at force −f is minus this one's at f (docs/physics.md §6.13, the flange).
+    pub fn mirrored(&self) -> JointPrediction {
+        JointPrediction {
+            closure_m: -self.closure_m,
+            previous_closure_m: -self.previous_closure_m,
+            free_rate_m_s: -self.free_rate_m_s,
+            compliance: self.compliance,
+        }
+    }
+
     /// Predicts the joint between the right end of `left` and the left end of `right`, given the
     /// forces (N, toward +x) on their other ends this step (they matter for rigid masses only).
     pub fn new(

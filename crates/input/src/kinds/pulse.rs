@@ -13,6 +13,7 @@ use shpb_core::bar::Dispersion;
 use shpb_core::contact::{LawKind, LawSpec, Region2Form, Unloading};
 use shpb_core::error::format_si;
 use shpb_core::fidelity::Fidelity;
+use shpb_core::loading::Loading;
 use shpb_core::scene::SceneParams;
 use shpb_core::specimen::{CYLINDER_MIN_CELLS, Specimen, SphereSpecimen};
 use std::path::Path;
@@ -110,6 +111,14 @@ pub(super) const GAUGE_LENGTH: Key = Key {
     meaning: "grid length of the strain gauges (they read the mean strain over it), 0 to 0.05",
 };
 
+/// `loading` (shpb only): compression or tension (docs/physics.md §6.13).
+pub(super) const LOADING: Key = Key {
+    key: "loading",
+    unit: "",
+    default: "compression",
+    meaning: "compression (a pressure bar) or tension (a tension bar, SHTB: the striker tube on the incident bar's flange, a tensile incident pulse, the specimen bonded to both bars; a cylinder specimen only, without friction or [incident_record]; docs/physics.md §6.13)",
+};
+
 /// `[incident_record]` (shpb only).
 pub(super) const INCIDENT_RECORD: Key = Key {
     key: "incident_record",
@@ -153,6 +162,7 @@ struct PulseFile {
     #[serde(default = "default_gauge_length")]
     gauge_length_m: f64,
     smooth_s: Option<f64>,
+    loading: Option<String>,
 }
 
 /// `[incident_record]`: a gauge record whose incident wave drives the incident bar.
@@ -298,6 +308,7 @@ pub(super) fn parse_bars(
             "no [shaper] table in a test driven by a record",
         ));
     }
+    let loading = parse_loading(&f, specimen.as_ref(), v, is_test)?;
     let shaper = f.shaper.unwrap_or_default().apply(
         apparatus.shaper,
         face_modulus_pa,
@@ -472,6 +483,7 @@ pub(super) fn parse_bars(
         snapshot_interval_s: is_test.then_some(knobs.snapshot_interval_s),
         reduction_smoothing_s,
         incident_drive: drive,
+        loading,
     };
     // Refuse a run too large for this machine before its bars are built (below), then a grid
     // the bars cannot run (time step over the stability limit) now, not mid-run.
@@ -509,6 +521,50 @@ pub(super) fn parse_bars(
             options: Box::new(options),
         },
     ))
+}
+
+/// The scene's `loading` (docs/physics.md §6.13): compression unless `tension` is given; a
+/// tension test needs a cylinder without end friction, loaded by the striker (not a record).
+fn parse_loading(
+    f: &PulseFile,
+    specimen: Option<&Specimen>,
+    v: &Validator,
+    is_test: bool,
+) -> Result<Loading> {
+    let allowed = Loading::ALL.map(Loading::name).join(", ");
+    let loading = match f.loading.as_deref() {
+        None => return Ok(Loading::Compression),
+        Some(name) => Loading::parse(name)
+            .ok_or_else(|| v.error("loading", format!("unknown loading `{name}`"), &allowed))?,
+    };
+    if !is_test {
+        return Err(v.error(
+            "loading",
+            "given in a pulse scene, which has no specimen to load",
+            "loading only in shpb scenes",
+        ));
+    }
+    if !loading.is_tension() {
+        return Ok(loading);
+    }
+    match specimen {
+        Some(Specimen::Cylinder(c)) if c.friction.is_some() => Err(v.error(
+            "loading",
+            "tension with specimen.friction_coefficient: a tension specimen is threaded or bonded to the bars, whose faces do not slide",
+            "loading = \"tension\" without friction_coefficient (or loading = \"compression\")",
+        )),
+        Some(Specimen::Cylinder(_)) if f.incident_record.is_some() => Err(v.error(
+            "loading",
+            "tension with [incident_record]: a recorded incident wave drives a compression test",
+            "loading = \"tension\" with pressure or striker_velocity_m_s",
+        )),
+        Some(Specimen::Cylinder(_)) => Ok(loading),
+        _ => Err(v.error(
+            "loading",
+            "tension with spheres: spheres in contact carry no tension",
+            "loading = \"tension\" with a cylinder specimen (shape = \"cylinder\"), or loading = \"compression\"",
+        )),
+    }
 }
 
 /// Checks of the key documentation shared by pulse and shpb.
@@ -649,7 +705,7 @@ mod tests {
 
     #[test]
     fn registry_entry() {
-        // A pulse scene accepts but refuses `specimen`, `smooth_s` and `incident_record`, and
+        // A pulse scene accepts but refuses `specimen`, `smooth_s`, `incident_record` and `loading`, and
         // has no use for `law`, `region2` and `unloading`.
         super::super::check_kind(
             &KIND,
@@ -660,6 +716,7 @@ mod tests {
                 "unloading",
                 "smooth_s",
                 "incident_record",
+                "loading",
             ],
         );
         check_bar_key_docs();

@@ -2,8 +2,8 @@
 //! between the bars, gauges and the lab's reduction.
 
 use super::pulse::{
-    self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, INCIDENT_RECORD, PRESSURE, SHAPER,
-    SMOOTH, STRIKER_VELOCITY,
+    self, BARS, CELL_SIZE, DISPERSION, END_TIME, GAUGE_LENGTH, INCIDENT_RECORD, LOADING, PRESSURE,
+    SHAPER, SMOOTH, STRIKER_VELOCITY,
 };
 use super::{Key, LAW, Parsed, REGION2, SceneKind, UNLOADING};
 use crate::error::{Result, Validator};
@@ -29,6 +29,7 @@ pub(super) const KIND: SceneKind = SceneKind {
         END_TIME,
         GAUGE_LENGTH,
         SMOOTH,
+        LOADING,
     ],
     example: "kind = \"shpb\"\nbars = \"authors\"\npressure = \"10psi\"\nspecimen = { pair = \"ss440c\" }\n",
     example_dir: None,

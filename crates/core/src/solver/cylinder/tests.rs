@@ -369,3 +369,151 @@ fn friction_raises_the_stress_by_its_factor() {
         assert!(c.friction_work_j() > 0.3 * c.plastic_work_j());
     }
 }
+
+/// Tension kinematics (docs/physics.md §6.13): one element pulled at a steady rate between
+/// prescribed end velocities. Its true stress F/A_p (A_p = A₀L₀/l_p, constant plastic volume)
+/// is σ_f at its own ε̄p, ε̇p, T to 1e-6, as in compression; and the reduction's conversion of
+/// the faces' engineering stress T/A₀ and strain ΔL/L₀ in the uniform limit, σ(1 + ε) and
+/// ln(1 + ε) (§7.8.1), gives σ_f (1 + σ_f/E) and ε̄p + ln(1 + σ_f/E): the constitutive law, up to
+/// the elastic stretch L/l_p = 1 + σ/E that a constant-volume reduction counts as plastic
+/// (exactly, to 1e-9 and 1e-12). The series in the loading's sense is tension positive.
+#[test]
+fn a_uniform_element_in_tension_reproduces_its_flow_law() {
+    let table = FlowTable::new("t", vec![0.0, 0.1, 0.4], vec![100e6, 180e6, 240e6]).unwrap();
+    for flow in [
+        FlowModel::JohnsonCook(copper_jc(false)),
+        FlowModel::JohnsonCook(copper_jc(true)),
+        FlowModel::Tabulated(table),
+    ] {
+        let l0 = 5e-3;
+        let spec = cylinder(COPPER, 5e-3, l0, flow.clone());
+        let dt = l0 / (1.5 * COPPER.wave_speed_m_s());
+        let mut c = PlasticCylinder::new(&spec, dt).unwrap();
+        let speed = 5.0; // ε̇ ≈ 1000/s
+        let e_mod = COPPER.youngs_modulus_pa;
+        let area0 = PI * 0.25 * 5e-3 * 5e-3;
+        let (mut worst, mut worst_stress, mut worst_strain) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut eqps, mut temp) = (0.0, 298.0);
+        let mut series = SpecimenSeries::default();
+        let mut steps = 0;
+        // The element's stress and plastic strain at the last level (after its return map).
+        let mut previous: Option<(f64, f64)> = None;
+        while -c.sample().true_strain < 0.3 {
+            let f = c.step_with_end_velocities(-0.5 * speed, 0.5 * speed);
+            steps += 1;
+            series.push(c.time_s(), c.sample());
+            // Once steady, the right face's pull at level n is the element's force there: the
+            // faces' engineering stress and strain at that level, converted as the reduction
+            // converts them.
+            if let Some((sigma_n, eqps_n)) = previous
+                && steps > 3
+                && eqps_n > 0.0
+            {
+                let length = l0 * (-c.sample().true_strain).exp();
+                let (s_eng, e_eng) = (f[1] / area0, length / l0 - 1.0);
+                let (s_true, e_true) = (s_eng * (1.0 + e_eng), (1.0 + e_eng).ln());
+                let elastic = 1.0 + sigma_n / e_mod;
+                worst_stress = worst_stress.max((s_true / (sigma_n * elastic) - 1.0).abs());
+                worst_strain = worst_strain.max((e_true - (eqps_n + elastic.ln())).abs());
+            }
+            let new_eqps = c.plastic_strain(0);
+            if new_eqps > eqps {
+                let rate = (new_eqps - eqps) / dt;
+                let sigma_f = flow.flow_stress_pa(new_eqps, rate, temp);
+                // Tension: the element's stress is positive.
+                let sigma = c.element_stress_pa(0);
+                worst = worst.max((sigma - sigma_f).abs() / sigma_f);
+            }
+            previous = Some((c.element_stress_pa(0), new_eqps));
+            eqps = new_eqps;
+            temp = c.temperature_k(0);
+        }
+        eprintln!(
+            "{flow:?}: element {worst:.1e}, true stress {worst_stress:.1e}, strain {worst_strain:.1e}"
+        );
+        assert!(worst <= 1e-6, "{flow:?}: {worst:e}");
+        assert!(worst_stress <= 1e-9, "{flow:?}: {worst_stress:e}");
+        assert!(worst_strain <= 1e-12, "{flow:?}: {worst_strain:e}");
+        // It lengthened and thinned at constant plastic volume; the series reads it tension
+        // positive in the loading's sense (and as written in compression).
+        assert!(c.plastic_strain(0) > 0.25);
+        let pulled = series
+            .clone()
+            .in_loading_sense(crate::loading::Loading::Tension);
+        assert_eq!(
+            series.in_loading_sense(crate::loading::Loading::Compression),
+            SpecimenSeries {
+                face_stress_pa: pulled.face_stress_pa.iter().map(|x| -x).collect(),
+                element_stress_pa: pulled.element_stress_pa.iter().map(|x| -x).collect(),
+                friction_stress_pa: pulled.friction_stress_pa.iter().map(|x| -x).collect(),
+                inertia_stress_pa: pulled.inertia_stress_pa.iter().map(|x| -x).collect(),
+                true_strain: pulled.true_strain.iter().map(|x| -x).collect(),
+                true_strain_rate_per_s: pulled.true_strain_rate_per_s.iter().map(|x| -x).collect(),
+                ..pulled.clone()
+            }
+        );
+        let last = pulled.true_strain.len() - 1;
+        assert!(pulled.true_strain[last] > 0.29 && pulled.face_stress_pa[last] > 100e6);
+        // Its true strain rate is the pull speed over its current length, ε̇ = v/L.
+        let length = l0 * pulled.true_strain[last].exp();
+        assert!((pulled.true_strain_rate_per_s[last] * length / speed - 1.0).abs() < 1e-12);
+    }
+}
+
+/// The test chain loaded in tension (docs/physics.md §6.13): the striker on the flange (a joint
+/// that pulls only) moving away at `speed`, the specimen bonded to both bars.
+fn tension_chain(specimen: BodySpec, speed: f64) -> ChainSetup {
+    let mut setup = test_chain(specimen, -speed);
+    setup.joints = vec![Joint::Flange(None), Joint::Bonded, Joint::Bonded];
+    setup
+}
+
+/// The tension bar's flange is the pressure bar's striker mirrored: until the specimen's
+/// reflection reaches the incident gauge the tension run's gauge strain is the compression run's
+/// with its sign turned, bit for bit. The copper specimen then flows in tension (lengthens), and
+/// the chain's energy ledger closes at every sample to 1e-9 of the striker's energy (striker =
+/// bars + specimen + joints + plastic work), friction off, radial inertia off and on.
+#[test]
+fn a_tension_chain_mirrors_the_striker_and_closes_its_ledger() {
+    for inertia in [false, true] {
+        let mut spec = cylinder(COPPER, 0.01, 6e-3, FlowModel::JohnsonCook(copper_jc(true)));
+        spec.radial_inertia = inertia;
+        spec.design_true_strain = 0.4;
+        let pushed = simulate_chain(&test_chain(BodySpec::Cylinder(spec.clone()), 15.0)).unwrap();
+        let pulled = simulate_chain(&tension_chain(BodySpec::Cylinder(spec), 15.0)).unwrap();
+        // Incident wave at the gauge (x = 0.5 m of 1 m) from 0.5/c0; the reflection from 1.5/c0.
+        let c0 = (200e9f64 / 8000.0).sqrt();
+        let before = pulled.time_s.iter().position(|&t| t >= 1.45 / c0).unwrap();
+        let mirrored: Vec<f64> = pushed.strain[0][..before].iter().map(|e| -e).collect();
+        assert_eq!(pulled.strain[0][..before], mirrored[..]);
+        assert!(pulled.strain[0][..before].iter().any(|&e| e > 1e-4));
+        assert_eq!(pulled.striker_energy_j, pushed.striker_energy_j);
+        let e0 = pulled.striker_energy_j;
+        let mut worst = 0.0f64;
+        for i in 0..pulled.time_s.len() {
+            let books = pulled.bar_energy_j[i]
+                + pulled.absorbed_energy_j[i]
+                + pulled.shaper_energy_j[i]
+                + pulled.contact_energy_j[i]
+                + pulled.plastic_work_j[i]
+                + pulled.friction_work_j[i]
+                - pulled.inertia_exchange_j[i];
+            worst = worst.max((books - e0).abs() / e0);
+        }
+        let s = pulled
+            .specimen
+            .clone()
+            .unwrap()
+            .in_loading_sense(crate::loading::Loading::Tension);
+        let strain = s.true_strain.iter().fold(0.0f64, |a, &x| a.max(x));
+        let plastic = *pulled.plastic_work_j.last().unwrap();
+        eprintln!(
+            "inertia {inertia}: closure {worst:.1e}, plastic {:.3} of E0, tensile strain {strain:.3}",
+            plastic / e0
+        );
+        assert!(worst <= 1e-9, "inertia {inertia}: {worst:e}");
+        assert!(plastic > 0.01 * e0 && strain > 0.05, "it flows: {strain}");
+        // The transmission bar is pulled: its gauge reads tension.
+        assert!(pulled.strain[1].iter().fold(0.0f64, |a, &e| a.max(e)) > 1e-4);
+    }
+}
