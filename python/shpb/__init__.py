@@ -83,6 +83,13 @@ class Run:
         return self._data.origin
 
     @property
+    def verdict(self) -> Optional[Tuple[str, str]]:
+        """The reduction's equilibrium verdict (``"equilibrium"``, ``"marginal"``, ``"not in
+        equilibrium"``) and the sentence saying which alignment was used and why the verdict
+        follows (``verdict_reason`` of ``shpb reduce --summary``); None without a reduction."""
+        return self._data.verdict()
+
+    @property
     def warnings(self) -> List[str]:
         """What the user should know about the run (range of validity, reduction windows)."""
         return self._data.warnings()

@@ -692,3 +692,13 @@ def test_reduce_layout_keyword_equals_the_flag(cli, tmp_path):
         assert same(r[k], data), k
     csv = shpb.reduce(RECORD, bars="authors")
     assert same(r["reduction/force_back"], csv["reduction/force_back"])
+
+
+def test_reduce_verdict_is_the_sentence_shpb_reduce_writes(cli):
+    # Run.verdict is (verdict, reason) as `shpb reduce --json` gives them.
+    out = json.loads(cli("reduce", RECORD, "--align", "balance", "--json").stdout)
+    r = shpb.reduce(RECORD, align="balance")
+    verdict, reason = r.verdict
+    assert reason == out["verdict_reason"]
+    assert verdict in ("equilibrium", "marginal", "not in equilibrium")
+    assert "balance" in reason

@@ -410,6 +410,20 @@ impl RunData {
         found.ok_or_else(|| PyKeyError::new_err(path.to_string()))
     }
 
+    /// The equilibrium verdict of the reduction and the sentence saying why it follows
+    /// (`shpb_core::reduce::verdict_reason`); None for a run without a reduction or a file.
+    fn verdict(&self) -> Option<(String, String)> {
+        let r = match &self.source {
+            Source::Simulated { out, .. } => out.reduction.as_ref()?,
+            Source::Reduced { reduction, .. } => reduction,
+            Source::Loaded { .. } => return None,
+        };
+        Some((
+            r.quality.verdict.name().to_string(),
+            shpb_core::reduce::verdict_reason(r),
+        ))
+    }
+
     /// The warnings of the run (one string each).
     fn warnings(&self) -> Vec<String> {
         match &self.source {
