@@ -41,6 +41,8 @@ pub struct ReductionOptions {
     pub alignment: Alignment,
     /// Bound of the balance search on each shift, s (default [`DEFAULT_BALANCE_BOUND_S`]).
     pub balance_bound_s: f64,
+    /// Wave separation of overlapping pulses (default none; docs/physics.md §7.11).
+    pub wave_separation: super::WaveSeparation,
 }
 
 impl Default for ReductionOptions {
@@ -56,6 +58,7 @@ impl Default for ReductionOptions {
             smoothing_window_s: DEFAULT_SMOOTHING_S,
             alignment: Alignment::Geometric,
             balance_bound_s: DEFAULT_BALANCE_BOUND_S,
+            wave_separation: super::WaveSeparation::None,
         }
     }
 }
@@ -67,6 +70,7 @@ impl ReductionOptions {
     pub fn validate(&self) -> Result<()> {
         let o = self;
         let file = "reduction options";
+        super::separation::validate(o)?;
         if o.tyas_pope && o.dispersion == DispersionCorrection::None {
             return Err(input_err(
                 file,

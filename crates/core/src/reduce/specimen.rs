@@ -394,6 +394,7 @@ mod tests {
             dispersion: crate::reduce::DispersionCorrection::None,
             tyas_pope: false,
             warnings: vec![],
+            separation: None,
         }
     }
 
