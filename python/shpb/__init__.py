@@ -422,6 +422,7 @@ def reduce(
     layout: Optional[PathLike] = None,
     balance_bound_s: float = 60e-6,
     specimen: Optional[PathLike] = None,
+    wave_separation: str = "none",
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -440,7 +441,11 @@ def reduce(
     each window shift, s (``--balance-bound``). ``specimen``: a specimen file (``--specimen``),
     a ``[specimen]`` table as in a scene: spheres of any diameter (the strain rate over their
     radii, δ̇/Σrᵢ) or ``shape = "cylinder"`` (its 1/2/3-wave curves); not with
-    ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own."""
+    ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own.
+    ``wave_separation``: ``"none"``, ``"one-gauge"`` or ``"two-gauge"``
+    (``--wave-separation``, docs/physics.md §7.11): the waves toward and away from the specimen
+    at each face when the pulses overlap at the gauges (two gauges: the set-up's
+    ``incident_2`` and ``transmission_2`` channels, recorded in a run file)."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -456,6 +461,7 @@ def reduce(
             None if layout is None else os.fspath(layout),
             _number("balance_bound_s", balance_bound_s, "a positive bound in seconds"),
             None if specimen is None else os.fspath(specimen),
+            wave_separation,
         )
     )
 

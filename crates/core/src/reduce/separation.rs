@@ -418,12 +418,14 @@ pub(crate) fn stage(
                     ));
                 }
             }
+            // Smoothed as the first gauges; the baseline ends before the pulse reaches the
+            // gauge: on the incident bar the second gauge sees it (d₂ − d₁)/c0 earlier.
             let half = (options.smoothing_window_s / dt / 2.0).round() as usize;
-            let condition = |e: &[f64]| {
-                super::baseline::debias(
-                    &crate::numeric::moving_average(e, half),
-                    strains.baseline_samples,
-                )
+            let condition = |e: &[f64], earlier_s: f64| {
+                let nb = strains
+                    .baseline_samples
+                    .saturating_sub((earlier_s / dt).ceil() as usize);
+                super::baseline::debias(&crate::numeric::moving_average(e, half), nb)
             };
             if g.incident_strain.len() != n || g.transmission_strain.len() != n {
                 return Err(missing(
@@ -437,7 +439,7 @@ pub(crate) fn stage(
             }
             let inc = two_gauge(
                 &strains.incident,
-                &condition(&g.incident_strain),
+                &condition(&g.incident_strain, (g.incident_gauge_m - d_i) / c_i),
                 d_i,
                 g.incident_gauge_m,
                 dt,
@@ -445,7 +447,7 @@ pub(crate) fn stage(
             );
             let tra = two_gauge(
                 &strains.transmission,
-                &condition(&g.transmission_strain),
+                &condition(&g.transmission_strain, 0.0),
                 d_t,
                 g.transmission_gauge_m,
                 dt,
