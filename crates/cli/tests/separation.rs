@@ -60,8 +60,30 @@ fn two_gauges_give_the_specimen_stress_of_a_short_bar_test_and_one_gauge_is_refu
             "--wave-separation",
             "two-gauge",
             "--json",
+            "-o",
+            "reduced.h5",
         ],
     ));
+    // The reduction file says how it was made: the command line and the separation.
+    let f = hdf5::File::open(dir.path().join("reduced.h5")).unwrap();
+    let scene = f
+        .attr("scene")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert!(
+        scene.as_str().contains("--wave-separation two-gauge"),
+        "{}",
+        scene.as_str()
+    );
+    let gauges = f
+        .group("summary")
+        .unwrap()
+        .attr("wave_separation_gauges_per_bar")
+        .unwrap()
+        .read_scalar::<f64>()
+        .unwrap();
+    assert_eq!(gauges, 2.0);
     assert_eq!(sep["wave_separation"]["method"], "two-gauge");
     assert_eq!(sep["wave_separation"]["exact_mode"], true);
     assert_eq!(

@@ -687,7 +687,7 @@ fn second_gauges(
             input_err(
                 "--wave-separation",
                 format!(
-                    "two-gauge separation: the set-up {} has no `{name}` gauge channel",
+                    "two-gauge separation: {} has no `{name}` gauge channel",
                     apparatus.source
                 ),
                 need,
