@@ -123,9 +123,13 @@ pub struct SeparatedWaves {
     pub away: Vec<f64>,
 }
 
-/// Σ_{n<N} zⁿ for |z| = 1, z = e^{−iθ}: e^{−i(N−1)θ/2} sin(Nθ/2)/sin(θ/2), N where sin(θ/2) = 0
-/// (the truncated geometric series that replaces 1/(1 − z), docs/physics.md §7.11).
+/// Σ_{n<N} zⁿ (the truncated geometric series that replaces 1/(1 − z), docs/physics.md §7.11):
+/// for |z| = 1, z = e^{−iθ}, e^{−i(N−1)θ/2} sin(Nθ/2)/sin(θ/2), N where sin(θ/2) = 0; else
+/// (1 − z^N)/(1 − z) (an absorbing far end, z = 0, gives 1).
 fn truncated_series(z: Complex<f64>, n_terms: usize) -> Complex<f64> {
+    if (z.norm() - 1.0).abs() > 1e-9 {
+        return (Complex::new(1.0, 0.0) - z.powu(n_terms as u32)) / (Complex::new(1.0, 0.0) - z);
+    }
     let theta = -z.arg();
     let n = n_terms as f64;
     let half = 0.5 * theta;
@@ -770,6 +774,11 @@ mod tests {
         let want_b: Vec<f64> = time.iter().map(|&t| back(t)).collect();
         assert!(rms(&w.away[..k], &want_t[..k]) < 1e-12 * peak(&want_t));
         assert!(rms(&w.toward[..k], &want_b[..k]) < 1e-12 * peak(&want_t));
+        // An absorbing far end: no echo, the gauge's record is the transmitted wave.
+        let e: Vec<f64> = time.iter().map(|&t| tr(t - s / c0)).collect();
+        let w = one_gauge_transmission(&e, s, a, 0.0, dt, &prop);
+        assert!(rms(&w.away[..k], &want_t[..k]) < 1e-12 * peak(&want_t));
+        assert!(peak(&w.toward[..k]) < 1e-12 * peak(&want_t));
 
         // Incident bar: incident 90 µs (over before 2 s/c0 = 100 µs), reflection 150 µs long
         // overlapping its own echo from the impact end (2 a/c0 = 120 µs).
@@ -789,9 +798,17 @@ mod tests {
         assert!(rms(&w.away[..k], &want_r[..k]) < 1e-12 * peak(&want_r));
     }
 
-    /// The truncated series is the sum it stands for, at and away from its singular points.
+    /// The truncated series is the sum it stands for, at and away from its singular points, and
+    /// off the unit circle (an absorbing end's z = 0 sums to 1).
     #[test]
     fn truncated_series_sums_its_terms() {
+        assert_eq!(
+            truncated_series(Complex::new(0.0, 0.0), 17),
+            Complex::new(1.0, 0.0)
+        );
+        let z = Complex::from_polar(0.5, 0.7);
+        let direct: Complex<f64> = (0..17).map(|k| z.powu(k)).sum();
+        assert!((truncated_series(z, 17) - direct).norm() < 1e-12);
         for theta in [
             0.0,
             1e-9,
