@@ -431,6 +431,7 @@ def reduce(
     balance_bound_s: float = 60e-6,
     specimen: Optional[PathLike] = None,
     tension: bool = False,
+    wave_separation: str = "none",
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -452,7 +453,12 @@ def reduce(
     ``specimen_length_m``/``specimen_diameter_m``; for a run file it overrides the run's own.
     ``tension``: a tension test (``--tension``, docs/physics.md §7.8.1): forces, stresses and
     strains tension positive, a cylinder specimen needed (a run file of a tension scene is
-    reduced in tension without it)."""
+    reduced in tension without it).
+
+    ``wave_separation``: ``"none"``, ``"one-gauge"`` or ``"two-gauge"``
+    (``--wave-separation``, docs/physics.md §7.11): the waves toward and away from the specimen
+    at each face when the pulses overlap at the gauges (two gauges: the set-up's
+    ``incident_2`` and ``transmission_2`` channels, recorded in a run file)."""
     if isinstance(dispersion, bool):
         dispersion = "bancroft" if dispersion else "none"
     return Run(
@@ -469,6 +475,7 @@ def reduce(
             _number("balance_bound_s", balance_bound_s, "a positive bound in seconds"),
             None if specimen is None else os.fspath(specimen),
             bool(tension),
+            wave_separation,
         )
     )
 

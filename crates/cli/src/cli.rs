@@ -120,6 +120,28 @@ impl From<AlignArg> for shpb_core::reduce::Alignment {
     }
 }
 
+/// The wave separations of `shpb reduce` (`--wave-separation`; docs/physics.md §7.11).
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum WaveSeparationArg {
+    /// No separation: each wave cut from its gauge record in its own window.
+    None,
+    /// One gauge per bar, unrolling each bar's far-end echoes (free or absorbing far end).
+    OneGauge,
+    /// Two gauges per bar: the set-up's channels `incident_2` and `transmission_2`.
+    TwoGauge,
+}
+
+impl From<WaveSeparationArg> for shpb_core::reduce::WaveSeparation {
+    fn from(a: WaveSeparationArg) -> Self {
+        use shpb_core::reduce::WaveSeparation;
+        match a {
+            WaveSeparationArg::None => WaveSeparation::None,
+            WaveSeparationArg::OneGauge => WaveSeparation::OneGauge,
+            WaveSeparationArg::TwoGauge => WaveSeparation::TwoGauge,
+        }
+    }
+}
+
 /// The fidelity presets selectable on the command line (`--fidelity`).
 #[derive(ValueEnum, Clone, Copy, Debug)]
 pub enum FidelityArg {
@@ -581,6 +603,12 @@ pub enum Command {
         /// cylinder specimen [default: a run file's own loading].
         #[arg(long)]
         tension: bool,
+        /// Separate the waves travelling toward and away from the specimen at each face, for
+        /// records whose pulses overlap at the gauges (docs/physics.md §7.11): from one gauge
+        /// per bar and the bars' far-end echoes, or from two gauges per bar (the set-up's
+        /// channels `incident_2`, `transmission_2`; a run file of that set-up records them).
+        #[arg(long, value_enum, default_value = "none")]
+        wave_separation: WaveSeparationArg,
     },
     /// Convert a raw gauge record (the authors' CSV: time_s, incident_V, transmission_V) to bar strain.
     Strain {
@@ -1039,6 +1067,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             force,
             channel,
             tension,
+            wave_separation,
         } => {
             let channels = (!channel.is_empty())
                 .then(|| shpb_input::channel_file::ChannelSet::from_specs(&channel, "--channel"))
@@ -1101,6 +1130,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                         .transpose()?,
                     channels,
                     tension,
+                    wave_separation: wave_separation.into(),
                 },
             )
         }

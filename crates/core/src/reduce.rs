@@ -29,6 +29,7 @@ pub mod correction;
 pub mod options;
 pub mod plausibility;
 pub mod quality;
+pub mod separation;
 pub mod specimen;
 pub mod waves;
 pub mod windows;
@@ -43,6 +44,7 @@ pub use correction::{
 pub use options::{DEFAULT_BALANCE_BOUND_S, MAX_BALANCE_BOUND_S, ReductionOptions};
 pub use quality::{EquilibriumDetail, equilibrium_detail, verdict_reason};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
+pub use separation::{SECOND_GAUGE_CHANNELS, SecondGauges, Separation, WaveSeparation};
 pub use specimen::{PAPER_SPHERE_RADII_M, ReducedSpecimen};
 pub use waves::{ImpliedIncident, implied_incident};
 pub use windows::{WindowOverride, Windows};
@@ -207,6 +209,8 @@ pub struct Reduction {
     pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
+    /// The wave separation applied, if any (docs/physics.md §7.11).
+    pub separation: Option<Separation>,
     /// A tension reduction (docs/physics.md §7.8.1): every series is in the loading's sense, the
     /// face strains −ε of the gauges', forces, δ (the elongation) and stresses tension positive.
     pub tension: bool,
@@ -366,11 +370,59 @@ pub fn reduce_named(
     options: &ReductionOptions,
     file: &str,
 ) -> Result<Reduction> {
+    reduce_separated(input, None, setup, options, file)
+}
+
+/// [`reduce_named`] with the records of a second gauge on each bar, which the two-gauge wave
+/// separation needs (`options.wave_separation`, docs/physics.md §7.11): with a separation the
+/// windows are cut from the separated face waves ([`separation`]) instead of the gauge records.
+pub fn reduce_separated(
+    input: &ReductionInput,
+    second: Option<&SecondGauges>,
+    setup: &ReductionSetup,
+    options: &ReductionOptions,
+    file: &str,
+) -> Result<Reduction> {
     options.validate()?;
     // A tension test is reduced in its loading's sense: its records turned (§7.8.1).
     let input = &*input.in_loading_sense(options.tension);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
+    if options.wave_separation != WaveSeparation::None {
+        let (placed, waves, separation) = separation::stage(
+            input,
+            second,
+            setup,
+            options,
+            &strains,
+            incident_start_s,
+            file,
+        )?;
+        let mut warnings = Vec::new();
+        let quality = quality::assess(options, &strains, &placed, &waves, &mut warnings);
+        // The windows of separated waves are not cut short by the overlap at the gauge.
+        warnings.retain(|w| !w.starts_with("the incident pulse lasts"));
+        let strain_rate_per_s = options
+            .specimen_radii_m
+            .map(|radii| specimen::sphere_strain_rate(&waves.faces.approach_velocity_m_s, radii));
+        let mut r = Reduction::assemble(
+            strains.dt,
+            setup,
+            options,
+            placed,
+            waves,
+            quality,
+            strain_rate_per_s,
+            warnings,
+        );
+        r.separation = Some(separation);
+        r.record = RecordTrace {
+            time_s: input.time_s.clone(),
+            incident_strain: strains.incident.clone(),
+            transmission_strain: strains.transmission.clone(),
+        };
+        return Ok(r);
+    }
     let corrections = correction::FaceCorrections::new(setup, options)?;
     let mut warnings = Vec::new();
     let placed = windows::place(
@@ -463,6 +515,7 @@ impl Reduction {
             tyas_pope: options.tyas_pope,
             warnings,
             tension: options.tension,
+            separation: None,
             time_s,
             incident_strain: waves.incident,
             reflected_strain: waves.reflected,

@@ -30,6 +30,15 @@ pub fn read_hdf5_strains(path: &Path) -> Result<ReductionInput> {
     })
 }
 
+/// One dataset of an HDF5 file (e.g. `gauges/incident_2/strain`), None when it has none.
+pub fn read_hdf5_series(path: &Path, name: &str) -> Result<Option<Vec<f64>>> {
+    let f = crate::h5::open(path).map_err(h5err(path))?;
+    Ok(match f.dataset(name) {
+        Ok(ds) => Some(ds.read_raw::<f64>().map_err(h5err(path))?),
+        Err(_) => None,
+    })
+}
+
 /// `/time` and `/gauges/{incident,transmission}/voltage` of a run file (the digitised bridge
 /// outputs, V), or None when the file has no such datasets.
 pub fn read_hdf5_voltages(path: &Path) -> Result<Option<shpb_core::gauge::RawRecord>> {
@@ -156,6 +165,18 @@ pub fn summary_items(r: &Reduction) -> Vec<(&'static str, f64, &'static str)> {
     if let Some((pi, pt)) = a.balance_paths_m {
         v.push(("balance_incident_path", pi, "m"));
         v.push(("balance_transmission_path", pt, "m"));
+    }
+    if let Some(s) = &r.separation {
+        v.push((
+            "wave_separation_gauges_per_bar",
+            if s.incident_gauges_m.1.is_some() {
+                2.0
+            } else {
+                1.0
+            },
+            "1",
+        ));
+        v.push(("wave_separation_series_terms", s.series_terms as f64, "1"));
     }
     let q = &r.quality;
     v.extend([

@@ -644,10 +644,11 @@ fn curve<'py>(
 /// s (`--smooth`), `layout` a record layout file (`--layout`), `balance_bound_s` the bound of the
 /// balance search (`--balance-bound`); with a cylinder's length and diameter (m, both or
 /// neither) also its 1/2/3-wave curves; `specimen` a specimen file (`--specimen`: spheres of any
-/// diameter, a chain, or a cylinder); `tension` a tension test (`--tension`, §7.8.1)
-/// (docs/physics.md §7.3, §7.6–7.10).
+/// diameter, a chain, or a cylinder); `tension` a tension test (`--tension`, §7.8.1);
+/// `wave_separation` `none`, `one-gauge` or `two-gauge` (`--wave-separation`)
+/// (docs/physics.md §7.3, §7.6–7.11).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S, specimen = None, tension = false))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S, specimen = None, tension = false, wave_separation = "none".into()))]
 #[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
@@ -663,7 +664,19 @@ fn reduce(
     balance_bound_s: f64,
     specimen: Option<PathBuf>,
     tension: bool,
+    wave_separation: String,
 ) -> PyResult<RunData> {
+    let Some(separation) = shpb_core::reduce::WaveSeparation::from_name(&wave_separation) else {
+        return Err(input_error(
+            "wave_separation",
+            format!("unknown wave separation `{wave_separation}`"),
+            shpb_core::reduce::WaveSeparation::ALL
+                .iter()
+                .map(|a| a.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ));
+    };
     let Some(correction) = DispersionCorrection::from_name(&dispersion) else {
         return Err(input_error(
             "dispersion",
@@ -710,6 +723,7 @@ fn reduce(
                 .transpose()?,
             channels: None,
             tension,
+            wave_separation: separation,
         };
         let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;
         let mut scene = format!(

@@ -381,6 +381,9 @@ pub struct RecordOptions {
     /// A tension test (`--tension`, docs/physics.md §7.8.1): forces, stresses and strains tension
     /// positive; a cylinder specimen needed. A run file of a tension scene is one without it.
     pub tension: bool,
+    /// Wave separation of overlapping pulses (`--wave-separation`, default none; docs/physics.md
+    /// §7.11); two gauges read the set-up's `incident_2` and `transmission_2` channels.
+    pub wave_separation: shpb_core::reduce::WaveSeparation,
 }
 
 impl RecordOptions {
@@ -431,6 +434,12 @@ impl RecordOptions {
         if self.tension {
             c.push_str(" --tension");
         }
+        if self.wave_separation != shpb_core::reduce::WaveSeparation::None {
+            c.push_str(&format!(
+                " --wave-separation {}",
+                self.wave_separation.name()
+            ));
+        }
         c
     }
 }
@@ -449,6 +458,7 @@ impl Default for RecordOptions {
             specimen: None,
             channels: None,
             tension: false,
+            wave_separation: shpb_core::reduce::WaveSeparation::None,
         }
     }
 }
@@ -464,6 +474,7 @@ fn reduce_flag(quantity: &str) -> &str {
         "window.transmitted_delay_s" => "--transmitted-delay",
         "window.duration_s" => "--duration",
         "tension" => "--tension",
+        "wave_separation" => "--wave-separation",
         other => other,
     }
 }
@@ -514,6 +525,7 @@ pub fn reduce_record_with(
         smoothing_window_s: choices.smoothing_s,
         balance_bound_s: choices.balance_bound_s,
         window: choices.window,
+        wave_separation: choices.wave_separation,
         ..ReductionOptions::default()
     };
     options.validate().map_err(flag_err)?;
@@ -651,7 +663,14 @@ pub fn reduce_record_with(
             other => other.into(),
         }
     })?;
-    let reduction = shpb_core::reduce::reduce_named(&input, &setup, &options, &name)?;
+    let second = match options.wave_separation {
+        shpb_core::reduce::WaveSeparation::TwoGauge => {
+            second_gauges(record, &apparatus, hdf5_input, own_set_up)?
+        }
+        _ => None,
+    };
+    let reduction =
+        shpb_core::reduce::reduce_separated(&input, second.as_ref(), &setup, &options, &name)?;
     shpb_core::reduce::plausibility::check_reduction(
         &reduction,
         shpb_core::reduce::plausibility::SpecimenSize::of(&specimen),
@@ -665,6 +684,74 @@ pub fn reduce_record_with(
         cylinder,
         specimen,
     })
+}
+
+/// The second gauge on each bar of a record, for the two-gauge wave separation (docs/physics.md
+/// §7.11): the set-up's channels `incident_2` and `transmission_2`
+/// ([`shpb_core::reduce::SECOND_GAUGE_CHANNELS`]) as a run file recorded them (its digitised
+/// voltages through their bridges when `run_voltages`, else its strains). A text record holds
+/// two channels only: refused, naming the flag.
+fn second_gauges(
+    record: &Path,
+    apparatus: &Apparatus,
+    hdf5_input: bool,
+    run_voltages: bool,
+) -> Result<Option<shpb_core::reduce::SecondGauges>> {
+    let [inc, tra] = shpb_core::reduce::SECOND_GAUGE_CHANNELS;
+    let need = "a set-up with channels `incident_2` and `transmission_2` (bar incident and \
+                transmission, farther from the specimen than the first gauges) and a run file of \
+                it, or --wave-separation one-gauge";
+    let channel = |name: &str| {
+        apparatus.gauges.channel(name).ok_or_else(|| {
+            input_err(
+                "--wave-separation",
+                format!(
+                    "two-gauge separation: {} has no `{name}` gauge channel",
+                    apparatus.source
+                ),
+                need,
+            )
+        })
+    };
+    let (ci, ct) = (channel(inc)?, channel(tra)?);
+    if !hdf5_input {
+        return Err(input_err(
+            "--wave-separation",
+            format!(
+                "two-gauge separation reads the second gauges from a run file; {} is a text \
+                 record of two channels",
+                record.display()
+            ),
+            need,
+        ));
+    }
+    let read = |ch: &shpb_core::gauge::GaugeChannel| -> Result<Vec<f64>> {
+        if run_voltages
+            && let Some(v) = shpb_output::reduction::read_hdf5_series(
+                record,
+                &format!("gauges/{}/voltage", ch.name),
+            )?
+        {
+            return Ok(ch.strains_from_voltages(&v));
+        }
+        shpb_output::reduction::read_hdf5_series(record, &format!("gauges/{}/strain", ch.name))?
+            .ok_or_else(|| {
+                input_err(
+                    "--wave-separation",
+                    format!("{} has no /gauges/{}/strain", record.display(), ch.name),
+                    need,
+                )
+            })
+    };
+    let (ins_i, ins_t) = apparatus
+        .inserts
+        .equivalent_bar_lengths_m(apparatus.material.wave_speed_m_s());
+    Ok(Some(shpb_core::reduce::SecondGauges {
+        incident_gauge_m: ci.distance_from_specimen_m + ins_i,
+        transmission_gauge_m: ct.distance_from_specimen_m + ins_t,
+        incident_strain: read(ci)?,
+        transmission_strain: read(ct)?,
+    }))
 }
 
 /// The gauge strains of a record, the one way every command reads one (`shpb reduce`,

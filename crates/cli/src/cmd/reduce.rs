@@ -340,6 +340,20 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
             stated.as_ref().map_or(f64::NAN, |s| s.transmission_gauge_m),
         ));
     }
+    if let Some(s) = &r.separation {
+        let mm = |d: (f64, Option<f64>)| match d.1 {
+            Some(d2) => format!("{:.1} and {:.1} mm", d.0 * 1e3, d2 * 1e3),
+            None => format!("{:.1} mm", d.0 * 1e3),
+        };
+        text.push_str(&format!(
+            "wave separation {}: incident gauges {}, transmission gauges {}, {}; {} terms of the series (the noise gain at its singular frequencies)\n",
+            s.method.name(),
+            mm(s.incident_gauges_m),
+            mm(s.transmission_gauges_m),
+            if s.exact_mode { "exact first mode" } else { "at c0" },
+            s.series_terms
+        ));
+    }
     if let (Some((r1, r2)), Some(rate)) = (specimen.radii_m(), &r.strain_rate_per_s) {
         text.push_str(&format!(
             "spheres, r1 + r2 = {:.3} mm: peak strain rate δ̇/(r1 + r2) {:.0} 1/s\n",
@@ -420,6 +434,16 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
             "peak_strain_rate_per_s": finite(rate.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
         });
     }
+    json["wave_separation"] = match &r.separation {
+        Some(s) => serde_json::json!({
+            "method": s.method.name(),
+            "incident_gauges_m": [finite(s.incident_gauges_m.0), opt(s.incident_gauges_m.1)],
+            "transmission_gauges_m": [finite(s.transmission_gauges_m.0), opt(s.transmission_gauges_m.1)],
+            "exact_mode": s.exact_mode,
+            "series_terms": s.series_terms,
+        }),
+        None => serde_json::json!({ "method": "none" }),
+    };
     if let Some(c) = &reduced.cylinder {
         json["cylinder"] = serde_json::json!({
             "length_m": finite(c.geometry.length_m),

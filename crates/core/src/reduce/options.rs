@@ -44,6 +44,8 @@ pub struct ReductionOptions {
     /// A tension test (split Hopkinson tension bar; default false): the records are read in the
     /// loading's sense, every force, stress and strain tension positive (docs/physics.md §7.8.1).
     pub tension: bool,
+    /// Wave separation of overlapping pulses (default none; docs/physics.md §7.11).
+    pub wave_separation: super::WaveSeparation,
 }
 
 impl Default for ReductionOptions {
@@ -60,6 +62,7 @@ impl Default for ReductionOptions {
             alignment: Alignment::Geometric,
             balance_bound_s: DEFAULT_BALANCE_BOUND_S,
             tension: false,
+            wave_separation: super::WaveSeparation::None,
         }
     }
 }
@@ -71,6 +74,7 @@ impl ReductionOptions {
     pub fn validate(&self) -> Result<()> {
         let o = self;
         let file = "reduction options";
+        super::separation::validate(o)?;
         if o.tyas_pope && o.dispersion == DispersionCorrection::None {
             return Err(input_err(
                 file,

@@ -430,6 +430,7 @@ mod tests {
             warnings: vec![],
             record: crate::reduce::RecordTrace::default(),
             tension: false,
+            separation: None,
         }
     }
 

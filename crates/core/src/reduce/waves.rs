@@ -33,19 +33,34 @@ pub(crate) fn faces(
     bi: &BarProperties,
     bt: &BarProperties,
 ) -> Faces {
+    faces_with_return(e_in, e_re, e_tr, None, dt, bi, bt)
+}
+
+/// [`faces`] with a wave `e_ret` coming back to the transmission-bar face from its far end
+/// (separated waves, docs/physics.md §7.11): F_back = −E A (εT + εB), v_back = −c0 (εT − εB).
+pub(crate) fn faces_with_return(
+    e_in: &[f64],
+    e_re: &[f64],
+    e_tr: &[f64],
+    e_ret: Option<&[f64]>,
+    dt: f64,
+    bi: &BarProperties,
+    bt: &BarProperties,
+) -> Faces {
     let samples = e_in.len();
+    let ret = |k: usize| e_ret.map_or(0.0, |r| r[k]);
     let (ea_i, ea_t) = (
         bi.youngs_modulus_pa * bi.area_m2,
         bt.youngs_modulus_pa * bt.area_m2,
     );
     let (c_i, c_t) = (bi.wave_speed_m_s, bt.wave_speed_m_s);
     let force_front_n: Vec<f64> = (0..samples).map(|k| -ea_i * (e_in[k] + e_re[k])).collect();
-    let force_back_n: Vec<f64> = e_tr.iter().map(|e| -ea_t * e).collect();
+    let force_back_n: Vec<f64> = (0..samples).map(|k| -ea_t * (e_tr[k] + ret(k))).collect();
     let force_3wave_n: Vec<f64> = (0..samples)
         .map(|k| 0.5 * (force_front_n[k] + force_back_n[k]))
         .collect();
     let v_front: Vec<f64> = (0..samples).map(|k| -c_i * (e_in[k] - e_re[k])).collect();
-    let v_back: Vec<f64> = e_tr.iter().map(|e| -c_t * e).collect();
+    let v_back: Vec<f64> = (0..samples).map(|k| -c_t * (e_tr[k] - ret(k))).collect();
     let front_displacement_m = cumulative_trapezoid(&v_front, dt);
     let back_displacement_m = cumulative_trapezoid(&v_back, dt);
     let displacement_m: Vec<f64> = (0..samples)
