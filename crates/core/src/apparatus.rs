@@ -203,6 +203,10 @@ pub struct PulseOptions {
     /// A measured incident wave driving the incident bar's impact end in place of gun, striker
     /// and shaper (docs/physics.md §6.10); None: the striker.
     pub incident_drive: Option<IncidentDrive>,
+    /// The filter of the simulated records before their reduction (docs/physics.md §7.11):
+    /// [`crate::reduce::Filter::DEFAULT`] unless the scene sets `smooth_s`, which makes it a
+    /// moving average of `reduction_smoothing_s` (0: none), as `shpb reduce --smooth` does.
+    pub reduction_filter: crate::reduce::Filter,
 }
 
 /// A prescribed incident wave (docs/physics.md §6.10): the compressive stress the incident gauge
@@ -553,6 +557,7 @@ impl Apparatus {
                 snapshot_interval_s: None,
                 reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
                 incident_drive: None,
+                reduction_filter: crate::reduce::Filter::DEFAULT,
             },
             None,
         );

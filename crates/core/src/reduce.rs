@@ -26,6 +26,7 @@ use crate::gauge::GaugeChannel;
 pub mod align;
 pub mod baseline;
 pub mod correction;
+pub mod filter;
 pub mod options;
 pub mod plausibility;
 pub mod quality;
@@ -34,12 +35,13 @@ pub mod waves;
 pub mod windows;
 
 pub use align::{Alignment, AlignmentReport};
-pub use baseline::record_strains;
+pub use baseline::{Baseline, record_strains};
 pub use correction::{
     BANCROFT_FIT, BANCROFT_FIT_POISSON_RATIO, DispersionCorrection, TYAS_POPE_CUTOFF_FA_OVER_C0,
     bancroft_phase_velocity_m_s, bancroft_velocity_ratio, dispersion_delay_s, dispersion_shift,
     dispersion_shift_exact,
 };
+pub use filter::Filter;
 pub use options::{DEFAULT_BALANCE_BOUND_S, MAX_BALANCE_BOUND_S, ReductionOptions};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
 pub use specimen::{PAPER_SPHERE_RADII_M, ReducedSpecimen};
@@ -189,6 +191,10 @@ pub struct Reduction {
     pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
+    /// The filter applied to both records, its parameters fixed (docs/physics.md §7.11).
+    pub filter: Filter,
+    /// How the baselines were removed (docs/physics.md §7.11).
+    pub baseline: Baseline,
 }
 
 /// The arrivals of a record's pulses by the rule of the reduction's measured delays
@@ -228,6 +234,7 @@ pub fn measured_arrivals(
     file: &str,
 ) -> Result<Arrivals> {
     options.validate()?;
+    let options = &options.resolved_for(setup);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
     let dt = strains.dt;
@@ -331,6 +338,7 @@ pub fn reduce_named(
     file: &str,
 ) -> Result<Reduction> {
     options.validate()?;
+    let options = &options.resolved_for(setup);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
     let corrections = correction::FaceCorrections::new(setup, options)?;
@@ -415,6 +423,8 @@ impl Reduction {
             dispersion: options.dispersion,
             tyas_pope: options.tyas_pope,
             warnings,
+            filter: options.filter,
+            baseline: options.baseline,
             time_s,
             incident_strain: waves.incident,
             reflected_strain: waves.reflected,
@@ -499,6 +509,7 @@ mod tests {
         ReductionOptions {
             dispersion: DispersionCorrection::None,
             smoothing_window_s: 0.0,
+            filter: Filter::None,
             ..ReductionOptions::default()
         }
     }

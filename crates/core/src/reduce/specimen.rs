@@ -394,6 +394,8 @@ mod tests {
             dispersion: crate::reduce::DispersionCorrection::None,
             tyas_pope: false,
             warnings: vec![],
+            filter: crate::reduce::Filter::None,
+            baseline: crate::reduce::Baseline::StartMean,
         }
     }
 

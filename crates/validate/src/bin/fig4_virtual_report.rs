@@ -59,6 +59,7 @@ fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(usize,
     let options = ReductionOptions {
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
         smoothing_window_s: 0.0,
+        filter: shpb_core::reduce::Filter::None,
         ..Default::default()
     };
     let r = reduce_record_file(&s.record_path(root), app, &options).unwrap();

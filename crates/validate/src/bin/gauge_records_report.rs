@@ -642,6 +642,7 @@ fn main() -> Result<()> {
     // The alignment section uses `shpb reduce`'s defaults (2 µs smoothing).
     let default = ReductionOptions {
         smoothing_window_s: 0.0,
+        filter: shpb_core::reduce::Filter::None,
         ..ReductionOptions::default()
     };
     let mut rows = Vec::new();
