@@ -288,6 +288,8 @@ pub fn write_reduction_hdf5_with(
         string_attr(&s, "warnings", &r.warnings.join("\n"), path)?;
         string_attr(&s, "alignment", r.alignment.strategy.name(), path)?;
         string_attr(&s, "equilibrium_verdict", r.quality.verdict.name(), path)?;
+        string_attr(&s, "filter", &r.filter.describe(), path)?;
+        string_attr(&s, "baseline", r.baseline.name(), path)?;
         f.close().map_err(h5err(path))
     })
 }

@@ -70,11 +70,11 @@ pub fn remove_baseline(
             file,
             "baseline",
             format!(
-                "linear-drift: the {channel} record's last {n} samples are not quiet (their                  scatter about the fitted line is {:.1} times the pre-trigger noise): a pulse or                  its echoes are still there",
+                "linear-drift: the {channel} record's last {n} samples are not quiet (their scatter about the fitted line is {:.1} times the pre-trigger noise): a pulse or its echoes are still there",
                 tail / head.max(f64::MIN_POSITIVE)
             ),
             format!(
-                "a record whose last {n} samples are as quiet as its first (within {QUIET_TAIL_FACTOR}                  times their noise), or --baseline start-mean"
+                "a record whose last {n} samples are as quiet as its first (within {QUIET_TAIL_FACTOR} times their noise), or --baseline start-mean"
             ),
         ));
     }
@@ -326,6 +326,40 @@ pub(crate) fn condition(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_linear_drift_is_removed_and_a_busy_tail_refused() {
+        // A pulse on a gauge whose zero drifts linearly (1e-5 over the record), a little noise,
+        // quiet at both ends: the line through the first and last 500 samples takes the drift
+        // away, leaving the pulse to within the noise's share of the fit (≪ 1e-6).
+        let n = 4000;
+        let noise = |k: usize| 2e-7 * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
+        let pulse = |k: usize| {
+            let x = (k as f64 - 1500.0) / 1000.0;
+            if (0.0..=1.0).contains(&x) {
+                -1e-4 * (std::f64::consts::PI * x).sin().powi(2)
+            } else {
+                0.0
+            }
+        };
+        let drift = |k: usize| 3e-6 + 1e-5 * k as f64 / n as f64;
+        let v: Vec<f64> = (0..n).map(|k| pulse(k) + drift(k) + noise(k)).collect();
+        let clean = remove_baseline(&v, 500, Baseline::LinearDrift, "incident", "r").unwrap();
+        let worst = (0..n)
+            .map(|k| (clean[k] - pulse(k) - noise(k)).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 5e-8, "{worst}");
+        // The start mean leaves the drift: 1e-5 × 3500/4000 at the end less its start share.
+        let start = remove_baseline(&v, 500, Baseline::StartMean, "incident", "r").unwrap();
+        assert!((start[n - 1] - noise(n - 1)).abs() > 8e-6);
+        // A pulse still in the tail is refused, naming the baseline.
+        let echo = |k: usize| if k >= 2100 { pulse(k - 2100) } else { 0.0 };
+        let busy: Vec<f64> = (0..n).map(|k| pulse(k) + echo(k) + noise(k)).collect();
+        match remove_baseline(&busy, 500, Baseline::LinearDrift, "incident", "r") {
+            Err(crate::Error::Invalid { quantity, .. }) => assert_eq!(quantity, "baseline"),
+            other => panic!("a busy tail accepted: {:?}", other.map(|v| v.len())),
+        }
+    }
 
     #[test]
     fn polarity_is_not_judged_on_noise() {
