@@ -200,10 +200,12 @@ impl Filter {
                     return Err(err(
                         "filter.cutoff_hz",
                         format!(
-                            "{fc:e} Hz is not below the record's Nyquist frequency {nyquist:e} Hz"
+                            "{fc:e} Hz is not below the record's Nyquist frequency {}",
+                            crate::error::format_si(nyquist, "Hz")
                         ),
                         format!(
-                            "a cut-off above 0 and below {nyquist:e} Hz (half the sample rate)"
+                            "a cut-off above 0 and below {} (half the sample rate)",
+                            crate::error::format_si(nyquist, "Hz")
                         ),
                     ));
                 }
@@ -216,8 +218,9 @@ impl Filter {
                     return Err(err(
                         "filter.window_s",
                         format!(
-                            "{window_s:e} s is {m} samples at this record's step {dt_s:e} s, for \
+                            "{window_s:e} s spans {m} of this record's samples (step {}), for \
                              order {order} on {} samples",
+                            crate::error::format_si(dt_s, "s"),
                             v.len()
                         ),
                         format!(
