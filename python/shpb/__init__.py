@@ -424,7 +424,7 @@ def reduce(
     dispersion: Union[str, bool] = "bancroft",
     tyas_pope: bool = False,
     align: str = "geometric",
-    smooth: float = 2e-6,
+    smooth: Optional[float] = None,
     specimen_length_m: Optional[float] = None,
     specimen_diameter_m: Optional[float] = None,
     layout: Optional[PathLike] = None,
@@ -432,6 +432,11 @@ def reduce(
     specimen: Optional[PathLike] = None,
     tension: bool = False,
     wave_separation: str = "none",
+    filter: Optional[str] = None,
+    filter_cutoff: Optional[float] = None,
+    filter_order: Optional[int] = None,
+    filter_window: Optional[float] = None,
+    baseline: str = "start-mean",
 ) -> Run:
     """The lab's reduction (``shpb reduce``) of a raw record (CSV: time_s, incident_V,
     transmission_V) or of a run file, as a :class:`Run` with ``reduction/*`` datasets.
@@ -439,8 +444,13 @@ def reduce(
     ``"none"``, ``"bancroft"`` or ``"pochhammer-chree"`` (``--dispersion``; ``True``/``False``,
     the old form, mean ``"bancroft"``/``"none"``); ``tyas_pope``: the Tyas–Pope amplitude
     factors (``--tyas-pope``). ``align``: ``"geometric"``, ``"foot"`` or ``"balance"``
-    (``--align``); ``smooth``: moving-average width, s (``--smooth``, 0 is off; the default is
-    what ``shpb run`` applies to simulated records). ``specimen_length_m`` and
+    (``--align``); ``smooth``: moving-average width, s (``--smooth``; without ``filter``, the
+    moving-average filter of that width, 0 is no filter). ``filter``: ``"none"``,
+    ``"butterworth"`` (the default: 4th order forward and backward at the bars' dispersion
+    band), ``"savitzky-golay"`` or ``"moving-average"`` (``--filter``), with ``filter_cutoff``
+    (Hz), ``filter_order`` and ``filter_window`` (s) (``--filter-cutoff``, ``--filter-order``,
+    ``--filter-window``; docs/physics.md §7.12). ``baseline``: ``"start-mean"`` or
+    ``"linear-drift"`` (``--baseline``). ``specimen_length_m`` and
     ``specimen_diameter_m`` (both or neither): a cylindrical specimen's 1/2/3-wave curves,
     ``reduction/cylinder/{one_wave,two_wave,three_wave}/
     {stress,strain,strain_rate,true_stress,true_strain}``, compression positive
@@ -468,7 +478,9 @@ def reduce(
             dispersion,
             bool(tyas_pope),
             align,
-            _number("smooth", smooth, "0 (off) or a positive width in seconds"),
+            None
+            if smooth is None
+            else _number("smooth", smooth, "0 (off) or a positive width in seconds"),
             specimen_length_m,
             specimen_diameter_m,
             None if layout is None else os.fspath(layout),
@@ -476,6 +488,15 @@ def reduce(
             None if specimen is None else os.fspath(specimen),
             bool(tension),
             wave_separation,
+            filter,
+            None
+            if filter_cutoff is None
+            else _number("filter_cutoff", filter_cutoff, "a positive cut-off in Hz"),
+            filter_order,
+            None
+            if filter_window is None
+            else _number("filter_window", filter_window, "a positive window in seconds"),
+            baseline,
         )
     )
 

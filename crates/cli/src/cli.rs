@@ -557,15 +557,11 @@ pub enum Command {
         /// record's pulse feet, or a bounded force-balance search (docs/physics.md §7.6).
         #[arg(long, value_enum, default_value = "geometric")]
         align: AlignArg,
-        /// Width of the moving average applied to both records before the reduction, s (0: off);
-        /// the default is what `shpb run` applies to simulated records.
-        #[arg(
-            long,
-            value_name = "SECONDS",
-            default_value = "2e-6",
-            allow_hyphen_values = true
-        )]
-        smooth: f64,
+        /// Width of the moving average applied to both records before the reduction, s (0: no
+        /// filter): without --filter, `--filter moving-average` of this width (docs/physics.md
+        /// §7.12).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        smooth: Option<f64>,
         /// Bound of `--align balance`'s search on each window shift, s (docs/physics.md §7.6)
         /// [default: 6e-5]; only with `--align balance`.
         #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
@@ -609,6 +605,28 @@ pub enum Command {
         /// channels `incident_2`, `transmission_2`; a run file of that set-up records them).
         #[arg(long, value_enum, default_value = "none")]
         wave_separation: WaveSeparationArg,
+        /// The zero-phase filter of both records (docs/physics.md §7.12) [default: butterworth,
+        /// 4th order forward and backward at the bars' dispersion band, f a/c0 = 0.4]
+        #[arg(long, value_name = "NAME",
+              value_parser = ["none", "butterworth", "savitzky-golay", "moving-average"])]
+        filter: Option<String>,
+        /// Butterworth cut-off, Hz (one pass's gain 1/√2 there) [default: the bars' dispersion
+        /// band, 0.4 c0/a]; only with --filter butterworth.
+        #[arg(long, value_name = "HZ", allow_hyphen_values = true)]
+        filter_cutoff: Option<f64>,
+        /// Butterworth order per pass (1–12) [default: 4] or Savitzky–Golay polynomial order
+        /// (0–8) [default: 3].
+        #[arg(long, value_name = "N", allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("1 to 12 (butterworth) or 0 to 8 (savitzky-golay)"))]
+        filter_order: Option<usize>,
+        /// Savitzky–Golay window, s [default: 5e-6], or the moving average's width (as --smooth).
+        #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
+        filter_window: Option<f64>,
+        /// How each record's baseline is removed: the mean of its pre-trigger samples, or a line
+        /// through them and as many samples of its quiet tail (docs/physics.md §7.12).
+        #[arg(long, value_name = "NAME", default_value = "start-mean",
+              value_parser = ["start-mean", "linear-drift"])]
+        baseline: String,
     },
     /// Convert a raw gauge record (the authors' CSV: time_s, incident_V, transmission_V) to bar strain.
     Strain {
@@ -1068,6 +1086,11 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             channel,
             tension,
             wave_separation,
+            filter,
+            filter_cutoff,
+            filter_order,
+            filter_window,
+            baseline,
         } => {
             let channels = (!channel.is_empty())
                 .then(|| shpb_input::channel_file::ChannelSet::from_specs(&channel, "--channel"))
@@ -1087,6 +1110,20 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                 ));
             }
             let balance_bound = balance_bound.unwrap_or(shpb_core::reduce::DEFAULT_BALANCE_BOUND_S);
+            let (reduction_filter, smoothing_s) = shpb_study::api::filter_choice(
+                filter.as_deref(),
+                smooth,
+                filter_cutoff,
+                filter_order,
+                filter_window,
+                [
+                    "--filter",
+                    "--filter-cutoff",
+                    "--filter-order",
+                    "--filter-window",
+                    "--smooth",
+                ],
+            )?;
             let window = shpb_core::reduce::WindowOverride {
                 incident_start_s: incident_start,
                 reflected_delay_s: reflected_delay,
@@ -1112,7 +1149,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                     },
                     tyas_pope,
                     alignment: align.into(),
-                    smoothing_s: smooth,
+                    smoothing_s,
                     balance_bound_s: balance_bound,
                     window: (window != Default::default()).then_some(window),
                     layout: layout
@@ -1131,6 +1168,8 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                     channels,
                     tension,
                     wave_separation: wave_separation.into(),
+                    filter: reduction_filter,
+                    baseline: shpb_study::api::baseline_choice(&baseline, "--baseline")?,
                 },
             )
         }

@@ -34,6 +34,19 @@ fn run(pressure: &str, extra: &str) -> RunOutput {
         .unwrap()
 }
 
+/// [`run`] with `top` keys (e.g. `smooth_s`) before the `[specimen]` table.
+fn run_smoothed(pressure: &str, top: &str) -> RunOutput {
+    let text = format!(
+        "kind = \"shpb\"\nbars = \"authors-20cm-striker\"\npressure = \"{pressure}\"\n{top}\
+         [specimen]\nshape = \"cylinder\"\nmaterial = \"ofhc-copper\"\nlength_m = 6e-3\n\
+         diameter_m = 6e-3\n"
+    );
+    Params::from_toml(&text, "copper.toml", &root())
+        .unwrap()
+        .run()
+        .unwrap()
+}
+
 fn summary(out: &RunOutput, key: &str) -> f64 {
     out.summary_value(key)
         .unwrap_or_else(|| panic!("no {key} in the summary"))
@@ -59,11 +72,15 @@ fn loading_branch(out: &RunOutput, series: &[&[f64]]) -> (Vec<f64>, Vec<Vec<f64>
 
 /// 1-wave reduction against the true flow stress (docs/physics.md §6.12): the summary's error is
 /// below 3 % and equals the largest error recomputed here from the two series; the rate over the
-/// compared window is near constant.
+/// compared window is near constant. The error is the largest over 100+ samples of a weak
+/// transmitted pulse (≈ 140 µε against 3.8 µε of digitiser noise), so it is set by the noise the
+/// filter leaves: the run keeps the 2 µs moving average (`smooth_s`) this bound was set with
+/// (with no filter 11.5 % at 15 psi, with the default Butterworth at 0.4 c0/a 3.1 %, with the
+/// 2 µs box 1.9 %; docs/physics.md §7.12).
 #[test]
 fn the_reduction_of_a_copper_test_recovers_its_true_flow_stress() {
     for pressure in ["12.5psi", "15psi"] {
-        let out = run(pressure, "");
+        let out = run_smoothed(pressure, "smooth_s = 2e-6\n");
         let error = summary(&out, "reduced_true_stress_max_relative_error");
         let s = out.specimen.as_ref().unwrap();
         let (strain, v) = loading_branch(&out, &[&s.face_stress_pa, &s.true_strain_rate_per_s]);

@@ -12,6 +12,7 @@ use shpb::Error;
 fn unsmoothed() -> ReductionOptions {
     ReductionOptions {
         smoothing_window_s: 0.0,
+        filter: shpb::reduce::Filter::None,
         ..ReductionOptions::default()
     }
 }
@@ -213,6 +214,7 @@ fn synthetic_round_trip_integer_delays_recovers_forces_and_approach() {
         dispersion: DispersionCorrection::None,
         // The synthetic records are exact: no smoothing, so the round trip is too.
         smoothing_window_s: 0.0,
+        filter: shpb::reduce::Filter::None,
         start_fraction: 1e-9,
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
         ..ReductionOptions::default()
@@ -264,6 +266,7 @@ fn synthetic_round_trip_with_manual_windows_and_baseline() {
         dispersion: DispersionCorrection::None,
         // The synthetic records are exact: no smoothing, so the round trip is too.
         smoothing_window_s: 0.0,
+        filter: shpb::reduce::Filter::None,
         window: Some(WindowOverride {
             incident_start_s: Some(input.time_s[1200]),
             duration_s: Some(200e-6),
@@ -291,6 +294,7 @@ fn synthetic_round_trip_fractional_delays_uses_band_limited_shifts() {
         dispersion: DispersionCorrection::None,
         // The synthetic records are exact: no smoothing, so the round trip is too.
         smoothing_window_s: 0.0,
+        filter: shpb::reduce::Filter::None,
         start_fraction: 1e-9,
         ..ReductionOptions::default()
     };

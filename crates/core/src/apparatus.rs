@@ -206,6 +206,10 @@ pub struct PulseOptions {
     /// Compression (a pressure bar) or tension (a tension bar: the striker on the flange, the
     /// specimen bonded; docs/physics.md §6.13). Default compression.
     pub loading: crate::loading::Loading,
+    /// The filter of the simulated records before their reduction (docs/physics.md §7.12):
+    /// [`crate::reduce::Filter::DEFAULT`] unless the scene sets `smooth_s`, which makes it a
+    /// moving average of `reduction_smoothing_s` (0: none), as `shpb reduce --smooth` does.
+    pub reduction_filter: crate::reduce::Filter,
 }
 
 /// A prescribed incident wave (docs/physics.md §6.10): the compressive stress the incident gauge
@@ -573,6 +577,7 @@ impl Apparatus {
                 reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
                 incident_drive: None,
                 loading: crate::loading::Loading::Compression,
+                reduction_filter: crate::reduce::Filter::DEFAULT,
             },
             None,
         );

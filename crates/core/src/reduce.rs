@@ -26,6 +26,7 @@ use crate::gauge::GaugeChannel;
 pub mod align;
 pub mod baseline;
 pub mod correction;
+pub mod filter;
 pub mod options;
 pub mod plausibility;
 pub mod quality;
@@ -35,12 +36,13 @@ pub mod waves;
 pub mod windows;
 
 pub use align::{Alignment, AlignmentReport};
-pub use baseline::{beyond_digitiser_range, record_strains};
+pub use baseline::{Baseline, beyond_digitiser_range, record_strains};
 pub use correction::{
     BANCROFT_FIT, BANCROFT_FIT_POISSON_RATIO, DispersionCorrection, TYAS_POPE_CUTOFF_FA_OVER_C0,
     bancroft_phase_velocity_m_s, bancroft_velocity_ratio, dispersion_delay_s, dispersion_shift,
     dispersion_shift_exact,
 };
+pub use filter::Filter;
 pub use options::{DEFAULT_BALANCE_BOUND_S, MAX_BALANCE_BOUND_S, ReductionOptions};
 pub use quality::{EquilibriumDetail, equilibrium_detail, verdict_reason};
 pub use quality::{EquilibriumVerdict, Quality, WaveMetrics, wave_metrics};
@@ -209,6 +211,10 @@ pub struct Reduction {
     pub tyas_pope: bool,
     /// Things the user should know (Poisson's ratio off the fit, reflected delay off nominal, …).
     pub warnings: Vec<String>,
+    /// The filter applied to both records, its parameters fixed (docs/physics.md §7.12).
+    pub filter: Filter,
+    /// How the baselines were removed (docs/physics.md §7.12).
+    pub baseline: Baseline,
     /// The wave separation applied, if any (docs/physics.md §7.11).
     pub separation: Option<Separation>,
     /// A tension reduction (docs/physics.md §7.8.1): every series is in the loading's sense, the
@@ -268,6 +274,7 @@ pub fn measured_arrivals(
     file: &str,
 ) -> Result<Arrivals> {
     options.validate()?;
+    let options = &options.resolved_for(setup);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
     let dt = strains.dt;
@@ -384,6 +391,7 @@ pub fn reduce_separated(
     file: &str,
 ) -> Result<Reduction> {
     options.validate()?;
+    let options = &options.resolved_for(setup);
     // A tension test is reduced in its loading's sense: its records turned (§7.8.1).
     let input = &*input.in_loading_sense(options.tension);
     let strains = baseline::condition(input, options, file)?;
@@ -516,6 +524,8 @@ impl Reduction {
             warnings,
             tension: options.tension,
             separation: None,
+            filter: options.filter,
+            baseline: options.baseline,
             time_s,
             incident_strain: waves.incident,
             reflected_strain: waves.reflected,
@@ -601,6 +611,7 @@ mod tests {
         ReductionOptions {
             dispersion: DispersionCorrection::None,
             smoothing_window_s: 0.0,
+            filter: Filter::None,
             ..ReductionOptions::default()
         }
     }

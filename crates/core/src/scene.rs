@@ -968,6 +968,7 @@ fn reduce_simulated_records(
         specimen_radii_m: specimen_radii,
         smoothing_window_s: options.reduction_smoothing_s,
         tension: options.loading.is_tension(),
+        filter: options.reduction_filter,
         ..Default::default()
     };
     crate::reduce::reduce(

@@ -320,6 +320,8 @@ pub fn write_reduction_hdf5_with(
             &shpb_core::reduce::verdict_reason(r),
             path,
         )?;
+        string_attr(&s, "filter", &r.filter.describe(), path)?;
+        string_attr(&s, "baseline", r.baseline.name(), path)?;
         f.close().map_err(h5err(path))
     })
 }

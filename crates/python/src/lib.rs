@@ -641,14 +641,16 @@ fn curve<'py>(
 /// The lab's reduction of a raw record or run file (`shpb reduce`): `dispersion` is `none`,
 /// `bancroft` or `pochhammer-chree` (`--dispersion`), `tyas_pope` adds the Tyas–Pope factors,
 /// `align` is `geometric`, `foot` or `balance` (`--align`), `smooth` the moving-average width in
-/// s (`--smooth`), `layout` a record layout file (`--layout`), `balance_bound_s` the bound of the
+/// s (`--smooth`), `filter` `none`, `butterworth`, `savitzky-golay` or `moving-average`
+/// (`--filter`, with `filter_cutoff` Hz, `filter_order`, `filter_window` s; docs/physics.md
+/// §7.12), `baseline` `start-mean` or `linear-drift` (`--baseline`), `layout` a record layout file (`--layout`), `balance_bound_s` the bound of the
 /// balance search (`--balance-bound`); with a cylinder's length and diameter (m, both or
 /// neither) also its 1/2/3-wave curves; `specimen` a specimen file (`--specimen`: spheres of any
 /// diameter, a chain, or a cylinder); `tension` a tension test (`--tension`, §7.8.1);
 /// `wave_separation` `none`, `one-gauge` or `two-gauge` (`--wave-separation`)
 /// (docs/physics.md §7.3, §7.6–7.11).
 #[pyfunction]
-#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = shpb_core::reduce::DEFAULT_SMOOTHING_S, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S, specimen = None, tension = false, wave_separation = "none".into()))]
+#[pyo3(signature = (record, bars = None, dispersion = "bancroft".into(), tyas_pope = false, align = "geometric".into(), smooth = None, specimen_length_m = None, specimen_diameter_m = None, layout = None, balance_bound_s = shpb_core::reduce::DEFAULT_BALANCE_BOUND_S, specimen = None, tension = false, wave_separation = "none".into(), filter = None, filter_cutoff = None, filter_order = None, filter_window = None, baseline = "start-mean".into()))]
 #[allow(clippy::too_many_arguments)]
 fn reduce(
     py: Python<'_>,
@@ -657,7 +659,7 @@ fn reduce(
     dispersion: String,
     tyas_pope: bool,
     align: String,
-    smooth: f64,
+    smooth: Option<f64>,
     specimen_length_m: Option<f64>,
     specimen_diameter_m: Option<f64>,
     layout: Option<PathBuf>,
@@ -665,6 +667,11 @@ fn reduce(
     specimen: Option<PathBuf>,
     tension: bool,
     wave_separation: String,
+    filter: Option<String>,
+    filter_cutoff: Option<f64>,
+    filter_order: Option<usize>,
+    filter_window: Option<f64>,
+    baseline: String,
 ) -> PyResult<RunData> {
     let Some(separation) = shpb_core::reduce::WaveSeparation::from_name(&wave_separation) else {
         return Err(input_error(
@@ -705,11 +712,25 @@ fn reduce(
             specimen_diameter_m,
             ("specimen_length_m", "specimen_diameter_m"),
         )?;
+        let (reduction_filter, smoothing_s) = api::filter_choice(
+            filter.as_deref(),
+            smooth,
+            filter_cutoff,
+            filter_order,
+            filter_window,
+            [
+                "filter",
+                "filter_cutoff",
+                "filter_order",
+                "filter_window",
+                "smooth",
+            ],
+        )?;
         let choices = api::RecordOptions {
             dispersion: correction,
             tyas_pope,
             alignment,
-            smoothing_s: smooth,
+            smoothing_s,
             balance_bound_s,
             window: None,
             cylinder: geometry,
@@ -724,6 +745,8 @@ fn reduce(
             channels: None,
             tension,
             wave_separation: separation,
+            filter: reduction_filter,
+            baseline: api::baseline_choice(&baseline, "baseline")?,
         };
         let r = api::reduce_record_with(&record, bars.as_deref(), &choices)?;
         let mut scene = format!(

@@ -384,6 +384,11 @@ pub struct RecordOptions {
     /// Wave separation of overlapping pulses (`--wave-separation`, default none; docs/physics.md
     /// §7.11); two gauges read the set-up's `incident_2` and `transmission_2` channels.
     pub wave_separation: shpb_core::reduce::WaveSeparation,
+    /// The zero-phase filter of both records (`--filter`, docs/physics.md §7.12; default
+    /// [`shpb_core::reduce::Filter::DEFAULT`]); [`filter_choice`] makes it from the flags.
+    pub filter: shpb_core::reduce::Filter,
+    /// How the baselines are removed (`--baseline`, default start-mean).
+    pub baseline: shpb_core::reduce::Baseline,
 }
 
 impl RecordOptions {
@@ -399,11 +404,11 @@ impl RecordOptions {
         if self.tyas_pope {
             c.push_str(" --tyas-pope");
         }
-        c.push_str(&format!(
-            " --align {} --smooth {:e}",
-            self.alignment.name(),
-            self.smoothing_s
-        ));
+        c.push_str(&format!(" --align {}", self.alignment.name()));
+        c.push_str(&filter_flags(self.filter, self.smoothing_s));
+        if self.baseline != shpb_core::reduce::Baseline::StartMean {
+            c.push_str(&format!(" --baseline {}", self.baseline.name()));
+        }
         if self.alignment == shpb_core::reduce::Alignment::Balance {
             c.push_str(&format!(" --balance-bound {:e}", self.balance_bound_s));
         }
@@ -459,14 +464,185 @@ impl Default for RecordOptions {
             channels: None,
             tension: false,
             wave_separation: shpb_core::reduce::WaveSeparation::None,
+            filter: shpb_core::reduce::Filter::DEFAULT,
+            baseline: shpb_core::reduce::Baseline::StartMean,
         }
     }
+}
+
+/// The `shpb reduce` flags of a filter (each preceded by a space): `--filter NAME` and its
+/// parameters, a moving average's width as `--smooth`.
+fn filter_flags(filter: shpb_core::reduce::Filter, smoothing_s: f64) -> String {
+    use shpb_core::reduce::Filter;
+    let mut c = format!(" --filter {}", filter.name());
+    match filter {
+        Filter::None => {}
+        Filter::MovingAverage { width_s } => {
+            c.push_str(&format!(" --smooth {:e}", width_s.unwrap_or(smoothing_s)))
+        }
+        Filter::Butterworth { order, cutoff_hz } => {
+            c.push_str(&format!(" --filter-order {order}"));
+            if let Some(f) = cutoff_hz {
+                c.push_str(&format!(" --filter-cutoff {f:e}"));
+            }
+        }
+        Filter::SavitzkyGolay { window_s, order } => {
+            c.push_str(&format!(
+                " --filter-window {window_s:e} --filter-order {order}"
+            ));
+        }
+    }
+    c
+}
+
+/// The names `--filter` accepts.
+pub const FILTER_NAMES: [&str; 4] = ["none", "butterworth", "savitzky-golay", "moving-average"];
+
+/// The filter and the moving-average width of `shpb reduce`'s flags (and of Python's
+/// `shpb.reduce`; docs/physics.md §7.12): `--filter NAME` (default butterworth) with
+/// `--filter-cutoff HZ` and `--filter-order N` (butterworth), `--filter-window S` and
+/// `--filter-order N` (savitzky-golay), `--smooth S` or `--filter-window S` (moving-average).
+/// `--smooth S` without `--filter` is the moving average of width S (0: no filter), as before
+/// the filters. A parameter the chosen filter does not take is refused, naming its flag.
+/// `names` gives the flags' names as the caller spells them (`--filter`, `--filter-cutoff`,
+/// `--filter-order`, `--filter-window`, `--smooth`).
+pub fn filter_choice(
+    filter: Option<&str>,
+    smooth_s: Option<f64>,
+    cutoff_hz: Option<f64>,
+    order: Option<usize>,
+    window_s: Option<f64>,
+    names: [&str; 5],
+) -> Result<(shpb_core::reduce::Filter, f64)> {
+    use shpb_core::reduce::Filter;
+    use shpb_core::reduce::filter::{
+        DEFAULT_BUTTERWORTH_ORDER, DEFAULT_SAVGOL_ORDER, DEFAULT_SAVGOL_WINDOW_S,
+    };
+    let [f_flag, cutoff_flag, order_flag, window_flag, smooth_flag] = names;
+    let name = match (filter, smooth_s) {
+        (Some(n), _) => n,
+        (None, Some(_)) => "moving-average",
+        (None, None) => Filter::DEFAULT.name(),
+    };
+    let refuse = |flag: &str, what: &str| -> Error {
+        input_err(
+            flag,
+            format!("{flag} given with {f_flag} {name}, which has no {what}"),
+            match name {
+                "butterworth" => format!("with {f_flag} butterworth: {cutoff_flag}, {order_flag}"),
+                "savitzky-golay" => {
+                    format!("with {f_flag} savitzky-golay: {window_flag}, {order_flag}")
+                }
+                "moving-average" => {
+                    format!("with {f_flag} moving-average: {smooth_flag} or {window_flag}")
+                }
+                _ => format!("with {f_flag} none: no filter parameter"),
+            },
+        )
+    };
+    let smoothing_default = shpb_core::reduce::DEFAULT_SMOOTHING_S;
+    match name {
+        "none" => {
+            if let Some(s) = smooth_s
+                && s != 0.0
+            {
+                return Err(refuse(smooth_flag, "width"));
+            }
+            for (flag, given) in [
+                (cutoff_flag, cutoff_hz.is_some()),
+                (order_flag, order.is_some()),
+                (window_flag, window_s.is_some()),
+            ] {
+                if given {
+                    return Err(refuse(flag, "parameter"));
+                }
+            }
+            Ok((Filter::None, smooth_s.unwrap_or(smoothing_default)))
+        }
+        "moving-average" => {
+            if cutoff_hz.is_some() {
+                return Err(refuse(cutoff_flag, "cut-off"));
+            }
+            if order.is_some() {
+                return Err(refuse(order_flag, "order"));
+            }
+            let width = match (smooth_s, window_s) {
+                (Some(a), Some(b)) if a != b => {
+                    return Err(input_err(
+                        window_flag,
+                        format!(
+                            "{window_flag} {b:e} and {smooth_flag} {a:e} both give the moving average's width"
+                        ),
+                        format!("one of {smooth_flag} S or {window_flag} S"),
+                    ));
+                }
+                (Some(a), _) | (None, Some(a)) => a,
+                (None, None) => smoothing_default,
+            };
+            Ok((Filter::MovingAverage { width_s: None }, width))
+        }
+        "butterworth" => {
+            if smooth_s.is_some() {
+                return Err(refuse(smooth_flag, "moving-average width"));
+            }
+            if window_s.is_some() {
+                return Err(refuse(window_flag, "window"));
+            }
+            Ok((
+                Filter::Butterworth {
+                    order: order.unwrap_or(DEFAULT_BUTTERWORTH_ORDER),
+                    cutoff_hz,
+                },
+                smoothing_default,
+            ))
+        }
+        "savitzky-golay" => {
+            if smooth_s.is_some() {
+                return Err(refuse(smooth_flag, "moving-average width"));
+            }
+            if cutoff_hz.is_some() {
+                return Err(refuse(cutoff_flag, "cut-off"));
+            }
+            Ok((
+                Filter::SavitzkyGolay {
+                    window_s: window_s.unwrap_or(DEFAULT_SAVGOL_WINDOW_S),
+                    order: order.unwrap_or(DEFAULT_SAVGOL_ORDER),
+                },
+                smoothing_default,
+            ))
+        }
+        other => Err(input_err(
+            f_flag,
+            format!("unknown filter `{other}`"),
+            FILTER_NAMES.join(", "),
+        )),
+    }
+}
+
+/// The baseline of `--baseline NAME` (`start-mean`, `linear-drift`; docs/physics.md §7.12).
+pub fn baseline_choice(name: &str, flag: &str) -> Result<shpb_core::reduce::Baseline> {
+    use shpb_core::reduce::Baseline;
+    [Baseline::StartMean, Baseline::LinearDrift]
+        .into_iter()
+        .find(|b| b.name() == name)
+        .ok_or_else(|| {
+            input_err(
+                flag,
+                format!("unknown baseline `{name}`"),
+                "start-mean, linear-drift",
+            )
+        })
 }
 
 /// The `shpb reduce` flag of each quantity of [`ReductionOptions`] (the core's name otherwise).
 fn reduce_flag(quantity: &str) -> &str {
     match quantity {
         "smoothing_window_s" => "--smooth",
+        "filter.width_s" => "--smooth",
+        "filter.order" => "--filter-order",
+        "filter.cutoff_hz" => "--filter-cutoff",
+        "filter.window_s" => "--filter-window",
+        "baseline" => "--baseline",
         "balance_bound_s" => "--balance-bound",
         "tyas_pope" => "--tyas-pope",
         "window.incident_start_s" => "--incident-start",
@@ -526,6 +702,8 @@ pub fn reduce_record_with(
         balance_bound_s: choices.balance_bound_s,
         window: choices.window,
         wave_separation: choices.wave_separation,
+        filter: choices.filter,
+        baseline: choices.baseline,
         ..ReductionOptions::default()
     };
     options.validate().map_err(flag_err)?;
@@ -670,7 +848,16 @@ pub fn reduce_record_with(
         _ => None,
     };
     let reduction =
-        shpb_core::reduce::reduce_separated(&input, second.as_ref(), &setup, &options, &name)?;
+        shpb_core::reduce::reduce_separated(&input, second.as_ref(), &setup, &options, &name)
+            .map_err(|e| match e {
+                // A filter the record's sample step cannot take names its flag.
+                shpb_core::Error::Invalid { ref quantity, .. }
+                    if quantity.starts_with("filter.") =>
+                {
+                    flag_err(e)
+                }
+                other => other.into(),
+            })?;
     shpb_core::reduce::plausibility::check_reduction(
         &reduction,
         shpb_core::reduce::plausibility::SpecimenSize::of(&specimen),
@@ -918,9 +1105,78 @@ mod tests {
     /// correction unsaid, the bound only with `--align balance`, a cylinder's geometry when
     /// given.
     #[test]
+    fn the_filter_flags_map_to_one_filter_and_refuse_what_it_does_not_take() {
+        use shpb_core::reduce::Filter;
+        let names = [
+            "--filter",
+            "--filter-cutoff",
+            "--filter-order",
+            "--filter-window",
+            "--smooth",
+        ];
+        let choose = |f, s, c, o, w| filter_choice(f, s, c, o, w, names);
+        // No flag: the default; --smooth alone: the moving average of that width (0: none).
+        assert_eq!(
+            choose(None, None, None, None, None).unwrap().0,
+            Filter::DEFAULT
+        );
+        assert_eq!(
+            choose(None, Some(3e-6), None, None, None).unwrap(),
+            (Filter::MovingAverage { width_s: None }, 3e-6)
+        );
+        assert_eq!(
+            choose(Some("butterworth"), None, Some(1e5), Some(2), None)
+                .unwrap()
+                .0,
+            Filter::Butterworth {
+                order: 2,
+                cutoff_hz: Some(1e5)
+            }
+        );
+        // A parameter the filter does not take is named.
+        for (args, flag) in [
+            (
+                (Some("butterworth"), Some(2e-6), None, None, None),
+                "--smooth",
+            ),
+            (
+                (Some("savitzky-golay"), None, Some(1e5), None, None),
+                "--filter-cutoff",
+            ),
+            ((Some("none"), None, None, Some(3), None), "--filter-order"),
+            (
+                (Some("moving-average"), Some(1e-6), None, None, Some(2e-6)),
+                "--filter-window",
+            ),
+            ((Some("kalman"), None, None, None, None), "--filter"),
+        ] {
+            let (f, s, c, o, w) = args;
+            match choose(f, s, c, o, w) {
+                Err(Error::Input { key, .. }) => assert_eq!(key, flag, "{args:?}"),
+                other => panic!("{args:?}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
     fn command_flags_name_the_choices_made() {
         let default = RecordOptions::default().command_flags();
-        assert_eq!(default, " --align geometric --smooth 2e-6");
+        // The filter is always named (provenance), with its parameters.
+        assert_eq!(
+            default,
+            " --align geometric --filter butterworth --filter-order 4"
+        );
+        let smoothed = RecordOptions {
+            filter: shpb_core::reduce::Filter::MovingAverage { width_s: None },
+            smoothing_s: 2e-6,
+            baseline: shpb_core::reduce::Baseline::LinearDrift,
+            ..RecordOptions::default()
+        }
+        .command_flags();
+        assert_eq!(
+            smoothed,
+            " --align geometric --filter moving-average --smooth 2e-6 --baseline linear-drift"
+        );
         let balance = RecordOptions {
             dispersion: shpb_core::reduce::DispersionCorrection::PochhammerChree,
             alignment: shpb_core::reduce::Alignment::Balance,
@@ -934,7 +1190,8 @@ mod tests {
         .command_flags();
         assert_eq!(
             balance,
-            " --dispersion pochhammer-chree --align balance --smooth 2e-6 --balance-bound 3e-5 \
+            " --dispersion pochhammer-chree --align balance --filter butterworth --filter-order 4 \
+             --balance-bound 3e-5 \
              --specimen-length 6e-3 --specimen-diameter 1.2e-2"
         );
     }

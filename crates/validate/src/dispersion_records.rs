@@ -170,6 +170,7 @@ pub fn compare_records(root: &Path) -> Result<Vec<RecordComparison>> {
     let setup = ReductionSetup::from_apparatus(&app)?;
     let bancroft = ReductionOptions {
         smoothing_window_s: 0.0,
+        filter: shpb_core::reduce::Filter::None,
         ..ReductionOptions::default()
     };
     let exact = ReductionOptions {

@@ -294,7 +294,7 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
     let us = |v: Option<f64>| v.map_or("—".to_string(), |v| format!("{:.2}", v * 1e6));
     let mut text = format!(
         "record: {} ({}); bridges: {}\n\
-         windows ({} alignment): incident from {:.2} µs, reflected +{:.2} µs (geometric {}, record's foot {}), transmitted +{:.2} µs (geometric {}, record's foot {}), {:.1} µs long; dispersion correction {}\n\
+         windows ({} alignment): incident from {:.2} µs, reflected +{:.2} µs (geometric {}, record's foot {}), transmitted +{:.2} µs (geometric {}, record's foot {}), {:.1} µs long; dispersion correction {}; filter {}\n\
          peak back force {:.1} N at t = {:.2} µs; displacement at peak force {:.2} µm; equilibrium ratio at peak {:.3}\n\
          equilibrium over the loading ({:.1}–{:.1} µs): mean {:.3}, max {:.3}: {}; signal/noise {:.0} (incident), {:.0} (transmission)\n",
         record.display(),
@@ -314,6 +314,7 @@ fn summary_text(record: &Path, reduced: &Reduced) -> String {
         us(a.measured_transmitted_delay_s),
         r.windows.duration_s * 1e6,
         dispersion_summary(r),
+        r.filter.describe(),
         r.peak_back_force_n,
         r.peak_back_force_time_s * 1e6,
         r.displacement_at_peak_force_m * 1e6,
@@ -421,6 +422,8 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
         "dispersion": r.dispersion.name(),
         "tyas_pope": r.tyas_pope,
         "loading": if r.tension { "tension" } else { "compression" },
+        "filter": filter_json(&r.filter),
+        "baseline": r.baseline.name(),
         "peak_back_force_N": finite(r.peak_back_force_n),
         "peak_back_force_time_s": finite(r.peak_back_force_time_s),
         "displacement_at_peak_force_m": finite(r.displacement_at_peak_force_m),
@@ -453,6 +456,27 @@ fn summary_json(record: &Path, reduced: &Reduced) -> serde_json::Value {
             "strain_at_peak_stress": finite(c.strain_at_peak),
             "mean_strain_rate_per_s": finite(c.mean_strain_rate_per_s),
         });
+    }
+    json
+}
+
+/// The filter a reduction applied, with its parameters (`--json`; docs/physics.md §7.12).
+fn filter_json(f: &shpb_core::reduce::Filter) -> serde_json::Value {
+    use shpb_core::reduce::Filter;
+    let opt = |v: Option<f64>| v.map_or(serde_json::Value::Null, finite);
+    let mut json = serde_json::json!({ "name": f.name(), "description": f.describe() });
+    match *f {
+        Filter::None => {}
+        Filter::MovingAverage { width_s } => json["width_s"] = opt(width_s),
+        Filter::Butterworth { order, cutoff_hz } => {
+            json["order"] = order.into();
+            json["cutoff_hz"] = opt(cutoff_hz);
+            json["zero_phase"] = "forward-backward".into();
+        }
+        Filter::SavitzkyGolay { window_s, order } => {
+            json["window_s"] = finite(window_s);
+            json["order"] = order.into();
+        }
     }
     json
 }

@@ -6,7 +6,80 @@ use super::{ReductionInput, ReductionOptions, channel, input_err, quality};
 use crate::apparatus::Apparatus;
 use crate::error::Result;
 use crate::gauge::{GaugeChannel, RawRecord};
-use crate::numeric::moving_average;
+
+/// How a record's baseline is removed (`--baseline`; docs/physics.md §7.12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Baseline {
+    /// The mean of the pre-trigger samples (the first `baseline_samples`), as the authors do.
+    #[default]
+    StartMean,
+    /// A straight line fitted by least squares to the pre-trigger samples and to as many samples
+    /// of the record's quiet tail, for a gauge whose zero drifts during the record.
+    LinearDrift,
+}
+
+impl Baseline {
+    /// The name of `--baseline` (`start-mean`, `linear-drift`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Baseline::StartMean => "start-mean",
+            Baseline::LinearDrift => "linear-drift",
+        }
+    }
+}
+
+/// How many times the pre-trigger noise the tail's scatter about the fitted line may be for the
+/// tail to count as quiet (docs/physics.md §7.12): 3, above the ±√2 scatter of two RMS
+/// estimates of one white noise over hundreds of samples and well below a pulse or its echoes.
+pub const QUIET_TAIL_FACTOR: f64 = 3.0;
+
+/// `v` less its baseline taken from its first `n` samples (`mode`; docs/physics.md §7.12): their
+/// mean, or the least-squares line through them and the last `n` samples, refused (an error
+/// naming `channel` of `file`) when that tail scatters about the line by more than
+/// [`QUIET_TAIL_FACTOR`] times the first samples' RMS: a pulse or its echoes are still there.
+pub fn remove_baseline(
+    v: &[f64],
+    n: usize,
+    mode: Baseline,
+    channel: &str,
+    file: &str,
+) -> Result<Vec<f64>> {
+    let len = v.len();
+    if mode == Baseline::StartMean || n < 2 || 2 * n > len {
+        return Ok(debias(v, n));
+    }
+    let idx: Vec<f64> = (0..n).chain(len - n..len).map(|k| k as f64).collect();
+    let ones = vec![1.0; idx.len()];
+    let y: Vec<f64> = (0..n).chain(len - n..len).map(|k| v[k]).collect();
+    let p = crate::numeric::least_squares(&[&ones, &idx], &y).ok_or_else(|| {
+        input_err(
+            file,
+            &format!("{channel}_strain"),
+            "the baseline line could not be fitted",
+            "finite samples",
+        )
+    })?;
+    let line = |k: usize| p[0] + p[1] * k as f64;
+    let rms = |r: std::ops::Range<usize>| {
+        let m = r.len() as f64;
+        (r.map(|k| (v[k] - line(k)).powi(2)).sum::<f64>() / m).sqrt()
+    };
+    let (head, tail) = (rms(0..n), rms(len - n..len));
+    if tail > QUIET_TAIL_FACTOR * head {
+        return Err(input_err(
+            file,
+            "baseline",
+            format!(
+                "linear-drift: the {channel} record's last {n} samples are not quiet (their scatter about the fitted line is {:.1} times the pre-trigger noise): a pulse or its echoes are still there",
+                tail / head.max(f64::MIN_POSITIVE)
+            ),
+            format!(
+                "a record whose last {n} samples are as quiet as its first (within {QUIET_TAIL_FACTOR} times their noise), or --baseline start-mean"
+            ),
+        ));
+    }
+    Ok((0..len).map(|k| v[k] - line(k)).collect())
+}
 
 /// Checks the input series: equal lengths, enough samples, finite, uniform time axis; returns dt.
 pub(crate) fn check_input(input: &ReductionInput, file: &str) -> Result<f64> {
@@ -222,8 +295,10 @@ pub(crate) struct Conditioned {
     pub transmission_noise: f64,
 }
 
-/// Checks, smooths and debiases the two records, judges their polarity and finds the incident
-/// foot; the baseline is re-taken before the pulse if the pulse starts within it.
+/// Checks, filters and debiases the two records, judges their polarity and finds the incident
+/// foot; the baseline is re-taken before the pulse if the pulse starts within it. The options'
+/// filter must be resolved ([`ReductionOptions::resolved_for`]). With a linear-drift baseline the
+/// foot is found on the start-mean record and the line then removed from both.
 pub(crate) fn condition(
     input: &ReductionInput,
     options: &ReductionOptions,
@@ -232,10 +307,9 @@ pub(crate) fn condition(
     let dt = check_input(input, file)?;
     let n = input.time_s.len();
 
-    // 0. Optional smoothing (a centred moving average over an odd number of samples).
-    let half = (options.smoothing_window_s / dt / 2.0).round() as usize;
-    let incident_strain = moving_average(&input.incident_strain, half);
-    let transmission_strain = moving_average(&input.transmission_strain, half);
+    // 0. The zero-phase filter (options resolved for the set-up, docs/physics.md §7.12).
+    let incident_strain = options.filter.apply(&input.incident_strain, dt, file)?;
+    let transmission_strain = options.filter.apply(&input.transmission_strain, dt, file)?;
 
     // 1–3. Baseline, polarity, then the incident foot; the baseline must end before the pulse.
     let mut nb = options.baseline_samples.min(n / 2);
@@ -260,7 +334,16 @@ pub(crate) fn condition(
         eps_i = debias(&incident_strain, nb);
         detected = foot(&eps_i);
     }
-    let eps_t = debias(&transmission_strain, nb);
+    if options.baseline != Baseline::StartMean {
+        eps_i = remove_baseline(&incident_strain, nb, options.baseline, "incident", file)?;
+    }
+    let eps_t = remove_baseline(
+        &transmission_strain,
+        nb,
+        options.baseline,
+        "transmission",
+        file,
+    )?;
     let incident_peak = detected.map(|(_, k)| -eps_i[k]).unwrap_or(0.0);
     let transmission_noise = quality::baseline_rms(&eps_t, nb);
     Ok(Conditioned {
@@ -277,6 +360,40 @@ pub(crate) fn condition(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_linear_drift_is_removed_and_a_busy_tail_refused() {
+        // A pulse on a gauge whose zero drifts linearly (1e-5 over the record), a little noise,
+        // quiet at both ends: the line through the first and last 500 samples takes the drift
+        // away, leaving the pulse to within the noise's share of the fit (≪ 1e-6).
+        let n = 4000;
+        let noise = |k: usize| 2e-7 * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
+        let pulse = |k: usize| {
+            let x = (k as f64 - 1500.0) / 1000.0;
+            if (0.0..=1.0).contains(&x) {
+                -1e-4 * (std::f64::consts::PI * x).sin().powi(2)
+            } else {
+                0.0
+            }
+        };
+        let drift = |k: usize| 3e-6 + 1e-5 * k as f64 / n as f64;
+        let v: Vec<f64> = (0..n).map(|k| pulse(k) + drift(k) + noise(k)).collect();
+        let clean = remove_baseline(&v, 500, Baseline::LinearDrift, "incident", "r").unwrap();
+        let worst = (0..n)
+            .map(|k| (clean[k] - pulse(k) - noise(k)).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 5e-8, "{worst}");
+        // The start mean leaves the drift: 1e-5 × 3500/4000 at the end less its start share.
+        let start = remove_baseline(&v, 500, Baseline::StartMean, "incident", "r").unwrap();
+        assert!((start[n - 1] - noise(n - 1)).abs() > 8e-6);
+        // A pulse still in the tail is refused, naming the baseline.
+        let echo = |k: usize| if k >= 2100 { pulse(k - 2100) } else { 0.0 };
+        let busy: Vec<f64> = (0..n).map(|k| pulse(k) + echo(k) + noise(k)).collect();
+        match remove_baseline(&busy, 500, Baseline::LinearDrift, "incident", "r") {
+            Err(crate::Error::Invalid { quantity, .. }) => assert_eq!(quantity, "baseline"),
+            other => panic!("a busy tail accepted: {:?}", other.map(|v| v.len())),
+        }
+    }
 
     #[test]
     fn polarity_is_not_judged_on_noise() {

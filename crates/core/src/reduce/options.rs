@@ -2,7 +2,10 @@
 //! library, `shpb reduce`, `shpb run` and the Python package all pass, refused here when out of
 //! range with the quantity at fault.
 
-use super::{Alignment, DEFAULT_SMOOTHING_S, DispersionCorrection, WindowOverride, input_err};
+use super::{
+    Alignment, Baseline, DEFAULT_SMOOTHING_S, DispersionCorrection, Filter, ReductionSetup,
+    WindowOverride, input_err,
+};
 use crate::error::Result;
 
 /// Default bound of the balance search on each window shift, s: 60 µs (docs/physics.md §7.6).
@@ -46,6 +49,14 @@ pub struct ReductionOptions {
     pub tension: bool,
     /// Wave separation of overlapping pulses (default none; docs/physics.md §7.11).
     pub wave_separation: super::WaveSeparation,
+    /// The zero-phase filter of both strain records before the reduction (default
+    /// [`Filter::DEFAULT`]: 4th-order Butterworth at the bars' dispersion band, forward and
+    /// backward; docs/physics.md §7.12). A moving average without its own width takes
+    /// `smoothing_window_s`.
+    pub filter: Filter,
+    /// How each record's baseline is removed (default [`Baseline::StartMean`]; docs/physics.md
+    /// §7.12).
+    pub baseline: Baseline,
 }
 
 impl Default for ReductionOptions {
@@ -63,11 +74,27 @@ impl Default for ReductionOptions {
             balance_bound_s: DEFAULT_BALANCE_BOUND_S,
             tension: false,
             wave_separation: super::WaveSeparation::None,
+            filter: Filter::DEFAULT,
+            baseline: Baseline::StartMean,
         }
     }
 }
 
 impl ReductionOptions {
+    /// These options with the filter's parameters fixed for `setup` (docs/physics.md §7.12): a
+    /// moving average's width from `smoothing_window_s`, a Butterworth cut-off not given from
+    /// the bars' dispersion band (the lower of the two bars'
+    /// [`super::filter::band_cutoff_hz`]).
+    pub fn resolved_for(&self, setup: &ReductionSetup) -> ReductionOptions {
+        let band =
+            |b: &super::BarProperties| super::filter::band_cutoff_hz(b.radius_m, b.wave_speed_m_s);
+        let band_hz = band(&setup.incident_bar).min(band(&setup.transmission_bar));
+        ReductionOptions {
+            filter: self.filter.resolved(self.smoothing_window_s, band_hz),
+            ..*self
+        }
+    }
+
     /// Checks every choice once (docs/physics.md §7.3, §7.6): an [`crate::Error::Invalid`] of
     /// object `"reduction options"` whose quantity is the field at fault (`smoothing_window_s`,
     /// `balance_bound_s`, `window.reflected_delay_s`, …) and whose `allowed` gives the range.
@@ -118,6 +145,7 @@ impl ReductionOptions {
                 "a positive bound in seconds up to 2e-4 (200 µs), e.g. 6e-5",
             ));
         }
+        o.filter.validate(file)?;
         if let Some((r1, r2)) = o.specimen_radii_m
             && !(r1 > 0.0 && r2 > 0.0 && r1.is_finite() && r2.is_finite())
         {

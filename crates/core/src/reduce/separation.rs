@@ -422,14 +422,19 @@ pub(crate) fn stage(
                     ));
                 }
             }
-            // Smoothed as the first gauges; the baseline ends before the pulse reaches the
-            // gauge: on the incident bar the second gauge sees it (d₂ − d₁)/c0 earlier.
-            let half = (options.smoothing_window_s / dt / 2.0).round() as usize;
-            let condition = |e: &[f64], earlier_s: f64| {
+            // Filtered as the first gauges (and turned in a tension test, as they are, §7.8.1);
+            // the baseline ends before the pulse reaches the gauge: on the incident bar the
+            // second gauge sees it (d₂ − d₁)/c0 earlier.
+            let sign = if options.tension { -1.0 } else { 1.0 };
+            let condition = |e: &[f64], earlier_s: f64| -> Result<Vec<f64>> {
                 let nb = strains
                     .baseline_samples
                     .saturating_sub((earlier_s / dt).ceil() as usize);
-                super::baseline::debias(&crate::numeric::moving_average(e, half), nb)
+                let turned: Vec<f64> = e.iter().map(|x| sign * x).collect();
+                Ok(super::baseline::debias(
+                    &options.filter.apply(&turned, dt, file)?,
+                    nb,
+                ))
             };
             if g.incident_strain.len() != n || g.transmission_strain.len() != n {
                 return Err(missing(
@@ -443,7 +448,7 @@ pub(crate) fn stage(
             }
             let inc = two_gauge(
                 &strains.incident,
-                &condition(&g.incident_strain, (g.incident_gauge_m - d_i) / c_i),
+                &condition(&g.incident_strain, (g.incident_gauge_m - d_i) / c_i)?,
                 d_i,
                 g.incident_gauge_m,
                 dt,
@@ -451,7 +456,7 @@ pub(crate) fn stage(
             );
             let tra = two_gauge(
                 &strains.transmission,
-                &condition(&g.transmission_strain, 0.0),
+                &condition(&g.transmission_strain, 0.0)?,
                 d_t,
                 g.transmission_gauge_m,
                 dt,

@@ -431,6 +431,8 @@ mod tests {
             record: crate::reduce::RecordTrace::default(),
             tension: false,
             separation: None,
+            filter: crate::reduce::Filter::None,
+            baseline: crate::reduce::Baseline::StartMean,
         }
     }
 

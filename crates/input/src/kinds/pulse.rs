@@ -131,8 +131,8 @@ pub(super) const INCIDENT_RECORD: Key = Key {
 pub(super) const SMOOTH: Key = Key {
     key: "smooth_s",
     unit: "s",
-    default: "2e-6",
-    meaning: "width of the moving average applied to the simulated gauge records before the lab's reduction, as `shpb reduce --smooth` applies it to real ones; 0 (off) to 1e-4",
+    default: "none: the default filter of `shpb reduce` (Butterworth at the bars' band)",
+    meaning: "width of a moving average applied to the simulated gauge records before the lab's reduction instead of the default filter, as `shpb reduce --smooth` applies it to real ones; 0 (no filter) to 1e-4",
 };
 
 #[derive(Deserialize)]
@@ -484,6 +484,11 @@ pub(super) fn parse_bars(
         reduction_smoothing_s,
         incident_drive: drive,
         loading,
+        // `smooth_s` is the moving average of `shpb reduce --smooth` (0: no filter).
+        reduction_filter: match f.smooth_s {
+            Some(_) => shpb_core::reduce::Filter::MovingAverage { width_s: None },
+            None => shpb_core::reduce::Filter::DEFAULT,
+        },
     };
     // Refuse a run too large for this machine before its bars are built (below), then a grid
     // the bars cannot run (time step over the stability limit) now, not mid-run.

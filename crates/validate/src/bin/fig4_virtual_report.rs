@@ -59,6 +59,7 @@ fn record_2013(root: &Path, app: &Apparatus, m: &str, p: &str) -> Option<(usize,
     let options = ReductionOptions {
         specimen_radii_m: Some((3.175e-3, 3.175e-3)),
         smoothing_window_s: 0.0,
+        filter: shpb_core::reduce::Filter::None,
         ..Default::default()
     };
     let r = reduce_record_file(&s.record_path(root), app, &options).unwrap();
@@ -96,7 +97,7 @@ fn main() {
     )
     .unwrap();
     md.push_str(SUMMARY);
-    writeln!(md, "Each row is a full virtual test (`shpb run validation/fig4-virtual-shpb/<scene>`: calibrated gun and copper shaper of `bars/authors.toml`, the authors' bars, two 6.35 mm spheres with the rate-dependent law). *true*: the simulated contact history; *reduced*: the lab's reduction of the simulated gauge voltages (`/reduction`, 2 µs smoothing, no dispersion correction: the simulated bars are non-dispersive). *Fig. 4*: the measured record of the same material and pressure (authors' reduction; displacement counted from its value at the start of loading, as in the force-driven comparison). *2013-05-22*: the real raw record of the same material and pressure reduced by `shpb reduce` (dispersion corrected), and the authors' reduction of it in brackets (sample 1's uses the literal bridge formula: twice the others' reading, see `validation/gauge-records/REPORT.md`).\n").unwrap();
+    writeln!(md, "Each row is a full virtual test (`shpb run validation/fig4-virtual-shpb/<scene>`: calibrated gun and copper shaper of `bars/authors.toml`, the authors' bars, two 6.35 mm spheres with the rate-dependent law). *true*: the simulated contact history; *reduced*: the lab's reduction of the simulated gauge voltages (`/reduction`, the default filter of docs/physics.md §7.12, no dispersion correction: the simulated bars are non-dispersive). *Fig. 4*: the measured record of the same material and pressure (authors' reduction; displacement counted from its value at the start of loading, as in the force-driven comparison). *2013-05-22*: the real raw record of the same material and pressure reduced by `shpb reduce` (dispersion corrected), and the authors' reduction of it in brackets (sample 1's uses the literal bridge formula: twice the others' reading, see `validation/gauge-records/REPORT.md`).\n").unwrap();
     writeln!(md, "| test | F peak true (kN) | reduced | Fig. 4 | true / Fig. 4 | 2013-05-22 ours (authors') | δ at peak true (mm) | reduced | Fig. 4 | true / Fig. 4 | 2013-05-22 ours (authors') |").unwrap();
     writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|").unwrap();
     for m in ["ss440c", "ss302", "al2017"] {

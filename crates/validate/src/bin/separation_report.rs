@@ -118,11 +118,11 @@ fn main() -> Result<()> {
     // The simulated face waves: the incident one from the long-bar twin at the same distance
     // from the impact end, the reflected one the face strain less it; the transmission face's
     // strain is the transmitted wave plus the far end's echo (both in the back force).
-    // Smoothed by the reduction's own moving average (2 µs), so that the comparison is of the
-    // separation alone.
+    // Filtered by the reduction's own default filter (docs/physics.md §7.12), so that the
+    // comparison is of the separation alone.
     let dt = t[1] - t[0];
-    let half = (ReductionOptions::default().smoothing_window_s / dt / 2.0).round() as usize;
-    let smooth = |v: &[f64]| shpb_core::numeric::moving_average(v, half);
+    let filter = ReductionOptions::default().resolved_for(&setup).filter;
+    let smooth = |v: &[f64]| filter.apply(v, dt, "simulated face wave").expect("filter");
     let incident_true_full = smooth(&resample(
         &t_twin,
         true_strain(&twin, "incident_at_face"),
@@ -172,8 +172,8 @@ fn main() -> Result<()> {
          Over each reduction's window (from the incident foot's arrival at the face, 1.5 times \
          the separated incident pulse; in brackets the part compared, up to 2 L_I/c0 = {:.1} µs, \
          where the impact end's echo of the reflected wave, which the twin's incident wave \
-         lacks, comes back to the face). The simulated waves are smoothed by the reduction's \
-         2 µs moving average, so that the comparison is of the separation alone. RMS error over \
+         lacks, comes back to the face). The simulated waves are filtered by the reduction's \
+         default filter ({}), so that the comparison is of the separation alone. RMS error over \
          the largest simulated wave at the bar's face (the incident wave for the incident and \
          reflected waves: the reflected wave of this stiff elastic specimen is only a few per \
          cent of it) and, in brackets, over the RMS of the simulated wave itself; the specimen's stress from the separated waves (1-wave, `reduce_cylinder`, \
@@ -182,7 +182,8 @@ fn main() -> Result<()> {
          its peak) over the simulated peak.\n\n\
          | record | method | window (µs) | incident | reflected | transmission face | peak stress | stress RMS |\n\
          |---|---|---:|---:|---:|---:|---:|---:|",
-        echo_s * 1e6
+        echo_s * 1e6,
+        filter.describe()
     );
     let spec = out.specimen.as_ref().expect("a cylinder's series");
     let g = CylinderGeometry {
