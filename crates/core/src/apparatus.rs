@@ -207,9 +207,9 @@ pub struct PulseOptions {
     /// specimen bonded; docs/physics.md §6.13). Default compression.
     pub loading: crate::loading::Loading,
     /// The filter of the simulated records before their reduction (docs/physics.md §7.12):
-    /// [`crate::reduce::Filter::DEFAULT`] unless the scene sets `smooth_s`, which makes it a
+    /// [`crate::filter::Filter::DEFAULT`] unless the scene sets `smooth_s`, which makes it a
     /// moving average of `reduction_smoothing_s` (0: none), as `shpb reduce --smooth` does.
-    pub reduction_filter: crate::reduce::Filter,
+    pub reduction_filter: crate::filter::Filter,
 }
 
 /// A prescribed incident wave (docs/physics.md §6.10): the compressive stress the incident gauge
@@ -577,7 +577,7 @@ impl Apparatus {
                 reduction_smoothing_s: crate::gauge::DEFAULT_SMOOTHING_S,
                 incident_drive: None,
                 loading: crate::loading::Loading::Compression,
-                reduction_filter: crate::reduce::Filter::DEFAULT,
+                reduction_filter: crate::filter::Filter::DEFAULT,
             },
             None,
         );

@@ -16,6 +16,7 @@ pub mod dispersion;
 pub mod error;
 pub mod estimate;
 pub mod fidelity;
+pub mod filter;
 #[cfg(test)]
 mod fixtures;
 pub mod flow;

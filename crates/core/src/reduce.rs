@@ -26,7 +26,7 @@ use crate::gauge::GaugeChannel;
 pub mod align;
 pub mod baseline;
 pub mod correction;
-pub mod filter;
+pub use crate::filter;
 pub mod options;
 pub mod plausibility;
 pub mod quality;
