@@ -48,10 +48,16 @@ fn summary(out: &RunOutput, key: &str) -> f64 {
 /// here from the two series and equal to the summary's `reduced_true_stress_max_relative_error`.
 /// The specimen lengthens (true strain > 4 %) and both curves are tension positive; the ledger
 /// (striker = bars + specimen + joints + plastic work) closes to 1e-9 (the issue-40 bound).
+/// As in `plastic_cylinder.rs`, the error is the largest over a weak transmitted pulse, set by
+/// the noise the filter leaves, so the run keeps the 2 µs moving average (`smooth_s`) the 3 %
+/// bound was set with (measured at 12.5 psi: 2.1 % with it, 3.7 % with the default Butterworth
+/// at 0.4 c0/a; docs/physics.md §7.12).
 #[test]
 fn the_reduction_of_a_tension_test_recovers_its_true_flow_stress() {
     for pressure in ["12.5psi", "15psi"] {
-        let out = run(&scene(pressure, "tension", "gauge_length_m"));
+        let text = scene(pressure, "tension", "gauge_length_m")
+            .replace("[specimen]", "smooth_s = 2e-6\n[specimen]");
+        let out = run(&text);
         let error = summary(&out, "reduced_true_stress_max_relative_error");
         let s = out.specimen.as_ref().expect("a cylinder run has /specimen");
         let peak = shpb_core::numeric::argmax(&s.face_stress_pa);

@@ -22,8 +22,14 @@ fn the_records_balance_with_one_incident_path_and_an_early_transmitted_window() 
         reduce_record_file(
             &sample.record_path(&root),
             &app,
+            // The 2 µs moving average the threefold bound was set with: the default
+            // Butterworth leaves more of the two-wave front force's ringing, which the RMS
+            // imbalance counts (Al2017 12.5 psi: 0.1781 against a bound of 0.1780).
             &ReductionOptions {
                 alignment,
+                filter: shpb_core::reduce::Filter::MovingAverage {
+                    width_s: Some(2e-6),
+                },
                 ..ReductionOptions::default()
             },
         )
