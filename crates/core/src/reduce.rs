@@ -237,6 +237,17 @@ pub struct RecordTrace {
     pub transmission_strain: Vec<f64>,
 }
 
+impl RecordTrace {
+    /// The conditioned records of the first stage on the record's clock.
+    fn of(input: &ReductionInput, strains: &baseline::Conditioned) -> RecordTrace {
+        RecordTrace {
+            time_s: input.time_s.clone(),
+            incident_strain: strains.incident.clone(),
+            transmission_strain: strains.transmission.clone(),
+        }
+    }
+}
+
 /// The arrivals of a record's pulses by the rule of the reduction's measured delays
 /// (docs/physics.md §7.6, `--align foot`): every delay is a foot (2 % of the pulse's own peak,
 /// [`crate::gauge::pulse_foot`]) minus the incident foot, on the record's clock; what
@@ -424,11 +435,7 @@ pub fn reduce_separated(
             warnings,
         );
         r.separation = Some(separation);
-        r.record = RecordTrace {
-            time_s: input.time_s.clone(),
-            incident_strain: strains.incident.clone(),
-            transmission_strain: strains.transmission.clone(),
-        };
+        r.record = RecordTrace::of(input, &strains);
         return Ok(r);
     }
     let corrections = correction::FaceCorrections::new(setup, options)?;
@@ -457,11 +464,7 @@ pub fn reduce_separated(
     let strain_rate_per_s = options
         .specimen_radii_m
         .map(|radii| specimen::sphere_strain_rate(&waves.faces.approach_velocity_m_s, radii));
-    let record = RecordTrace {
-        time_s: input.time_s.clone(),
-        incident_strain: strains.incident.clone(),
-        transmission_strain: strains.transmission.clone(),
-    };
+    let record = RecordTrace::of(input, &strains);
     let reduction = Reduction::assemble(
         strains.dt,
         setup,

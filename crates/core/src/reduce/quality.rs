@@ -208,7 +208,7 @@ pub(crate) fn assess(
         if s < MINIMUM_SIGNAL_TO_NOISE {
             warnings.push(format!(
                 "the {name} channel's pulse is only {s:.1} times its baseline noise (RMS): feet \
-                 and peaks are uncertain (smooth with --smooth, or check the gauge)"
+                 and peaks are uncertain (filter with a lower --filter-cutoff, or check the gauge)"
             ));
         }
     }
