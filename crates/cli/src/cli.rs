@@ -825,11 +825,9 @@ fn invalid_utf8_argument(args: impl Iterator<Item = std::ffi::OsString>) -> Stri
     };
     let shown = args[i].to_string_lossy();
     let option = args[..i]
-        .iter()
-        .rev()
-        .take(1)
-        .filter_map(|a| a.to_str())
-        .find(|a| a.starts_with('-'))
+        .last()
+        .and_then(|a| a.to_str())
+        .filter(|a| a.starts_with('-'))
         .map(|o| format!(" (the value of `{o}`)"))
         .unwrap_or_default();
     format!(

@@ -407,7 +407,10 @@ pub fn reduce_separated(
     let input = &*input.in_loading_sense(options.tension);
     let strains = baseline::condition(input, options, file)?;
     let incident_start_s = windows::incident_start_s(input, &strains, options, file)?;
-    if options.wave_separation != WaveSeparation::None {
+    // Stage 2, the windows and the waves at the faces: cut from the gauge records, or from the
+    // separated face waves (§7.11).
+    let mut warnings = Vec::new();
+    let (placed, waves, separation) = if options.wave_separation != WaveSeparation::None {
         let (placed, waves, separation) = separation::stage(
             input,
             second,
@@ -417,50 +420,36 @@ pub fn reduce_separated(
             incident_start_s,
             file,
         )?;
-        let mut warnings = Vec::new();
-        let quality = quality::assess(options, &strains, &placed, &waves, &mut warnings);
-        // The windows of separated waves are not cut short by the overlap at the gauge.
-        warnings.retain(|w| !w.starts_with("the incident pulse lasts"));
-        let strain_rate_per_s = options
-            .specimen_radii_m
-            .map(|radii| specimen::sphere_strain_rate(&waves.faces.approach_velocity_m_s, radii));
-        let mut r = Reduction::assemble(
-            strains.dt,
+        (placed, waves, Some(separation))
+    } else {
+        let corrections = correction::FaceCorrections::new(setup, options)?;
+        let placed = windows::place(
+            input,
             setup,
             options,
-            placed,
-            waves,
-            quality,
-            strain_rate_per_s,
-            warnings,
-        );
-        r.separation = Some(separation);
-        r.record = RecordTrace::of(input, &strains);
-        return Ok(r);
-    }
-    let corrections = correction::FaceCorrections::new(setup, options)?;
-    let mut warnings = Vec::new();
-    let placed = windows::place(
-        input,
-        setup,
-        options,
-        &strains,
-        incident_start_s,
-        &corrections,
-        file,
-        &mut warnings,
-    )?;
-    warnings.extend(corrections.warnings());
-    let waves = waves::at_faces(setup, &strains, &placed, &corrections);
-    warnings.extend(waves::reflected_delay_warning(
-        setup,
-        options,
-        &strains,
-        &placed,
-        &corrections,
-        &waves,
-    ));
+            &strains,
+            incident_start_s,
+            &corrections,
+            file,
+            &mut warnings,
+        )?;
+        warnings.extend(corrections.warnings());
+        let waves = waves::at_faces(setup, &strains, &placed, &corrections);
+        warnings.extend(waves::reflected_delay_warning(
+            setup,
+            options,
+            &strains,
+            &placed,
+            &corrections,
+            &waves,
+        ));
+        (placed, waves, None)
+    };
     let quality = quality::assess(options, &strains, &placed, &waves, &mut warnings);
+    if separation.is_some() {
+        // The windows of separated waves are not cut short by the overlap at the gauge.
+        warnings.retain(|w| !w.starts_with("the incident pulse lasts"));
+    }
     let strain_rate_per_s = options
         .specimen_radii_m
         .map(|radii| specimen::sphere_strain_rate(&waves.faces.approach_velocity_m_s, radii));
@@ -477,6 +466,7 @@ pub fn reduce_separated(
     );
     Ok(Reduction {
         record,
+        separation,
         ..reduction
     })
 }
@@ -561,6 +551,57 @@ pub(crate) fn authors_bar() -> BarProperties {
     }
 }
 
+/// A synthetic record of the authors' bars (no dispersion), for the unit tests: a compressive
+/// incident sin² pulse of 4e-4 and 120 µs whose foot passes the incident gauge at 100 µs, its
+/// tensile reflection of `reflected` 2 d_I/c0 later, a compressive transmitted pulse of 1e-4
+/// (d_I + d_T)/c0 + `late_s` later, sampled at 10 MHz with a deterministic noise of amplitude
+/// `noise` (absorbing transmission bar).
+#[cfg(test)]
+pub(crate) fn synthetic_record(
+    reflected: f64,
+    late_s: f64,
+    noise: f64,
+) -> (ReductionInput, ReductionSetup) {
+    let bar = authors_bar();
+    let setup = ReductionSetup {
+        incident_bar: bar,
+        transmission_bar: bar,
+        incident_gauge_m: 0.644525,
+        transmission_gauge_m: 0.3683,
+        transmission_absorbing: true,
+    };
+    let c0 = bar.wave_speed_m_s;
+    let pulse = |t: f64| {
+        let x = t / 120e-6;
+        if (0.0..=1.0).contains(&x) {
+            (std::f64::consts::PI * x).sin().powi(2)
+        } else {
+            0.0
+        }
+    };
+    let (t_i, d_r, d_t) = (100e-6, 2.0 * 0.644525 / c0, (0.644525 + 0.3683) / c0);
+    let time_s: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-7).collect();
+    let noise = |k: usize| noise * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
+    let incident_strain = time_s
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| -4e-4 * pulse(t - t_i) + reflected * pulse(t - t_i - d_r) + noise(k))
+        .collect();
+    let transmission_strain = time_s
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| -1e-4 * pulse(t - t_i - d_t - late_s) + noise(k + 3))
+        .collect();
+    (
+        ReductionInput {
+            time_s,
+            incident_strain,
+            transmission_strain,
+        },
+        setup,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -569,44 +610,7 @@ mod tests {
     /// foot passes the incident gauge at 100 µs, its reflection (tensile, 60 % of it) 2 d_I/c0
     /// later, and a compressive transmitted pulse, sampled at 10 MHz with a little noise.
     fn record() -> (ReductionInput, ReductionSetup) {
-        let bar = authors_bar();
-        let setup = ReductionSetup {
-            incident_bar: bar,
-            transmission_bar: bar,
-            incident_gauge_m: 0.644525,
-            transmission_gauge_m: 0.3683,
-            transmission_absorbing: true,
-        };
-        let c0 = bar.wave_speed_m_s;
-        let pulse = |t: f64| {
-            let x = t / 120e-6;
-            if (0.0..=1.0).contains(&x) {
-                (std::f64::consts::PI * x).sin().powi(2)
-            } else {
-                0.0
-            }
-        };
-        let (t_i, d_r, d_t) = (100e-6, 2.0 * 0.644525 / c0, (0.644525 + 0.3683) / c0);
-        let time_s: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-7).collect();
-        let noise = |k: usize| 1e-7 * ((k * 7919 % 101) as f64 / 50.0 - 1.0);
-        let incident_strain = time_s
-            .iter()
-            .enumerate()
-            .map(|(k, &t)| -4e-4 * pulse(t - t_i) + 2.4e-4 * pulse(t - t_i - d_r) + noise(k))
-            .collect();
-        let transmission_strain = time_s
-            .iter()
-            .enumerate()
-            .map(|(k, &t)| -1e-4 * pulse(t - t_i - d_t) + noise(k + 3))
-            .collect();
-        (
-            ReductionInput {
-                time_s,
-                incident_strain,
-                transmission_strain,
-            },
-            setup,
-        )
+        synthetic_record(2.4e-4, 0.0, 1e-7)
     }
 
     /// No dispersion and no smoothing: the record's own samples.

@@ -512,10 +512,10 @@ pub fn assemble(channels: &[(Role, ChannelFile)]) -> Result<RawRecord> {
         for c in &of {
             alone(role, c, "clipped")?;
         }
-        if of.iter().any(|c| alone(role, c, "dead-channel").is_ok()) {
-            for c in &of {
-                alone(role, c, "dead-channel")?;
-            }
+        let dead: Vec<shpb_core::Result<()>> =
+            of.iter().map(|c| alone(role, c, "dead-channel")).collect();
+        if dead.iter().any(|d| d.is_ok()) {
+            dead.into_iter().collect::<shpb_core::Result<()>>()?;
         }
     }
     let mean = |role: Role| -> Vec<f64> {
