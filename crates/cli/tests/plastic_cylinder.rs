@@ -185,26 +185,5 @@ fn the_run_reports_what_friction_and_inertia_contribute() {
 /// curves (solid orange) and the 1-wave reduction (dashed dark red) are in both specimen panels.
 #[test]
 fn a_cylinder_run_plots_its_true_and_reduced_stress_strain_and_rate() {
-    let tmp = tempfile::tempdir().unwrap();
-    let scene = common::repo_path("scenes/shpb-cylinder-copper.toml");
-    let out = common::shpb(tmp.path(), &["run", &scene, "--plot", "cu.png"]);
-    assert!(out.status.success(), "{}", common::stderr(&out));
-    let png = std::fs::read(tmp.path().join("cu.png")).unwrap();
-    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
-    let img = image::load_from_memory(&png).unwrap().to_rgb8();
-    assert_eq!(img.dimensions(), (2400, 1300));
-    let pixels_in = |panel: u32, rgb: [u8; 3]| {
-        (800 * panel..800 * (panel + 1))
-            .flat_map(|x| (0..620).map(move |y| (x, y)))
-            .filter(|&(x, y)| img.get_pixel(x, y).0 == rgb)
-            .count()
-    };
-    for panel in [1, 2] {
-        let own = pixels_in(panel, [230, 140, 20]);
-        let reduced = pixels_in(panel, [140, 20, 20]);
-        assert!(
-            own > 300 && reduced > 300,
-            "panel {panel}: {own}, {reduced}"
-        );
-    }
+    common::assert_cylinder_figure("scenes/shpb-cylinder-copper.toml");
 }

@@ -9,34 +9,23 @@
 //! `shpb_core::reduce::separation` check the numerics on analytic overlapping pulses.
 //! One gauge cannot separate pulses that overlap at the incident gauge: refused, exit 2.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-const BIN: &str = env!("CARGO_BIN_EXE_shpb");
-
-fn root() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-}
-
-fn shpb(dir: &std::path::Path, args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("shpb runs")
-}
+use common::{repo, shpb};
+use std::path::Path;
+use std::process::Output;
 
 fn json(o: &Output) -> serde_json::Value {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     serde_json::from_slice(&o.stdout).expect("one JSON object")
 }
 
-#[test]
-fn two_gauges_give_the_specimen_stress_of_a_short_bar_test_and_one_gauge_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("validation/separation/short-bar-al.toml");
+/// `shpb run` of the repository scene `scene` into `dir/run.h5`: its true (simulated) peak
+/// stress of the cylinder, Pa.
+fn run_true_peak(dir: &Path, scene: &str) -> f64 {
+    let scene = repo().join(scene);
     let run = json(&shpb(
-        dir.path(),
+        dir,
         &[
             "run",
             scene.to_str().unwrap(),
@@ -46,9 +35,15 @@ fn two_gauges_give_the_specimen_stress_of_a_short_bar_test_and_one_gauge_is_refu
             "--json",
         ],
     ));
-    let true_peak = run["summary"]["true_peak_stress"]["value"]
+    run["summary"]["true_peak_stress"]["value"]
         .as_f64()
-        .expect("the cylinder's true peak stress");
+        .expect("the cylinder's true peak stress")
+}
+
+#[test]
+fn two_gauges_give_the_specimen_stress_of_a_short_bar_test_and_one_gauge_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let true_peak = run_true_peak(dir.path(), "validation/separation/short-bar-al.toml");
 
     let sep = json(&shpb(
         dir.path(),
@@ -120,21 +115,7 @@ fn two_gauges_give_the_specimen_stress_of_a_short_bar_test_and_one_gauge_is_refu
 #[test]
 fn one_gauge_on_long_bars_gives_the_specimen_stress() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = root().join("scenes/shpb-cylinder-al.toml");
-    let run = json(&shpb(
-        dir.path(),
-        &[
-            "run",
-            scene.to_str().unwrap(),
-            "-o",
-            "run.h5",
-            "--no-bands",
-            "--json",
-        ],
-    ));
-    let true_peak = run["summary"]["true_peak_stress"]["value"]
-        .as_f64()
-        .unwrap();
+    let true_peak = run_true_peak(dir.path(), "scenes/shpb-cylinder-al.toml");
     let one = json(&shpb(
         dir.path(),
         &[

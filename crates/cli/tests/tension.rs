@@ -188,27 +188,7 @@ fn spheres_refuse_tension() {
 /// the 1-wave reduction (dashed dark red) in both specimen panels, labelled tension positive.
 #[test]
 fn a_tension_run_plots_its_true_and_reduced_stress_strain_and_rate() {
-    let tmp = tempfile::tempdir().unwrap();
-    let scene = common::repo_path("scenes/shtb-cylinder-copper.toml");
-    let out = shpb(tmp.path(), &["run", &scene, "--plot", "t.png"]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    let png = std::fs::read(tmp.path().join("t.png")).unwrap();
-    let img = image::load_from_memory(&png).unwrap().to_rgb8();
-    assert_eq!(img.dimensions(), (2400, 1300));
-    let pixels_in = |panel: u32, rgb: [u8; 3]| {
-        (800 * panel..800 * (panel + 1))
-            .flat_map(|x| (0..620).map(move |y| (x, y)))
-            .filter(|&(x, y)| img.get_pixel(x, y).0 == rgb)
-            .count()
-    };
-    for panel in [1, 2] {
-        let own = pixels_in(panel, [230, 140, 20]);
-        let reduced = pixels_in(panel, [140, 20, 20]);
-        assert!(
-            own > 300 && reduced > 300,
-            "panel {panel}: {own}, {reduced}"
-        );
-    }
+    common::assert_cylinder_figure("scenes/shtb-cylinder-copper.toml");
 }
 
 /// With the authors' copper shaper on the flange (`bars = "authors"`) the tension bar's incident

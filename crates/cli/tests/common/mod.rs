@@ -43,3 +43,31 @@ pub fn stdout(out: &Output) -> String {
 pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
+
+/// `shpb run SCENE --plot` of the repository scene `scene` draws a cylinder test's figure
+/// (three panels of 800 × 620 pixels across above the bars' x–t diagram, 2400 × 1300 in all),
+/// a PNG with the specimen's own curves (solid orange) and the 1-wave reduction (dashed dark
+/// red) in both specimen panels (the second and third): more than 300 pixels of each.
+pub fn assert_cylinder_figure(scene: &str) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = shpb(tmp.path(), &["run", &repo_path(scene), "--plot", "c.png"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let png = std::fs::read(tmp.path().join("c.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"));
+    let img = image::load_from_memory(&png).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (2400, 1300));
+    let pixels_in = |panel: u32, rgb: [u8; 3]| {
+        (800 * panel..800 * (panel + 1))
+            .flat_map(|x| (0..620).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0 == rgb)
+            .count()
+    };
+    for panel in [1, 2] {
+        let own = pixels_in(panel, [230, 140, 20]);
+        let reduced = pixels_in(panel, [140, 20, 20]);
+        assert!(
+            own > 300 && reduced > 300,
+            "{scene}, panel {panel}: {own}, {reduced}"
+        );
+    }
+}

@@ -455,39 +455,7 @@ mod tests {
     fn balanced_record(
         late_s: f64,
     ) -> (crate::reduce::ReductionInput, crate::reduce::ReductionSetup) {
-        let bar = crate::reduce::authors_bar();
-        let setup = crate::reduce::ReductionSetup {
-            incident_bar: bar,
-            transmission_bar: bar,
-            incident_gauge_m: 0.644525,
-            transmission_gauge_m: 0.3683,
-            transmission_absorbing: true,
-        };
-        let c0 = bar.wave_speed_m_s;
-        let pulse = |t: f64| {
-            let x = t / 120e-6;
-            if (0.0..=1.0).contains(&x) {
-                (std::f64::consts::PI * x).sin().powi(2)
-            } else {
-                0.0
-            }
-        };
-        let (t_i, d_r, d_t) = (100e-6, 2.0 * 0.644525 / c0, (0.644525 + 0.3683) / c0);
-        let time_s: Vec<f64> = (0..8000).map(|k| k as f64 * 1e-7).collect();
-        let incident_strain = time_s
-            .iter()
-            .map(|&t| -4e-4 * pulse(t - t_i) + 3e-4 * pulse(t - t_i - d_r))
-            .collect();
-        let transmission_strain = time_s
-            .iter()
-            .map(|&t| -1e-4 * pulse(t - t_i - d_t - late_s))
-            .collect();
-        let input = crate::reduce::ReductionInput {
-            time_s,
-            incident_strain,
-            transmission_strain,
-        };
-        (input, setup)
+        crate::reduce::synthetic_record(3e-4, late_s, 0.0)
     }
 
     fn reduce_with(late_s: f64, alignment: crate::reduce::Alignment) -> crate::reduce::Reduction {
