@@ -59,7 +59,7 @@ pub struct Cli {
     /// No result table and no `wrote` lines (warnings and errors still go to stderr).
     #[arg(short, long, global = true)]
     pub quiet: bool,
-    /// Print the result of `run`, `reduce`, `incident`, `sweep`, `study`, `design` and `calibrate`
+    /// Print the result of `run`, `reduce`, `incident`, `sweep`, `study`, `design`, `calibrate` and `fit`
     /// as one JSON object on stdout (refused by the other commands).
     #[arg(long, global = true)]
     pub json: bool,
@@ -392,6 +392,66 @@ pub enum Command {
         #[arg(long, default_value_t = 20, allow_hyphen_values = true,
               value_parser = whole_number::<usize>("3 to 1000 runs per 1-D search"))]
         max_runs: usize,
+    },
+    /// Fit free scene keys (a specimen's constants, nuisance values) to records: least squares,
+    /// then posterior samples of an affine-invariant ensemble sampler, with a noise model
+    /// estimated from the records (docs/physics.md §11). Prints each key's best fit and 90 %
+    /// interval; writes the samples, correlations and predictive bands with -o.
+    Fit {
+        /// The scene TOML file (its own measured record, or the set-up that reduces --record).
+        scene: PathBuf,
+        /// KEY=MIN:MAX, a key `--set` reaches and its bounds (uniform prior), e.g.
+        /// specimen.yield_stress_pa=1.5e9:2.3e9, pressure=8psi:12psi, or time_shift_s=-2e-6:2e-6
+        /// (the model's time axis against the records'). Repeat for several.
+        #[arg(long = "free", required = true, allow_hyphen_values = true)]
+        free: Vec<String>,
+        /// KEY=normal:MEAN:SD, a normal prior on a --free key (SI units), on top of its bounds.
+        #[arg(long, allow_hyphen_values = true)]
+        prior: Vec<String>,
+        /// A record: a raw gauge record or run file (reduced through the scene's set-up), or a
+        /// reduced curve as CSV (time_s with force_N, displacement_m, stress_Pa and strain, or
+        /// reflected_strain and transmitted_strain). None: the scene's own (a force-driven
+        /// scene whose CSV has displacement_m). Repeat for several.
+        #[arg(long)]
+        record: Vec<PathBuf>,
+        /// What is compared: force-time, force-approach, stress-strain or strains [default:
+        /// force-approach for a force-driven or contact scene, stress-strain for a cylinder
+        /// test, force-time for spheres between bars].
+        #[arg(long)]
+        residual: Option<String>,
+        /// HDF5 output: best fit, posterior samples, correlations, effective sample sizes,
+        /// predictive bands.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// PNG of each record with the best fit and its 90 % posterior-predictive band.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// PNG of the posterior: each key's marginal and every pair's samples.
+        #[arg(long)]
+        corner: Option<PathBuf>,
+        /// Walkers of the ensemble: even, at least twice the free keys [default: max(16, 4 × keys)].
+        #[arg(long, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("an even number of walkers, at least twice the free keys"))]
+        walkers: Option<usize>,
+        /// Sampler steps (each runs every walker once).
+        #[arg(long, default_value_t = 200, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("4 sampler steps or more"))]
+        steps: usize,
+        /// Steps dropped as burn-in [default: a quarter of --steps].
+        #[arg(long, allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("fewer burn-in steps than --steps"))]
+        burn_in: Option<usize>,
+        /// Seed of the sampler.
+        #[arg(long, default_value_t = 1, allow_hyphen_values = true,
+              value_parser = whole_number::<u64>("a seed from 0 up"))]
+        seed: u64,
+        /// Worker threads [default: one per core]: 1 up to 4 per core of the machine.
+        #[arg(short = 'j', long = "jobs", allow_hyphen_values = true,
+              value_parser = whole_number::<usize>("1 up to 4 worker threads per core of the machine"))]
+        jobs: Option<usize>,
+        /// Overwrite existing output files.
+        #[arg(long)]
+        force: bool,
     },
     /// Join the HDF5 files of the shards of one sweep into one file.
     Merge {
@@ -860,7 +920,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             "command line",
             "--json",
             format!("`shpb {name}` has no JSON result"),
-            "--json with run, reduce, incident, sweep, study, design or calibrate",
+            "--json with run, reduce, incident, sweep, study, design, calibrate or fit",
         ));
     }
     match cli.command {
@@ -1005,6 +1065,44 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                 },
             )
         }
+        Command::Fit {
+            scene,
+            free,
+            prior,
+            record,
+            residual,
+            output,
+            plot,
+            corner,
+            walkers,
+            steps,
+            burn_in,
+            seed,
+            jobs,
+            force,
+        } => cmd::fit::fit(
+            &scene,
+            &cmd::fit::FitOptions {
+                free: &free,
+                prior: &prior,
+                record: &record,
+                residual: residual.as_deref(),
+                output: output.as_deref(),
+                plot: plot.as_deref(),
+                corner: corner.as_deref(),
+                force,
+                settings: shpb_study::fit::Settings {
+                    walkers: walkers.unwrap_or(0),
+                    steps,
+                    burn_in,
+                    seed,
+                    jobs: jobs.unwrap_or_else(|| {
+                        std::thread::available_parallelism().map_or(1, |n| n.get())
+                    }),
+                    ..shpb_study::fit::Settings::default()
+                },
+            },
+        ),
         Command::Merge {
             inputs,
             output,

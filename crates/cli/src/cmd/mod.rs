@@ -6,6 +6,7 @@ pub mod common;
 pub mod convergence;
 pub mod curve;
 pub mod design;
+pub mod fit;
 pub mod gun;
 pub mod incident;
 pub mod list;

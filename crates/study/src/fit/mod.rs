@@ -1,0 +1,616 @@
+//! `shpb fit` (issue 44; docs/physics.md §11): the constants a record implies, with their
+//! uncertainty. The free scene keys ([`spec::Free`]) are fitted by least squares (argmin's
+//! Nelder–Mead, [`crate::calibrate::optimise`]) to the records' series ([`observe`]); a noise
+//! model is then estimated from the best fit's residuals (each series' standard deviation and
+//! correlation length, [`noise`]), and the posterior is sampled by the affine-invariant ensemble
+//! sampler ([`mcmc`]) with the forward runs of each step in parallel. Every forward run is a whole
+//! run of the scene with the values set, without the outputs nobody reads (the bars' x–t
+//! snapshots).
+
+pub mod mcmc;
+pub mod noise;
+pub mod observe;
+pub mod spec;
+
+use crate::api::input_err;
+use observe::{Observables, Series};
+use rayon::prelude::*;
+use shpb_core::scene::{Params, SceneParams};
+use shpb_input::prelude::*;
+use shpb_input::{Error, Result};
+use shpb_output::fit::{FitParameter, FitRecord, FitReport};
+use spec::{Free, Prior, Reach, Residual};
+use std::path::{Path, PathBuf};
+
+/// A fit's question: the scene, its free keys and priors, and the series of its records.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The free keys, in order.
+    pub free: Vec<Free>,
+    /// Normal priors on some of them.
+    pub priors: Vec<Prior>,
+    /// What the residual compares.
+    pub residual: Residual,
+    /// The records' series.
+    pub series: Vec<Series>,
+    /// The scene is force-driven (its force is the drive, not a result).
+    pub force_driven: bool,
+}
+
+/// The residual a scene is fitted on unless `--residual` says: a force-driven or contact scene's
+/// force–approach, a cylinder's stress–strain, a sphere bar test's force–time.
+pub fn default_residual(params: &Params) -> Residual {
+    let cylinder = params
+        .specimen
+        .as_ref()
+        .and_then(shpb_core::specimen::Specimen::cylinder)
+        .is_some();
+    match &params.params {
+        SceneParams::Pulse { .. } if cylinder => Residual::StressStrain,
+        SceneParams::Pulse { .. } => Residual::ForceTime,
+        _ => Residual::ForceApproach,
+    }
+}
+
+/// The scene's own record: a force-driven scene whose CSV carries the measured approach.
+fn scene_record(params: &Params) -> Option<Observables> {
+    match &params.params {
+        SceneParams::ForceDriven {
+            setup,
+            measured_displacement_m: Some(d),
+        } => Some(Observables {
+            time_s: setup.drive.time_s.clone(),
+            force_n: Some(setup.drive.force_n.clone()),
+            approach_m: Some(d.clone()),
+            force_is_drive: true,
+            ..Observables::default()
+        }),
+        _ => None,
+    }
+}
+
+/// The set-up file or name a bar scene's `bars` key gives, resolved against the scene's folder.
+fn scene_bars(scene: &Path) -> Result<PathBuf> {
+    let text = shpb_input::csv::read_text(scene)?;
+    let table: toml::Table = text.parse().map_err(|e| {
+        input_err(
+            "SCENE",
+            format!("{}: {e}", scene.display()),
+            "a scene .toml",
+        )
+    })?;
+    let Some(bars) = table.get("bars").and_then(toml::Value::as_str) else {
+        return Err(input_err(
+            "--record",
+            format!(
+                "{} names no `bars`: a gauge record needs the scene's set-up to be reduced",
+                scene.display()
+            ),
+            "a bar-test scene (kind = \"shpb\" with bars = …), or a reduced curve as CSV",
+        ));
+    };
+    let file = scene.parent().unwrap_or(Path::new(".")).join(bars);
+    Ok(if file.is_file() {
+        file
+    } else {
+        PathBuf::from(bars)
+    })
+}
+
+/// Reads one `--record`: a CSV with `time_s` and reduced quantities (a reduced curve), else a raw
+/// gauge record or run file reduced through the scene's set-up (`shpb reduce`'s defaults, the
+/// scene's cylinder as specimen).
+pub fn read_record(scene: &Path, params: &Params, record: &Path) -> Result<Observables> {
+    let is_csv = record
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if is_csv {
+        let table = shpb_input::csv::CsvTable::read(record)?;
+        let o = Observables::of_csv(&table);
+        let any = o.force_n.is_some()
+            || o.approach_m.is_some()
+            || o.stress_pa.is_some()
+            || o.reflected_strain.is_some();
+        if !o.time_s.is_empty() && any {
+            return Ok(o);
+        }
+    }
+    let cylinder = params
+        .specimen
+        .as_ref()
+        .and_then(shpb_core::specimen::Specimen::cylinder)
+        .map(|c| shpb_core::reduce_cylinder::CylinderGeometry {
+            length_m: c.length_m,
+            diameter_m: c.diameter_m,
+        });
+    let bars = scene_bars(scene)?;
+    let reduced = crate::api::reduce_record_with(
+        record,
+        Some(&bars),
+        &crate::api::RecordOptions {
+            cylinder,
+            ..crate::api::RecordOptions::default()
+        },
+    )?;
+    Ok(Observables::of_reduced(&reduced))
+}
+
+impl Problem {
+    /// Builds the question: reads the scene, checks that every free key reaches it at both
+    /// bounds, reads the records (none: the scene's own) into the series of `residual` (None: the
+    /// scene's [`default_residual`]).
+    pub fn new(
+        scene: &Path,
+        free: Vec<Free>,
+        priors: Vec<Prior>,
+        residual: Option<Residual>,
+        records: &[PathBuf],
+    ) -> Result<Problem> {
+        crate::sweep::require_scene(scene)?;
+        if free.is_empty() {
+            return Err(input_err(
+                "--free",
+                "no free key",
+                "one --free KEY=MIN:MAX or more",
+            ));
+        }
+        for (i, f) in free.iter().enumerate() {
+            if free[..i].iter().any(|g| g.key == f.key) {
+                return Err(input_err(
+                    "--free",
+                    format!("`{}` is given twice", f.key),
+                    "each key once",
+                ));
+            }
+        }
+        let params = Params::from_file(scene)?;
+        // Each bound is a valid scene (the scene's own checks name the key and its range).
+        for f in &free {
+            for x in [f.min, f.max] {
+                if let Some(o) = f.value(x) {
+                    Params::from_file_overridden(scene, &[o]).map_err(|e| {
+                        input_err(
+                            &format!("--free {}", f.key),
+                            format!("{} {}: {e}", x, f.unit),
+                            "bounds the scene accepts for that key",
+                        )
+                    })?;
+                }
+            }
+        }
+        let residual = residual.unwrap_or_else(|| default_residual(&params));
+        let force_driven = matches!(params.params, SceneParams::ForceDriven { .. });
+        let mut series = Vec::new();
+        if records.is_empty() {
+            let own = scene_record(&params).ok_or_else(|| {
+                input_err(
+                    "--record",
+                    format!("{} carries no record of its own", scene.display()),
+                    "one --record FILE or more (a raw gauge record, a run file, a reduced curve as CSV), or a force-driven scene whose CSV has displacement_m",
+                )
+            })?;
+            series.extend(observe::series_of("scene", &own, residual, force_driven)?);
+        }
+        for r in records {
+            let o = read_record(scene, &params, r)?;
+            let name = r.display().to_string();
+            series.extend(observe::series_of(&name, &o, residual, force_driven)?);
+        }
+        Ok(Problem {
+            scene: scene.to_path_buf(),
+            free,
+            priors,
+            residual,
+            series,
+            force_driven,
+        })
+    }
+
+    /// The model's values on every series at `theta` (None when the scene refuses the values or
+    /// the run fails: outside the posterior's support).
+    pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let overrides: Vec<_> = self
+            .free
+            .iter()
+            .zip(theta)
+            .filter_map(|(f, &x)| f.value(x))
+            .collect();
+        let shift = self
+            .free
+            .iter()
+            .zip(theta)
+            .find(|(f, _)| f.reach == Reach::TimeShift)
+            .map_or(0.0, |(_, &x)| x);
+        let mut params = Params::from_file_overridden(&self.scene, &overrides).ok()?;
+        // The runs of a fit skip what nobody reads: the bars' x–t snapshots.
+        if let SceneParams::Pulse { options, .. } = &mut params.params {
+            options.snapshot_interval_s = None;
+        }
+        let out = params.run().ok()?;
+        let m = Observables::of_run(&out, self.force_driven);
+        self.series.iter().map(|s| s.model(&m, shift)).collect()
+    }
+
+    /// Whether `theta` lies inside every bound.
+    pub fn inside(&self, theta: &[f64]) -> bool {
+        self.free
+            .iter()
+            .zip(theta)
+            .all(|(f, &x)| x >= f.min && x <= f.max)
+    }
+
+    /// ln of the priors at `theta` (uniform within the bounds, times the normal priors; −∞
+    /// outside), up to a constant.
+    pub fn log_prior(&self, theta: &[f64]) -> f64 {
+        if !self.inside(theta) {
+            return f64::NEG_INFINITY;
+        }
+        self.priors
+            .iter()
+            .map(|p| {
+                let i = self
+                    .free
+                    .iter()
+                    .position(|f| f.key == p.key)
+                    .expect("a prior names a free key");
+                -0.5 * ((theta[i] - p.mean) / p.sd).powi(2)
+            })
+            .sum()
+    }
+}
+
+/// The sampler's and the fit's settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Walkers of the ensemble (even, at least twice the free keys; 0: the default
+    /// max(16, 4 × keys)).
+    pub walkers: usize,
+    /// Sampler steps.
+    pub steps: usize,
+    /// Steps dropped as burn-in (None: a quarter of the steps).
+    pub burn_in: Option<usize>,
+    /// Seed of the sampler and of the predictive band's noise draws.
+    pub seed: u64,
+    /// Worker threads.
+    pub jobs: usize,
+    /// Posterior samples run again for the posterior-predictive band.
+    pub predictive_draws: usize,
+    /// Most forward runs of the least-squares search.
+    pub max_least_squares_runs: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Settings {
+        Settings {
+            walkers: 0,
+            steps: 200,
+            burn_in: None,
+            seed: 1,
+            jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            predictive_draws: 48,
+            max_least_squares_runs: 0,
+        }
+    }
+}
+
+/// Where a fit is, for a progress line: stage name, done, total.
+pub type Progress<'a> = &'a mut dyn FnMut(&str, usize, usize);
+
+/// The model values at many points, in parallel on `pool`.
+fn models(
+    problem: &Problem,
+    pool: &rayon::ThreadPool,
+    points: &[Vec<f64>],
+) -> Vec<Option<Vec<Vec<f64>>>> {
+    pool.install(|| points.par_iter().map(|p| problem.model(p)).collect())
+}
+
+/// The least-squares cost of model values `m` against the series, each series weighted by
+/// 1/(its scale² × its points) so that series of different units and lengths weigh alike.
+fn cost(problem: &Problem, scales: &[f64], m: &Option<Vec<Vec<f64>>>) -> f64 {
+    let Some(m) = m else { return f64::INFINITY };
+    problem
+        .series
+        .iter()
+        .zip(m)
+        .zip(scales)
+        .map(|((s, v), sc)| {
+            s.y.iter()
+                .zip(v)
+                .map(|(y, v)| ((y - v) / sc).powi(2))
+                .sum::<f64>()
+                / s.y.len() as f64
+        })
+        .sum()
+}
+
+/// Runs the whole fit: least squares, noise model, posterior samples, posterior-predictive
+/// bands. `keep_going` is asked between steps (Ctrl-C): once false the sampler stops and the
+/// report holds the steps done (with a warning).
+pub fn fit(
+    problem: &Problem,
+    settings: &Settings,
+    command_line: &str,
+    progress: Progress,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<FitReport> {
+    let d = problem.free.len();
+    let pool = crate::sweep::thread_pool(settings.jobs)?;
+    let walkers = match settings.walkers {
+        0 => (4 * d).max(16),
+        w => w,
+    };
+    if walkers % 2 != 0 || walkers < 2 * d {
+        return Err(input_err(
+            "--walkers",
+            format!("{walkers} walkers for {d} free keys"),
+            format!("an even number, at least {}", 2 * d),
+        ));
+    }
+    if settings.steps < 4 {
+        return Err(input_err(
+            "--steps",
+            format!("{}", settings.steps),
+            "at least 4 sampler steps",
+        ));
+    }
+    let burn = settings.burn_in.unwrap_or(settings.steps / 4);
+    if burn >= settings.steps {
+        return Err(input_err(
+            "--burn-in",
+            format!("{burn} of {} steps", settings.steps),
+            "fewer steps than --steps",
+        ));
+    }
+    let scales: Vec<f64> = problem
+        .series
+        .iter()
+        .map(|s| {
+            let rms = (s.y.iter().map(|v| v * v).sum::<f64>() / s.y.len() as f64).sqrt();
+            if rms > 0.0 { rms } else { 1.0 }
+        })
+        .collect();
+    let mut runs = 0usize;
+
+    // 1. Least squares on the unit cube of the bounds: the best of a start design (the centre
+    // and 4d points of a seeded Latin hypercube), then Nelder–Mead from it.
+    let to_x = |u: &[f64]| -> Vec<f64> {
+        problem
+            .free
+            .iter()
+            .zip(u)
+            .map(|(f, &u)| f.min + u.clamp(0.0, 1.0) * (f.max - f.min))
+            .collect()
+    };
+    let mut starts = vec![vec![0.5; d]];
+    let lhs = crate::uq::latin_hypercube(4 * d, d, &mut crate::uq::Rng::new(settings.seed));
+    starts.extend(lhs);
+    let start_x: Vec<Vec<f64>> = starts.iter().map(|u| to_x(u)).collect();
+    progress("least squares", 0, starts.len());
+    let start_costs: Vec<f64> = models(problem, &pool, &start_x)
+        .iter()
+        .map(|m| cost(problem, &scales, m))
+        .collect();
+    runs += starts.len();
+    let (i0, c0) =
+        start_costs.iter().enumerate().fold(
+            (0, f64::INFINITY),
+            |b, (i, &c)| if c < b.1 { (i, c) } else { b },
+        );
+    if !c0.is_finite() {
+        return Err(Error::Input {
+            file: problem.scene.display().to_string(),
+            key: "--free".into(),
+            problem: "no run of the start design succeeded".into(),
+            allowed: "bounds within which the scene runs".into(),
+        });
+    }
+    let budget = match settings.max_least_squares_runs {
+        0 => 60 * d + 40,
+        n => n,
+    };
+    let mut evals = 0usize;
+    let mut objective = |u: &[f64]| {
+        evals += 1;
+        progress("least squares", evals, budget);
+        let outside: f64 = u.iter().map(|v| (v.clamp(0.0, 1.0) - v).abs()).sum();
+        let m = problem.model(&to_x(u));
+        cost(problem, &scales, &m) + 1e3 * outside
+    };
+    let (u_best, best_cost, used) = crate::calibrate::optimise::nelder_mead(
+        &mut objective,
+        &starts[i0],
+        &vec![0.1; d],
+        budget,
+        1e-10 * c0.max(1e-300),
+    );
+    runs += used;
+    let best = to_x(&u_best);
+    let best_model = problem.model(&best).ok_or_else(|| Error::Input {
+        file: problem.scene.display().to_string(),
+        key: "--free".into(),
+        problem: "the best fit's run failed".into(),
+        allowed: "bounds within which the scene runs".into(),
+    })?;
+    runs += 1;
+
+    // 2. The noise model of each series from the best fit's residuals.
+    let noise: Vec<noise::Noise> = problem
+        .series
+        .iter()
+        .zip(&best_model)
+        .map(|(s, m)| {
+            let r: Vec<f64> = s.y.iter().zip(m).map(|(y, m)| y - m).collect();
+            noise::Noise::of_residuals(&r, d, problem.series.len())
+        })
+        .collect();
+    let log_prob = |theta: &[f64], m: &Option<Vec<Vec<f64>>>| -> f64 {
+        let lp = problem.log_prior(theta);
+        if !lp.is_finite() {
+            return f64::NEG_INFINITY;
+        }
+        let Some(m) = m else { return f64::NEG_INFINITY };
+        lp + problem
+            .series
+            .iter()
+            .zip(m)
+            .zip(&noise)
+            .map(|((s, v), n)| n.log_likelihood(&s.y, v))
+            .sum::<f64>()
+    };
+
+    // 3. The posterior: an ensemble in a small ball around the best fit.
+    let scale: Vec<f64> = problem
+        .free
+        .iter()
+        .map(|f| 1e-3 * (f.max - f.min))
+        .collect();
+    let start = mcmc::initial_ball(&best, &scale, walkers, settings.seed, &|x| {
+        problem.inside(x)
+    });
+    let sampler = mcmc::Settings {
+        walkers,
+        steps: settings.steps,
+        stretch_a: 2.0,
+        seed: settings.seed,
+    };
+    let evaluated = std::sync::atomic::AtomicUsize::new(0);
+    let batch = |points: &[Vec<f64>]| -> Vec<f64> {
+        evaluated.fetch_add(points.len(), std::sync::atomic::Ordering::Relaxed);
+        let ms = models(problem, &pool, points);
+        points
+            .iter()
+            .zip(&ms)
+            .map(|(p, m)| log_prob(p, m))
+            .collect()
+    };
+    let mut stopped = false;
+    let chain = mcmc::sample(&sampler, &start, None, &batch, &mut |c| {
+        progress("posterior", c.steps_done, settings.steps);
+        let go = keep_going();
+        stopped = !go;
+        go
+    });
+    runs += evaluated.into_inner();
+    let steps_done = chain.steps_done;
+    let burn = burn.min(steps_done.saturating_sub(1));
+    let samples = chain.flat_after(burn);
+    let tau = mcmc::integrated_autocorr_time(&chain, burn);
+    let ess = mcmc::effective_sample_size(&chain, burn);
+    let correlations = mcmc::correlations(&samples);
+    let mut warnings = Vec::new();
+    if stopped {
+        warnings.push(format!(
+            "interrupted after {steps_done} of {} sampler steps: the posterior is from those",
+            settings.steps
+        ));
+    }
+    let kept = steps_done - burn;
+    if let Some(t) = tau
+        .iter()
+        .cloned()
+        .filter(|t| t.is_finite())
+        .reduce(f64::max)
+        && (kept as f64) < 10.0 * t
+    {
+        warnings.push(format!(
+            "the chain kept {kept} steps after burn-in, fewer than 10 autocorrelation times ({t:.1} steps): run more --steps for trustworthy intervals"
+        ));
+    }
+
+    // 4. The posterior-predictive band: runs at draws of the posterior, plus the noise model.
+    let draws: Vec<Vec<f64>> = if samples.is_empty() {
+        Vec::new()
+    } else {
+        let k = settings.predictive_draws.min(samples.len()).max(1);
+        (0..k)
+            .map(|i| samples[i * samples.len() / k].clone())
+            .collect()
+    };
+    progress("predictive band", 0, draws.len());
+    let predicted: Vec<Vec<Vec<f64>>> = models(problem, &pool, &draws)
+        .into_iter()
+        .flatten()
+        .collect();
+    runs += draws.len();
+    let records = problem
+        .series
+        .iter()
+        .enumerate()
+        .map(|(j, s)| {
+            let (xl, xu, yl, yu) = s.quantity.labels();
+            let (low, high) = noise[j].predictive_band(
+                predicted.iter().map(|m| m[j].as_slice()),
+                s.y.len(),
+                settings.seed.wrapping_add(j as u64),
+            );
+            let inside = if low.is_empty() {
+                f64::NAN
+            } else {
+                s.y.iter()
+                    .zip(low.iter().zip(&high))
+                    .filter(|(y, (l, h))| *y >= *l && *y <= *h)
+                    .count() as f64
+                    / s.y.len() as f64
+            };
+            FitRecord {
+                name: s.record.clone(),
+                x_label: xl.into(),
+                x_unit: xu.into(),
+                y_label: yl.into(),
+                y_unit: yu.into(),
+                x: s.x.clone(),
+                y: s.y.clone(),
+                best: best_model[j].clone(),
+                band_low: low,
+                band_high: high,
+                noise_sd: noise[j].sd,
+                noise_correlation: noise[j].correlation_points,
+                inside_band: inside,
+            }
+        })
+        .collect();
+    let parameters = problem
+        .free
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let values: Vec<f64> = samples.iter().map(|s| s[i]).collect();
+            FitParameter {
+                key: f.key.clone(),
+                unit: f.unit.to_string(),
+                min: f.min,
+                max: f.max,
+                prior_normal: problem
+                    .priors
+                    .iter()
+                    .find(|p| p.key == f.key)
+                    .map(|p| (p.mean, p.sd)),
+                best: best[i],
+                median: mcmc::quantile(&values, 0.5),
+                band_90: mcmc::band_90(&values),
+                tau_steps: tau[i],
+                ess: ess[i],
+            }
+        })
+        .collect();
+    Ok(FitReport {
+        scene: problem.scene.display().to_string(),
+        residual: problem.residual.name().to_string(),
+        command_line: command_line.to_string(),
+        parameters,
+        walkers,
+        steps: steps_done,
+        burn_in: burn,
+        chain: chain.positions.clone(),
+        log_prob: chain.log_prob.clone(),
+        correlations,
+        acceptance: chain.acceptance_fraction(),
+        evaluations: runs,
+        best_cost,
+        records,
+        warnings,
+    })
+}

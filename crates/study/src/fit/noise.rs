@@ -1,0 +1,152 @@
+//! The noise model of a fit (docs/physics.md §11.3), estimated from the records: each series'
+//! residual at the least-squares best fit gives the standard deviation of one point and the
+//! noise's correlation length (its integrated autocorrelation time in points, Sokal's automatic
+//! window), so that N correlated points weigh as N/τ independent ones in the Gaussian likelihood.
+//! What the model cannot reproduce (its own error) is counted as noise: the intervals include it.
+
+use crate::uq::{Rng, normal_quantile, percentile};
+
+/// The noise of one series.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Noise {
+    /// Standard deviation of one point, in the series' units.
+    pub sd: f64,
+    /// Integrated autocorrelation time of the residual, points (1 for white noise).
+    pub correlation_points: f64,
+}
+
+/// Integrated autocorrelation time of a series, in samples: τ = 1 + 2 Σ_{k=1}^{M} ρ(k), the
+/// window M the first with M ≥ c τ(M), c = 5 (Sokal 1997, "Monte Carlo methods in statistical
+/// mechanics", §3); at least 1.
+pub fn autocorrelation_time(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n < 4 {
+        return 1.0;
+    }
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let c0: f64 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+    if c0 <= 0.0 {
+        return 1.0;
+    }
+    let mut tau = 1.0;
+    for k in 1..n / 2 {
+        let ck: f64 = x[..n - k]
+            .iter()
+            .zip(&x[k..])
+            .map(|(a, b)| (a - mean) * (b - mean))
+            .sum::<f64>()
+            / n as f64;
+        tau += 2.0 * ck / c0;
+        if k as f64 >= 5.0 * tau {
+            break;
+        }
+    }
+    tau.max(1.0)
+}
+
+impl Noise {
+    /// The noise of residuals `r` (record − best model) of one of `series` series of a fit with
+    /// `free` free values: SD with the free values' degrees of freedom shared among the series,
+    /// √(Σ r² / (N − free/series)), and the residuals' correlation time.
+    pub fn of_residuals(r: &[f64], free: usize, series: usize) -> Noise {
+        let n = r.len() as f64;
+        let dof = (n - free as f64 / series.max(1) as f64).max(1.0);
+        let sd = (r.iter().map(|v| v * v).sum::<f64>() / dof).sqrt();
+        Noise {
+            sd: if sd > 0.0 { sd } else { f64::MIN_POSITIVE },
+            correlation_points: autocorrelation_time(r),
+        }
+    }
+
+    /// ln L of record `y` given model `m` under this noise, up to a constant:
+    /// −Σ (y − m)² / (2 σ² τ).
+    pub fn log_likelihood(&self, y: &[f64], m: &[f64]) -> f64 {
+        let ss: f64 = y.iter().zip(m).map(|(y, m)| (y - m).powi(2)).sum();
+        -ss / (2.0 * self.sd * self.sd * self.correlation_points)
+    }
+
+    /// The 90 % posterior-predictive band (5 % and 95 % quantiles, point by point) of `models`
+    /// (the model at posterior draws) plus this noise: 16 normal noise draws per model, seeded.
+    /// Empty when no model is given.
+    pub fn predictive_band<'a>(
+        &self,
+        models: impl Iterator<Item = &'a [f64]>,
+        points: usize,
+        seed: u64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        const PER_MODEL: usize = 16;
+        let models: Vec<&[f64]> = models.collect();
+        if models.is_empty() {
+            return (Vec::new(), Vec::new());
+        }
+        let mut rng = Rng::new(seed);
+        let mut low = Vec::with_capacity(points);
+        let mut high = Vec::with_capacity(points);
+        let mut values = Vec::with_capacity(models.len() * PER_MODEL);
+        for i in 0..points {
+            values.clear();
+            for m in &models {
+                for _ in 0..PER_MODEL {
+                    values.push(m[i] + self.sd * normal_quantile(rng.uniform()));
+                }
+            }
+            values.sort_by(f64::total_cmp);
+            low.push(percentile(&values, 0.05));
+            high.push(percentile(&values, 0.95));
+        }
+        (low, high)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_ar1_series_has_its_known_correlation_time() {
+        // x_{t+1} = φ x_t + e: τ = (1 + φ)/(1 − φ) = 9 for φ = 0.8.
+        let mut rng = Rng::new(7);
+        let mut x = vec![0.0; 200_000];
+        for t in 1..x.len() {
+            x[t] = 0.8 * x[t - 1] + normal_quantile(rng.uniform());
+        }
+        let tau = autocorrelation_time(&x);
+        assert!((tau - 9.0).abs() < 0.1 * 9.0, "{tau}");
+        let white: Vec<f64> = (0..100_000)
+            .map(|_| normal_quantile(rng.uniform()))
+            .collect();
+        assert!((autocorrelation_time(&white) - 1.0).abs() < 0.1);
+    }
+
+    #[test]
+    fn the_band_of_one_exact_model_is_its_noise_band() {
+        // 40 draws of a model 0 everywhere, noise SD 2: 640 values a point, whose 5 % quantile
+        // has a standard error of √(0.05 × 0.95 / 640) / φ(1.645) = 0.084 SD; the mean over 2000
+        // points is within 0.01 SD of ±1.645 × 2 = ±3.29.
+        let n = Noise {
+            sd: 2.0,
+            correlation_points: 1.0,
+        };
+        let m = vec![0.0; 2000];
+        let (lo, hi) = n.predictive_band((0..40).map(|_| m.as_slice()), 2000, 3);
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        assert!((mean(&hi) - 3.29).abs() < 0.03, "{}", mean(&hi));
+        assert!((mean(&lo) + 3.29).abs() < 0.03, "{}", mean(&lo));
+    }
+
+    #[test]
+    fn correlated_points_weigh_as_fewer_independent_ones() {
+        let a = Noise {
+            sd: 1.0,
+            correlation_points: 1.0,
+        };
+        let b = Noise {
+            sd: 1.0,
+            correlation_points: 4.0,
+        };
+        let y = [1.0, 2.0];
+        let m = [0.0, 0.0];
+        assert_eq!(a.log_likelihood(&y, &m), -2.5);
+        assert_eq!(b.log_likelihood(&y, &m), -2.5 / 4.0);
+    }
+}
