@@ -183,18 +183,30 @@ fn parse(text: &str, file: &str) -> Result<(Material, Option<toml::Value>)> {
         density_kg_m3: v.positive("density_kg_m3", raw.density_kg_m3, 1e5, "kg/m³")?,
         youngs_modulus_pa: v.positive("youngs_modulus_pa", raw.youngs_modulus_pa, 1e13, "Pa")?,
         poisson_ratio: v.in_range("poisson_ratio", raw.poisson_ratio, -0.99, 0.4999, "")?,
-        yield_stress_pa: v.positive("yield_stress_pa", raw.yield_stress_pa, 1e20, "Pa")?,
+        yield_stress_pa: sphere_flow_constant(&v, "yield_stress_pa", raw.yield_stress_pa)?,
         rate: JohnsonCook {
-            c: v.in_range("jc_c", raw.jc_c, 0.0, 1.0, "")?,
-            reference_rate_per_s: v.positive(
+            c: sphere_flow_constant(&v, "jc_c", raw.jc_c)?,
+            reference_rate_per_s: sphere_flow_constant(
+                &v,
                 "jc_reference_rate_per_s",
                 raw.jc_reference_rate_per_s,
-                1e9,
-                "1/s",
             )?,
         },
     };
     Ok((m, raw.johnson_cook))
+}
+
+/// Checks one of a sphere's flow constants (`yield_stress_pa`, `jc_c`, `jc_reference_rate_per_s`:
+/// σy, C and ε̇0 of paper Eq. 2) against its range,
+/// reported for `key` of `v`: σy > 0 (at most 1e20 Pa), 0 ≤ C ≤ 1, 0 < ε̇0 ≤ 1e9 1/s. The one
+/// check of these keys, in a material file and in a scene's `[specimen]` table.
+pub(crate) fn sphere_flow_constant(v: &Validator, key: &str, value: f64) -> Result<f64> {
+    match key {
+        "yield_stress_pa" => v.positive(key, value, 1e20, "Pa"),
+        "jc_c" => v.in_range(key, value, 0.0, 1.0, ""),
+        "jc_reference_rate_per_s" => v.positive(key, value, 1e9, "1/s"),
+        other => unreachable!("`{other}` is not a sphere flow constant"),
+    }
 }
 
 /// A material reference (as [`MaterialFile::resolve`] reads it) with its `[johnson_cook]` table,

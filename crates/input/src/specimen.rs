@@ -86,6 +86,15 @@ pub struct SpecimenSpec {
     pub friction_model: Option<String>,
     /// Compressive true strain a flowing cylinder's grid is built to carry (0 to 2).
     pub design_true_strain: Option<f64>,
+    /// Spheres: quasi-static yield stress σy of every sphere, Pa (paper Eq. 2), replacing the
+    /// material file's (the paper's pairs are of one material).
+    pub yield_stress_pa: Option<f64>,
+    /// Spheres: Johnson–Cook rate constant C of every sphere (paper Eq. 2), replacing the
+    /// material file's.
+    pub jc_c: Option<f64>,
+    /// Spheres: Johnson–Cook reference rate ε̇0 of every sphere, 1/s (paper Eq. 2), replacing the
+    /// material file's.
+    pub jc_reference_rate_per_s: Option<f64>,
 }
 
 /// A tabulated flow curve (`[specimen.flow_curve]`): true stress at equivalent plastic strains.
@@ -195,6 +204,58 @@ pub fn resolve_pair(
 }
 
 impl SpecimenSpec {
+    /// Replaces the material constants of every sphere in `spheres` by the ones this table gives
+    /// (`yield_stress_pa`, `jc_c`, `jc_reference_rate_per_s`: σy, C and ε̇0 of paper Eq. 2), each
+    /// checked as a material file's: the paper's pairs are of one material, so one value holds
+    /// for all.
+    fn apply_sphere_flow_keys<'a>(
+        &self,
+        spheres: impl IntoIterator<Item = &'a mut Sphere>,
+        v: &Validator,
+    ) -> Result<()> {
+        let check = |key: &str, value: Option<f64>| {
+            value
+                .map(|x| crate::material::sphere_flow_constant(v, key, x))
+                .transpose()
+        };
+        let yield_stress = check("yield_stress_pa", self.yield_stress_pa)?;
+        let c = check("jc_c", self.jc_c)?;
+        let reference_rate = check("jc_reference_rate_per_s", self.jc_reference_rate_per_s)?;
+        for sphere in spheres {
+            let m = &mut sphere.material;
+            m.yield_stress_pa = yield_stress.unwrap_or(m.yield_stress_pa);
+            m.rate.c = c.unwrap_or(m.rate.c);
+            m.rate.reference_rate_per_s = reference_rate.unwrap_or(m.rate.reference_rate_per_s);
+        }
+        Ok(())
+    }
+
+    /// Refuses a sphere's flow constants for a cylinder, naming the cylinder's own key.
+    pub(crate) fn refuse_sphere_flow_keys(&self, v: &Validator) -> Result<()> {
+        for (key, given, instead) in [
+            ("yield_stress_pa", self.yield_stress_pa.is_some(), "a_pa"),
+            ("jc_c", self.jc_c.is_some(), "c"),
+            (
+                "jc_reference_rate_per_s",
+                self.jc_reference_rate_per_s.is_some(),
+                "reference_rate_per_s",
+            ),
+        ] {
+            if given {
+                return Err(v.error(
+                    key,
+                    format!(
+                        "`{key}` is a sphere's material constant (paper Eq. 2); a cylinder flows by its Johnson–Cook constants"
+                    ),
+                    format!(
+                        "specimen.johnson_cook.{instead} (a cylinder's [specimen.johnson_cook] table, merged over the material's)"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// How the spheres sit between the bars (`gap_m` or `preload_n`, `shpb` scenes;
     /// docs/physics.md §6.11): touching without either (or with a zero one).
     pub fn build_seating(&self, v: &Validator) -> Result<Seating> {
@@ -368,9 +429,9 @@ impl SpecimenSpec {
                     mass_kg: None,
                 }
                 .build(base_dir, v)?;
-                Ok(SphereChain {
-                    spheres: vec![sphere; n as usize],
-                })
+                let mut spheres = vec![sphere; n as usize];
+                self.apply_sphere_flow_keys(&mut spheres, v)?;
+                Ok(SphereChain { spheres })
             }
             (None, Some(list)) => {
                 if let Some(key) = [
@@ -393,11 +454,12 @@ impl SpecimenSpec {
                         format!("2 to {MAX_CHAIN_SPHERES} [[specimen.sphere]] tables"),
                     ));
                 }
-                let spheres = list
+                let mut spheres = list
                     .iter()
                     .enumerate()
                     .map(|(k, s)| s.build(base_dir, &v.table(&format!("sphere[{}]", k + 1))))
                     .collect::<Result<Vec<_>>>()?;
+                self.apply_sphere_flow_keys(&mut spheres, v)?;
                 Ok(SphereChain { spheres })
             }
             (None, None) => Err(v.error(
@@ -419,20 +481,219 @@ impl SpecimenSpec {
                 "pair = \"ss440c\" (or a pair .toml), or [specimen.sphere1] and [specimen.sphere2] tables",
             ));
         }
-        match (&self.pair, &self.sphere1, &self.sphere2) {
-            (Some(p), None, None) => resolve_pair(p, base_dir, v, "pair"),
-            (None, Some(a), Some(b)) => Ok(SpherePair {
+        let mut pair = match (&self.pair, &self.sphere1, &self.sphere2) {
+            (Some(p), None, None) => resolve_pair(p, base_dir, v, "pair")?,
+            (None, Some(a), Some(b)) => SpherePair {
                 sphere1: a.build(base_dir, &v.table("sphere1"))?,
                 sphere2: b.build(base_dir, &v.table("sphere2"))?,
-            }),
-            _ => Err(v.error(
+            },
+            _ => {
+                return Err(v.error(
                 "pair",
                 "give either `pair` or both `sphere1` and `sphere2`",
                 format!(
                     "pair = \"{}\" (or a pair .toml), or [specimen.sphere1] and [specimen.sphere2] tables",
                     crate::material::builtin_names()
                 ),
-            )),
+                ));
+            }
+        };
+        self.apply_sphere_flow_keys([&mut pair.sphere1, &mut pair.sphere2], v)?;
+        Ok(pair)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SceneFile;
+    use shpb_core::scene::Params;
+    use std::path::PathBuf;
+
+    /// The `[specimen]` table `text` built as a scene's pair (`chain` false) or chain.
+    fn spheres(text: &str, chain: bool) -> Result<Vec<Sphere>> {
+        let spec: SpecimenSpec = toml::from_str(text).expect("a [specimen] table");
+        let v = Validator::new("scene.toml").table("specimen");
+        if chain {
+            spec.build_chain(Path::new("."), &v).map(|c| c.spheres)
+        } else {
+            spec.build(Path::new("."), &v)
+                .map(|p| vec![p.sphere1, p.sphere2])
         }
+    }
+
+    fn builtin(name: &str) -> Material {
+        Material::builtin(name).expect("a built-in material")
+    }
+
+    /// `m` with σy, C and ε̇0 replaced: what the scene keys make of a material.
+    fn with_flow(m: Material, yield_stress_pa: f64, c: f64, rate: f64) -> Material {
+        Material {
+            yield_stress_pa,
+            rate: shpb_core::material::JohnsonCook {
+                c,
+                reference_rate_per_s: rate,
+            },
+            ..m
+        }
+    }
+
+    const KEYS: &str = "yield_stress_pa = 1700e6\njc_c = 0.05\njc_reference_rate_per_s = 1.0\n";
+
+    #[test]
+    fn flow_keys_replace_every_spheres_constants_and_nothing_else() {
+        let ss440c = with_flow(builtin("ss440c"), 1700e6, 0.05, 1.0);
+        // pair = name, and a chain of `count` spheres.
+        for (text, chain, n) in [
+            (format!("pair = \"ss440c\"\n{KEYS}"), false, 2),
+            (format!("pair = \"ss440c\"\n{KEYS}"), true, 2),
+            (
+                format!("count = 5\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n{KEYS}"),
+                true,
+                5,
+            ),
+        ] {
+            let got = spheres(&text, chain).unwrap();
+            assert_eq!(got.len(), n, "{text}");
+            for s in &got {
+                assert_eq!(s.material, ss440c, "{text}");
+                assert_eq!(s.radius_m, 6.35e-3 / 2.0);
+            }
+        }
+        // sphere1/sphere2 and [[specimen.sphere]] tables of two materials: both take the keys,
+        // each keeps its own elastic constants and density.
+        let two = "[sphere1]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n\
+                   [sphere2]\nmaterial = \"al2017\"\ndiameter_m = 10e-3\n";
+        let list = "[[sphere]]\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n\
+                    [[sphere]]\nmaterial = \"al2017\"\ndiameter_m = 10e-3\n";
+        for (text, chain) in [(two, false), (two, true), (list, true)] {
+            let got = spheres(&format!("{KEYS}{text}"), chain).unwrap();
+            assert_eq!(got[0].material, ss440c);
+            assert_eq!(
+                got[1].material,
+                with_flow(builtin("al2017"), 1700e6, 0.05, 1.0)
+            );
+        }
+        // One key alone changes only its constant.
+        let got = spheres("pair = \"ss440c\"\njc_c = 0.0\n", false).unwrap();
+        let own = builtin("ss440c");
+        assert_eq!(
+            got[1].material,
+            with_flow(own.clone(), own.yield_stress_pa, 0.0, 1e-3)
+        );
+        // Without the keys: the material's own constants.
+        let got = spheres("pair = \"ss440c\"\n", false).unwrap();
+        assert_eq!(got[0].material, own);
+    }
+
+    #[test]
+    fn flow_keys_are_checked_as_the_material_files_are() {
+        // The same value refused in a material file and in a scene's [specimen] table: the same
+        // problem and allowed range, under the key where each stands.
+        let material = include_str!("../../../specimens/ss440c.toml");
+        for (key, bad) in [
+            ("yield_stress_pa", "-1.0"),
+            ("yield_stress_pa", "0.0"),
+            ("jc_c", "1.5"),
+            ("jc_c", "-0.01"),
+            ("jc_reference_rate_per_s", "0.0"),
+            ("jc_reference_rate_per_s", "2e9"),
+            ("yield_stress_pa", "nan"),
+        ] {
+            let file_text: String = material
+                .lines()
+                .map(|l| {
+                    if l.starts_with(&format!("{key} ")) {
+                        format!("{key} = {bad}")
+                    } else {
+                        l.to_string()
+                    }
+                })
+                .collect::<Vec<_>>()
+                .join("\n");
+            let Err(Error::Input {
+                key: file_key,
+                problem: file_problem,
+                allowed: file_allowed,
+                ..
+            }) = Material::from_toml(&file_text, "m.toml")
+            else {
+                panic!("{key} = {bad} accepted in a material file");
+            };
+            assert_eq!(file_key, key);
+            for chain in [false, true] {
+                let e = spheres(&format!("pair = \"ss440c\"\n{key} = {bad}\n"), chain).unwrap_err();
+                let Error::Input {
+                    file,
+                    key: k,
+                    problem,
+                    allowed,
+                } = &e
+                else {
+                    panic!("{e}");
+                };
+                assert_eq!(file, "scene.toml");
+                assert_eq!(k, &format!("specimen.{key}"));
+                assert_eq!((problem, allowed), (&file_problem, &file_allowed), "{e}");
+            }
+        }
+    }
+
+    fn scene(name: &str) -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes")
+            .join(name)
+    }
+
+    /// The spheres of a repository scene read with `--set` overrides, as `shpb run --set` reads it.
+    fn scene_spheres(name: &str, set: &[(&str, f64)]) -> Result<Vec<Sphere>> {
+        let overrides: Vec<(String, toml::Value)> = set
+            .iter()
+            .map(|(k, x)| (k.to_string(), toml::Value::Float(*x)))
+            .collect();
+        let p = Params::from_file_overridden(&scene(name), &overrides)?;
+        Ok(p.specimen
+            .as_ref()
+            .and_then(|s| s.spheres())
+            .expect("a sphere scene")
+            .chain
+            .spheres
+            .clone())
+    }
+
+    #[test]
+    fn set_reaches_the_spheres_of_every_scene_kind() {
+        let set = [
+            ("specimen.yield_stress_pa", 1700e6),
+            ("specimen.jc_c", 0.05),
+            ("specimen.jc_reference_rate_per_s", 1.0),
+        ];
+        for name in [
+            "quasistatic-fig2.toml",
+            "constant-rate-ss440c-1e4.toml",
+            "collision-ss440c-5ms.toml",
+            "collision-dissimilar.toml",
+            "force-driven-ss440c-10psi.toml",
+            "chain-ss440c-10.toml",
+            "shpb-ss440c-10psi.toml",
+            "shpb-ss440c-seated-gap.toml",
+        ] {
+            let own = scene_spheres(name, &[]).unwrap();
+            let got = scene_spheres(name, &set).unwrap();
+            assert_eq!(got.len(), own.len(), "{name}");
+            for (g, o) in got.iter().zip(&own) {
+                let expected = with_flow(o.material.clone(), 1700e6, 0.05, 1.0);
+                assert_eq!(g.material, expected, "{name}");
+                assert_eq!((g.radius_m, g.mass_kg), (o.radius_m, o.mass_kg), "{name}");
+            }
+        }
+        // Out of range on the command line: the scene file and the key named.
+        let e = scene_spheres("force-driven-ss440c-10psi.toml", &[("specimen.jc_c", 2.0)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("force-driven-ss440c-10psi.toml") && e.contains("`specimen.jc_c`"),
+            "{e}"
+        );
     }
 }
