@@ -686,14 +686,10 @@ fn channel_file_hint(record: &Path, e: Error) -> Error {
     }
 }
 
-/// [`reduce_record`] with every choice of `shpb reduce` ([`RecordOptions`]).
-pub fn reduce_record_with(
-    record: &Path,
-    bars_flag: Option<&Path>,
-    choices: &RecordOptions,
-) -> Result<Reduced> {
-    // The options are checked once, by the core; its errors are reported as the flags.
-    let mut options = ReductionOptions {
+/// The core's reduction options of `shpb reduce`'s choices, checked once by the core (its
+/// errors reported as the flags).
+pub fn reduction_options(choices: &RecordOptions) -> Result<ReductionOptions> {
+    let options = ReductionOptions {
         tension: choices.tension,
         dispersion: choices.dispersion,
         tyas_pope: choices.tyas_pope,
@@ -707,6 +703,31 @@ pub fn reduce_record_with(
         ..ReductionOptions::default()
     };
     options.validate().map_err(flag_err)?;
+    Ok(options)
+}
+
+/// The gauge strains of a run as the lab reads its record: the digitised voltages through the
+/// set-up's bridges ([`record_input`] of a run file, without the file).
+pub fn run_input(out: &RunOutput, apparatus: &Apparatus) -> Option<ReductionInput> {
+    let strains = |name: &str| {
+        let ch = apparatus.gauges.channel(name)?;
+        let g = out.gauges.iter().find(|g| g.name == name)?;
+        Some(ch.strains_from_voltages(&g.voltage_v))
+    };
+    Some(ReductionInput {
+        time_s: out.time_s.clone()?,
+        incident_strain: strains("incident")?,
+        transmission_strain: strains("transmission")?,
+    })
+}
+
+/// [`reduce_record`] with every choice of `shpb reduce` ([`RecordOptions`]).
+pub fn reduce_record_with(
+    record: &Path,
+    bars_flag: Option<&Path>,
+    choices: &RecordOptions,
+) -> Result<Reduced> {
+    let mut options = reduction_options(choices)?;
     if let (Some(file), Some(_)) = (&choices.specimen, choices.cylinder) {
         return Err(input_err(
             "--specimen",

@@ -15,6 +15,7 @@ pub mod spec;
 use crate::api::input_err;
 use observe::{Observables, Series};
 use rayon::prelude::*;
+use shpb_core::run::RunOutput;
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::prelude::*;
 use shpb_input::{Error, Result};
@@ -37,6 +38,37 @@ pub struct Problem {
     pub series: Vec<Series>,
     /// The scene is force-driven (its force is the drive, not a result).
     pub force_driven: bool,
+    /// How the gauge records were reduced: the model's virtual gauges are reduced alike
+    /// (None: no gauge record; the run's own reduction or contact series is compared).
+    pub reducer: Option<Reducer>,
+}
+
+/// The reduction a fit's gauge records went through, applied alike to each run's virtual
+/// gauges: the same options, bars and specimen (like is compared with like).
+#[derive(Debug, Clone)]
+pub struct Reducer {
+    /// The reduction's options (`shpb reduce`'s defaults with the record's specimen).
+    pub options: shpb_core::reduce::ReductionOptions,
+    /// The bars and gauges.
+    pub setup: shpb_core::reduce::ReductionSetup,
+    /// The specimen reduced for.
+    pub specimen: shpb_core::reduce::ReducedSpecimen,
+}
+
+impl Reducer {
+    /// The reduction of a run's virtual gauges (their digitised voltages through the bridges).
+    pub fn reduce(
+        &self,
+        out: &RunOutput,
+        apparatus: &shpb_core::apparatus::Apparatus,
+    ) -> Option<Observables> {
+        let input = crate::api::run_input(out, apparatus)?;
+        let r =
+            shpb_core::reduce::reduce_separated(&input, None, &self.setup, &self.options, "model")
+                .ok()?;
+        let cylinder = self.specimen.reduce(&r, &self.setup).ok()?;
+        Some(Observables::of_reduction(&r, cylinder.as_ref()))
+    }
 }
 
 /// The residual a scene is fitted on unless `--residual` says: a force-driven or contact scene's
@@ -102,7 +134,11 @@ fn scene_bars(scene: &Path) -> Result<PathBuf> {
 /// Reads one `--record`: a CSV with `time_s` and reduced quantities (a reduced curve), else a raw
 /// gauge record or run file reduced through the scene's set-up (`shpb reduce`'s defaults, the
 /// scene's cylinder as specimen).
-pub fn read_record(scene: &Path, params: &Params, record: &Path) -> Result<Observables> {
+pub fn read_record(
+    scene: &Path,
+    params: &Params,
+    record: &Path,
+) -> Result<(Observables, Option<Reducer>)> {
     let is_csv = record
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
@@ -114,7 +150,7 @@ pub fn read_record(scene: &Path, params: &Params, record: &Path) -> Result<Obser
             || o.stress_pa.is_some()
             || o.reflected_strain.is_some();
         if !o.time_s.is_empty() && any {
-            return Ok(o);
+            return Ok((o, None));
         }
     }
     let cylinder = params
@@ -126,15 +162,26 @@ pub fn read_record(scene: &Path, params: &Params, record: &Path) -> Result<Obser
             diameter_m: c.diameter_m,
         });
     let bars = scene_bars(scene)?;
-    let reduced = crate::api::reduce_record_with(
-        record,
-        Some(&bars),
-        &crate::api::RecordOptions {
-            cylinder,
-            ..crate::api::RecordOptions::default()
-        },
-    )?;
-    Ok(Observables::of_reduced(&reduced))
+    let choices = crate::api::RecordOptions {
+        cylinder,
+        ..crate::api::RecordOptions::default()
+    };
+    // A run file carries its own set-up: given no --bars, as `shpb reduce` reads it.
+    let is_run_file = shpb_output::reduction::is_hdf5(record)?;
+    let reduced =
+        crate::api::reduce_record_with(record, (!is_run_file).then_some(bars.as_path()), &choices)?;
+    let mut options = crate::api::reduction_options(&choices)?;
+    options.specimen_radii_m = reduced.specimen.radii_m();
+    options.tension = reduced.cylinder.as_ref().is_some_and(|c| c.tension);
+    let reducer = Reducer {
+        options,
+        setup: shpb_core::reduce::ReductionSetup::from_apparatus(&reduced.apparatus)?,
+        specimen: reduced.specimen,
+    };
+    Ok((
+        Observables::of_reduction(&reduced.reduction, reduced.cylinder.as_ref()),
+        Some(reducer),
+    ))
 }
 
 impl Problem {
@@ -193,8 +240,10 @@ impl Problem {
             })?;
             series.extend(observe::series_of("scene", &own, residual, force_driven)?);
         }
+        let mut reducer = None;
         for r in records {
-            let o = read_record(scene, &params, r)?;
+            let (o, red) = read_record(scene, &params, r)?;
+            reducer = reducer.or(red);
             let name = r.display().to_string();
             series.extend(observe::series_of(&name, &o, residual, force_driven)?);
         }
@@ -205,12 +254,13 @@ impl Problem {
             residual,
             series,
             force_driven,
+            reducer,
         })
     }
 
-    /// The model's values on every series at `theta` (None when the scene refuses the values or
-    /// the run fails: outside the posterior's support).
-    pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
+    /// The scene with the values of `theta` set, and the time shift of the model against the
+    /// records (None when the scene refuses the values).
+    pub fn params_at(&self, theta: &[f64]) -> Option<(Params, f64)> {
         let overrides: Vec<_> = self
             .free
             .iter()
@@ -223,13 +273,49 @@ impl Problem {
             .zip(theta)
             .find(|(f, _)| f.reach == Reach::TimeShift)
             .map_or(0.0, |(_, &x)| x);
-        let mut params = Params::from_file_overridden(&self.scene, &overrides).ok()?;
-        // The runs of a fit skip what nobody reads: the bars' x–t snapshots.
-        if let SceneParams::Pulse { options, .. } = &mut params.params {
+        let params = Params::from_file_overridden(&self.scene, &overrides).ok()?;
+        Some((params, shift))
+    }
+
+    /// The run at `theta` as a fit makes it (with the set-up it ran with): without the bars' x–t snapshots (nobody reads them)
+    /// and, with `noise_seed` None, without the digitisers' noise (the noise model is the fit's
+    /// own, [`noise`]); with `Some(seed)` every channel's noise drawn from that seed (a
+    /// simulated record). Also the time shift.
+    pub fn run_at(
+        &self,
+        theta: &[f64],
+        noise_seed: Option<u64>,
+    ) -> Option<(RunOutput, Params, f64)> {
+        let (mut params, shift) = self.params_at(theta)?;
+        if let SceneParams::Pulse {
+            options, apparatus, ..
+        } = &mut params.params
+        {
             options.snapshot_interval_s = None;
+            for (i, ch) in apparatus.gauges.channels.iter_mut().enumerate() {
+                match noise_seed {
+                    None => ch.digitiser.noise_rms_v = 0.0,
+                    Some(seed) => ch.digitiser.seed = seed.wrapping_mul(31).wrapping_add(i as u64),
+                }
+            }
         }
-        let out = params.run().ok()?;
-        let m = Observables::of_run(&out, self.force_driven);
+        Some((params.run().ok()?, params, shift))
+    }
+
+    /// What the records are compared with in a run: its virtual gauges reduced as the records
+    /// were ([`Reducer`]), else its own reduction or contact series.
+    pub fn observe(&self, out: &RunOutput, params: &Params) -> Option<Observables> {
+        match (&self.reducer, &params.params) {
+            (Some(r), SceneParams::Pulse { apparatus, .. }) => r.reduce(out, apparatus),
+            _ => Some(Observables::of_run(out, self.force_driven)),
+        }
+    }
+
+    /// The model's values on every series at `theta` ([`Problem::run_at`] without noise; None
+    /// when the scene refuses the values or the run fails: outside the posterior's support).
+    pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
+        let (out, params, shift) = self.run_at(theta, None)?;
+        let m = self.observe(&out, &params)?;
         self.series.iter().map(|s| s.model(&m, shift)).collect()
     }
 

@@ -34,17 +34,7 @@ impl Observables {
     /// its contact series.
     pub fn of_run(out: &RunOutput, force_driven: bool) -> Observables {
         if let Some(r) = &out.reduction {
-            let cyl = out.cylinder_reduction.as_ref().map(|c| &c.one_wave);
-            return Observables {
-                time_s: r.time_s.clone(),
-                force_n: Some(r.force_back_n.clone()),
-                approach_m: Some(r.displacement_m.clone()),
-                stress_pa: cyl.map(|a| a.stress_pa.clone()),
-                strain: cyl.map(|a| a.strain.clone()),
-                reflected_strain: Some(r.reflected_strain.clone()),
-                transmitted_strain: Some(r.transmitted_strain.clone()),
-                force_is_drive: false,
-            };
+            return Observables::of_reduction(r, out.cylinder_reduction.as_ref());
         }
         match &out.contact {
             Some(c) => Observables {
@@ -58,10 +48,13 @@ impl Observables {
         }
     }
 
-    /// What a reduction of `shpb reduce` gives (as [`Observables::of_run`] takes a run's).
-    pub fn of_reduced(red: &crate::api::Reduced) -> Observables {
-        let r = &red.reduction;
-        let cyl = red.cylinder.as_ref().map(|c| &c.one_wave);
+    /// What a reduction gives: the back force, the approach, the face strains, and a cylinder's
+    /// 1-wave stress and strain.
+    pub fn of_reduction(
+        r: &shpb_core::reduce::Reduction,
+        cylinder: Option<&shpb_core::reduce_cylinder::CylinderReduction>,
+    ) -> Observables {
+        let cyl = cylinder.map(|c| &c.one_wave);
         Observables {
             time_s: r.time_s.clone(),
             force_n: Some(r.force_back_n.clone()),
