@@ -9,6 +9,7 @@
 
 pub mod atomic;
 pub mod batch;
+pub mod fit;
 pub mod h5;
 pub mod io;
 pub mod plan;

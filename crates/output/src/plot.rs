@@ -1488,3 +1488,457 @@ mod tests {
         assert!(column.iter().any(|p| p[0] == 255 && p[2] < 40), "no red");
     }
 }
+
+/// The display scale and unit text of an axis in engineering notation (a power of 1000): an SI
+/// prefix for the units that take one (`1.9e9 Pa` → × 1e-9, `GPa`); for the others the numbers
+/// as they are from 0.01 to 10⁴ (`0.035`, `250 m/s`), the power written out beyond
+/// (`0.00035 1/s` → × 1e6, `×1e-6 1/s`); `max_abs` is the largest magnitude shown.
+pub fn engineering_axis(max_abs: f64, unit: &str) -> (f64, String) {
+    let unit = if unit == "1" { "" } else { unit };
+    let power = if max_abs.is_finite() && max_abs > 0.0 {
+        ((max_abs.log10() / 3.0).floor() as i32 * 3).clamp(-15, 12)
+    } else {
+        0
+    };
+    let prefix = match power {
+        -15 => "f",
+        -12 => "p",
+        -9 => "n",
+        -6 => "µ",
+        -3 => "m",
+        3 => "k",
+        6 => "M",
+        9 => "G",
+        12 => "T",
+        _ => "",
+    };
+    if matches!(unit, "s" | "m" | "Pa" | "N" | "J" | "V" | "Hz") {
+        (10f64.powi(-power), format!("{prefix}{unit}"))
+    } else if (1e-2..1e4).contains(&max_abs) || power == 0 {
+        (1.0, unit.to_string())
+    } else {
+        let text = format!("×1e{power} {unit}").trim_end().to_string();
+        (10f64.powi(-power), text)
+    }
+}
+
+/// An axis label `name (unit)`, or `name` alone without a unit.
+fn with_unit(name: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        name.to_string()
+    } else {
+        format!("{name} ({unit})")
+    }
+}
+
+/// The smallest and largest finite value of `values` (None when there is none), widened by
+/// `pad` of the span on each side (a flat set gets a span of its own).
+fn finite_range(values: impl IntoIterator<Item = f64>, pad: f64) -> Option<(f64, f64)> {
+    let (lo, hi) = values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if lo > hi {
+        return None;
+    }
+    let span = if hi > lo {
+        hi - lo
+    } else {
+        lo.abs().max(1e-300)
+    };
+    Some((lo - pad * span, hi + pad * span))
+}
+
+/// One variable of a [`corner_plot`]: its name and unit, its samples (one per draw, the same
+/// number for every variable) and what to mark on it.
+pub struct CornerVariable<'a> {
+    /// Axis name (without the unit).
+    pub name: String,
+    /// SI unit (`Pa`, `1`).
+    pub unit: String,
+    /// The samples, one per draw.
+    pub samples: &'a [f64],
+    /// A value marked by a line on the histogram and a cross on the scatters (a best fit).
+    pub best: Option<f64>,
+    /// An interval shaded on the histogram (a 90 % band).
+    pub band: Option<(f64, f64)>,
+}
+
+/// The colours of a corner plot: histogram, band, best value, scatter points.
+const CORNER_COLOURS: [RGBColor; 4] = [
+    RGBColor(30, 90, 200),
+    RGBColor(40, 150, 60),
+    RGBColor(200, 30, 30),
+    RGBColor(20, 20, 20),
+];
+
+/// A corner plot (Foreman-Mackey, JOSS 1, 24 (2016)) of samples of several variables: each
+/// variable's histogram on the diagonal (its band shaded, its best value a dashed line), the
+/// pairwise scatter below it (at most `max_points` points, thinned evenly, the best values a
+/// cross) and, above it, the correlation `correlations[i][j]` when given. Axes in engineering
+/// notation ([`engineering_axis`]); 400 × 400 pixels a cell; PNG written atomically.
+pub fn corner_plot(
+    path: &Path,
+    force: bool,
+    title: &str,
+    variables: &[CornerVariable],
+    correlations: Option<&[Vec<f64>]>,
+    max_points: usize,
+) -> Result<()> {
+    let p = variables.len().max(1);
+    let cell = 400u32;
+    // Each variable's display range, scale and label.
+    let axes: Vec<((f64, f64), f64, String)> = variables
+        .iter()
+        .map(|v| {
+            let marked = v
+                .best
+                .into_iter()
+                .chain(v.band.into_iter().flat_map(|(a, b)| [a, b]));
+            let (lo, hi) =
+                finite_range(v.samples.iter().copied().chain(marked), 0.05).unwrap_or((0.0, 1.0));
+            let (scale, unit) = engineering_axis(lo.abs().max(hi.abs()), &v.unit);
+            ((lo * scale, hi * scale), scale, with_unit(&v.name, &unit))
+        })
+        .collect();
+    let stride = variables
+        .first()
+        .map_or(1, |v| v.samples.len().div_ceil(max_points.max(1)).max(1));
+    write_atomically(path, force, |tmp| {
+        let root =
+            BitMapBackend::new(tmp, (cell * p as u32, cell * p as u32 + 40)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        let body = root.titled(title, ("sans-serif", 24)).map_err(perr(path))?;
+        let cells = body.split_evenly((p, p));
+        for (i, vi) in variables.iter().enumerate() {
+            for (j, vj) in variables.iter().enumerate() {
+                let area = &cells[i * p + j];
+                if j > i {
+                    if let Some(r) = correlations.and_then(|c| c.get(i)?.get(j).copied()) {
+                        let text = format!("correlation {}", tick((r * 100.0).round() / 100.0));
+                        let middle = cell as i32 / 2;
+                        area.draw(&Text::new(text, (middle - 90, middle), ("sans-serif", 22)))
+                            .map_err(perr(path))?;
+                    }
+                } else if i == j {
+                    corner_histogram(area, path, vi, &axes[i])?;
+                } else {
+                    corner_scatter(area, path, (vj, &axes[j]), (vi, &axes[i]), stride)?;
+                }
+            }
+        }
+        root.present().map_err(perr(path))
+    })
+}
+
+/// The diagonal cell of a [`corner_plot`]: the histogram of one variable's samples (√n bins,
+/// 10 to 40), its band shaded and its best value dashed, captioned with both.
+fn corner_histogram(
+    area: &Area,
+    path: &Path,
+    v: &CornerVariable,
+    axis: &((f64, f64), f64, String),
+) -> Result<()> {
+    let ((lo, hi), scale, label) = axis;
+    let values: Vec<f64> = v
+        .samples
+        .iter()
+        .map(|s| s * scale)
+        .filter(|s| s.is_finite())
+        .collect();
+    let bins = ((values.len() as f64).sqrt() as usize).clamp(10, 40);
+    let width = (hi - lo) / bins as f64;
+    let mut counts = vec![0usize; bins];
+    for s in &values {
+        let k = ((s - lo) / width).floor();
+        if k >= 0.0 && (k as usize) < bins {
+            counts[k as usize] += 1;
+        }
+    }
+    let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
+    let unit = if v.unit == "1" { "" } else { v.unit.as_str() };
+    let si = |x: f64| shpb_core::error::format_si(x, unit);
+    let mut caption = match v.best {
+        Some(b) => format!("best {}", si(b)),
+        None => String::new(),
+    };
+    if let Some((a, b)) = v.band {
+        caption = format!("{caption}, 90 %: {} to {}", si(a), si(b));
+    }
+    if values.is_empty() {
+        caption = format!("{caption} (no samples)");
+    }
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption.trim_start_matches(", "), ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(50)
+        .y_label_area_size(60)
+        .build_cartesian_2d(*lo..*hi, 0.0..top)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(label.as_str())
+        .y_desc("samples")
+        .x_labels(5)
+        .x_label_formatter(&|x| tick(*x))
+        .y_label_formatter(&|y| tick(*y))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(perr(path))?;
+    let [blue, green, red, _] = CORNER_COLOURS;
+    if let Some((a, b)) = v.band {
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(a * scale, 0.0), (b * scale, top)],
+                green.mix(0.2).filled(),
+            )))
+            .map_err(perr(path))?;
+    }
+    chart
+        .draw_series(counts.iter().enumerate().map(|(k, &c)| {
+            let x0 = lo + k as f64 * width;
+            Rectangle::new([(x0, 0.0), (x0 + width, c as f64)], blue.mix(0.6).filled())
+        }))
+        .map_err(perr(path))?;
+    if let Some(b) = v.best {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(b * scale, 0.0), (b * scale, top)],
+                6,
+                4,
+                red.stroke_width(2),
+            ))
+            .map_err(perr(path))?;
+    }
+    Ok(())
+}
+
+/// A cell below the diagonal of a [`corner_plot`]: the samples of `y` against those of `x`
+/// (every `stride`-th), the best values a cross.
+fn corner_scatter(
+    area: &Area,
+    path: &Path,
+    (x, x_axis): (&CornerVariable, &((f64, f64), f64, String)),
+    (y, y_axis): (&CornerVariable, &((f64, f64), f64, String)),
+    stride: usize,
+) -> Result<()> {
+    let (((x0, x1), xs, xl), ((y0, y1), ys, yl)) = (x_axis, y_axis);
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .x_label_area_size(50)
+        .y_label_area_size(60)
+        .build_cartesian_2d(*x0..*x1, *y0..*y1)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(xl.as_str())
+        .y_desc(yl.as_str())
+        .x_labels(5)
+        .y_labels(5)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(perr(path))?;
+    let [_, _, red, ink] = CORNER_COLOURS;
+    chart
+        .draw_series(
+            x.samples
+                .iter()
+                .zip(y.samples)
+                .step_by(stride)
+                .map(|(a, b)| (a * xs, b * ys))
+                .filter(|(a, b)| a.is_finite() && b.is_finite())
+                .map(|p| Circle::new(p, 1, ink.mix(0.35).filled())),
+        )
+        .map_err(perr(path))?;
+    if let (Some(a), Some(b)) = (x.best, y.best) {
+        chart
+            .draw_series(std::iter::once(Cross::new(
+                (a * xs, b * ys),
+                8,
+                red.stroke_width(3),
+            )))
+            .map_err(perr(path))?;
+    }
+    Ok(())
+}
+
+/// One panel of [`band_panels_figure`]: measured points, a model's line and a shaded band
+/// around it (all on the same abscissae), in SI units with their names and units.
+pub struct BandedPanel<'a> {
+    /// Caption.
+    pub title: String,
+    /// x-axis name and SI unit.
+    pub x_name_unit: (&'a str, &'a str),
+    /// y-axis name and SI unit.
+    pub y_name_unit: (&'a str, &'a str),
+    /// Abscissae.
+    pub x: &'a [f64],
+    /// The measured points: legend label and ordinates.
+    pub points: (String, &'a [f64]),
+    /// The model's line: legend label and ordinates.
+    pub line: (String, &'a [f64]),
+    /// The band: legend label, lower and upper edges (empty edges: no band).
+    pub band: (String, &'a [f64], &'a [f64]),
+}
+
+/// The most points of a [`BandedPanel`] drawn (thinned evenly beyond).
+const BANDED_POINTS: usize = 3000;
+
+/// Panels of measured points with a model's line over its shaded band (a posterior-predictive
+/// band: translucent blue with darker edges, under the points, the line black on top), `columns`
+/// across, 800 × 600 pixels each, axes in engineering notation; PNG written atomically.
+pub fn band_panels_figure(
+    path: &Path,
+    force: bool,
+    columns: usize,
+    panels: &[BandedPanel],
+) -> Result<()> {
+    let columns = columns.max(1);
+    let rows = panels.len().div_ceil(columns).max(1);
+    write_atomically(path, force, |tmp| {
+        let root =
+            BitMapBackend::new(tmp, (800 * columns as u32, 600 * rows as u32)).into_drawing_area();
+        root.fill(&WHITE).map_err(perr(path))?;
+        for (area, panel) in root.split_evenly((rows, columns)).iter().zip(panels) {
+            draw_banded(area, path, panel)?;
+        }
+        root.present().map_err(perr(path))
+    })
+}
+
+/// Draws one [`BandedPanel`].
+fn draw_banded(area: &Area, path: &Path, p: &BandedPanel) -> Result<()> {
+    let has_band =
+        !p.band.1.is_empty() && p.band.1.len() == p.x.len() && p.band.2.len() == p.x.len();
+    let ys = || {
+        p.points
+            .1
+            .iter()
+            .chain(p.line.1)
+            .chain(if has_band { p.band.1 } else { &[] })
+            .chain(if has_band { p.band.2 } else { &[] })
+            .copied()
+    };
+    let (x0, x1) = finite_range(p.x.iter().copied(), 0.02).unwrap_or((0.0, 1.0));
+    let (y0, y1) = finite_range(ys(), 0.05).unwrap_or((0.0, 1.0));
+    let (xs, xu) = engineering_axis(x0.abs().max(x1.abs()), p.x_name_unit.1);
+    let (ys_, yu) = engineering_axis(y0.abs().max(y1.abs()), p.y_name_unit.1);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&p.title, ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(55)
+        .y_label_area_size(75)
+        .build_cartesian_2d(x0 * xs..x1 * xs, y0 * ys_..y1 * ys_)
+        .map_err(perr(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(with_unit(p.x_name_unit.0, &xu))
+        .y_desc(with_unit(p.y_name_unit.0, &yu))
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 17))
+        .draw()
+        .map_err(perr(path))?;
+    let blue = RGBColor(30, 90, 200);
+    let red = RGBColor(170, 20, 20);
+    if has_band {
+        // One polygon per run of finite edges: along the lower edge, back along the upper.
+        let finite =
+            |k: usize| p.x[k].is_finite() && p.band.1[k].is_finite() && p.band.2[k].is_finite();
+        let mut runs: Vec<Vec<usize>> = Vec::new();
+        for k in 0..p.x.len() {
+            match (finite(k), runs.last_mut()) {
+                (true, Some(run)) if run.last() == Some(&(k.wrapping_sub(1))) => run.push(k),
+                (true, _) => runs.push(vec![k]),
+                (false, _) => {}
+            }
+        }
+        let label = p.band.0.clone();
+        let mut first = true;
+        for run in &runs {
+            let mut poly: Vec<(f64, f64)> = run
+                .iter()
+                .map(|&k| (p.x[k] * xs, p.band.1[k] * ys_))
+                .collect();
+            poly.extend(run.iter().rev().map(|&k| (p.x[k] * xs, p.band.2[k] * ys_)));
+            let drawn = chart
+                .draw_series(std::iter::once(Polygon::new(poly, blue.mix(0.25).filled())))
+                .map_err(perr(path))?;
+            if std::mem::take(&mut first) {
+                drawn.label(label.clone()).legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 6), (x + 20, y + 6)], blue.mix(0.35).filled())
+                });
+            }
+            for edge in [p.band.1, p.band.2] {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        run.iter()
+                            .map(|&k| (p.x[k] * xs, edge[k] * ys_))
+                            .collect::<Vec<_>>(),
+                        blue.mix(0.7).stroke_width(1),
+                    )))
+                    .map_err(perr(path))?;
+            }
+        }
+    }
+    let stride = p.x.len().div_ceil(BANDED_POINTS).max(1);
+    chart
+        .draw_series(
+            p.x.iter()
+                .zip(p.points.1)
+                .step_by(stride)
+                .map(|(x, y)| (x * xs, y * ys_))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|q| Circle::new(q, 2, red.filled())),
+        )
+        .map_err(perr(path))?
+        .label(p.points.0.clone())
+        .legend(move |(x, y)| Circle::new((x + 10, y), 3, red.filled()));
+    let line: Vec<(f64, f64)> =
+        p.x.iter()
+            .zip(p.line.1)
+            .map(|(x, y)| (x * xs, y * ys_))
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect();
+    let runs = unreversed_runs(&line, |q| chart.backend_coord(q));
+    chart
+        .draw_series(
+            runs.into_iter()
+                .map(|run| PathElement::new(run, BLACK.stroke_width(2))),
+        )
+        .map_err(perr(path))?
+        .label(p.line.0.clone())
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(3)));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 17))
+        .position(SeriesLabelPosition::UpperLeft)
+        .draw()
+        .map_err(perr(path))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod engineering_tests {
+    use super::*;
+
+    #[test]
+    fn engineering_axes_use_powers_of_a_thousand() {
+        assert_eq!(engineering_axis(1.93e9, "Pa"), (1e-9, "GPa".to_string()));
+        assert_eq!(engineering_axis(45e-6, "s"), (1e6, "µs".to_string()));
+        assert_eq!(engineering_axis(0.045, "1"), (1.0, String::new()));
+        assert_eq!(engineering_axis(0.0045, "1"), (1e3, "×1e-3".to_string()));
+        assert_eq!(engineering_axis(2e4, "1/s"), (1e-3, "×1e3 1/s".to_string()));
+        assert_eq!(engineering_axis(5.3, "m/s"), (1.0, "m/s".to_string()));
+        assert_eq!(engineering_axis(0.0, "N"), (1.0, "N".to_string()));
+        assert_eq!(with_unit("strain", ""), "strain");
+    }
+}
