@@ -623,11 +623,11 @@ pub fn corner_figure(path: &Path, force: bool, r: &FitReport) -> Result<()> {
         })
         .collect();
     let title = format!(
-        "posterior of {} parameters ({} samples after {} burn-in steps of {} walkers)",
-        r.parameters.len(),
+        "posterior: {} samples ({} walkers, steps {} to {})",
         columns.first().map_or(0, Vec::len),
-        r.burn_in,
-        r.walkers
+        r.walkers,
+        r.burn_in + 1,
+        r.steps
     );
     corner_plot(
         path,
@@ -911,6 +911,14 @@ mod tests {
         let band = pixels_of(&records, [199, 214, 241]);
         assert!(band > 2000, "band fill: {band} pixels");
         assert!(pixels_of(&records, [170, 20, 20]) > 100, "points");
+        // One parameter, a band the sampler could not give (NaN): still a figure.
+        let mut one = r.clone();
+        one.parameters[0].band_90 = [f64::NAN, f64::NAN];
+        one.parameters.truncate(1);
+        one.chain = r.samples_of(0);
+        one.chain.splice(0..0, vec![1.9e9; 4 * 3]);
+        one.correlations = vec![vec![1.0]];
+        corner_figure(&dir.path().join("one.png"), false, &one).unwrap();
         let mut bare = r.clone();
         bare.records[0].band_low.clear();
         bare.records[0].band_high.clear();

@@ -1545,8 +1545,10 @@ fn finite_range(values: impl IntoIterator<Item = f64>, pad: f64) -> Option<(f64,
     }
     let span = if hi > lo {
         hi - lo
+    } else if lo != 0.0 {
+        lo.abs()
     } else {
-        lo.abs().max(1e-300)
+        1.0
     };
     Some((lo - pad * span, hi + pad * span))
 }
@@ -1578,7 +1580,8 @@ const CORNER_COLOURS: [RGBColor; 4] = [
 /// variable's histogram on the diagonal (its band shaded, its best value a dashed line), the
 /// pairwise scatter below it (at most `max_points` points, thinned evenly, the best values a
 /// cross) and, above it, the correlation `correlations[i][j]` when given. Axes in engineering
-/// notation ([`engineering_axis`]); 400 × 400 pixels a cell; PNG written atomically.
+/// notation ([`engineering_axis`]); 400 × 400 pixels a cell (800 for one variable); PNG written
+/// atomically. Non-finite samples and marks are left out.
 pub fn corner_plot(
     path: &Path,
     force: bool,
@@ -1588,7 +1591,8 @@ pub fn corner_plot(
     max_points: usize,
 ) -> Result<()> {
     let p = variables.len().max(1);
-    let cell = 400u32;
+    // 400 pixels a cell, 800 across at least (room for the title).
+    let cell = (800 / p as u32).max(400);
     // Each variable's display range, scale and label.
     let axes: Vec<((f64, f64), f64, String)> = variables
         .iter()
@@ -1660,11 +1664,11 @@ fn corner_histogram(
     let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
     let unit = if v.unit == "1" { "" } else { v.unit.as_str() };
     let si = |x: f64| shpb_core::error::format_si(x, unit);
-    let mut caption = match v.best {
+    let mut caption = match v.best.filter(|b| b.is_finite()) {
         Some(b) => format!("best {}", si(b)),
         None => String::new(),
     };
-    if let Some((a, b)) = v.band {
+    if let Some((a, b)) = v.band.filter(|(a, b)| a.is_finite() && b.is_finite()) {
         caption = format!("{caption}, 90 %: {} to {}", si(a), si(b));
     }
     if values.is_empty() {
@@ -1689,7 +1693,7 @@ fn corner_histogram(
         .draw()
         .map_err(perr(path))?;
     let [blue, green, red, _] = CORNER_COLOURS;
-    if let Some((a, b)) = v.band {
+    if let Some((a, b)) = v.band.filter(|(a, b)| a.is_finite() && b.is_finite()) {
         chart
             .draw_series(std::iter::once(Rectangle::new(
                 [(a * scale, 0.0), (b * scale, top)],
@@ -1703,7 +1707,7 @@ fn corner_histogram(
             Rectangle::new([(x0, 0.0), (x0 + width, c as f64)], blue.mix(0.6).filled())
         }))
         .map_err(perr(path))?;
-    if let Some(b) = v.best {
+    if let Some(b) = v.best.filter(|b| b.is_finite()) {
         chart
             .draw_series(DashedLineSeries::new(
                 [(b * scale, 0.0), (b * scale, top)],
@@ -1756,7 +1760,10 @@ fn corner_scatter(
                 .map(|p| Circle::new(p, 1, ink.mix(0.35).filled())),
         )
         .map_err(perr(path))?;
-    if let (Some(a), Some(b)) = (x.best, y.best) {
+    if let (Some(a), Some(b)) = (x.best, y.best)
+        && a.is_finite()
+        && b.is_finite()
+    {
         chart
             .draw_series(std::iter::once(Cross::new(
                 (a * xs, b * ys),
