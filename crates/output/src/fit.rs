@@ -235,8 +235,8 @@ fn number_attr<T: hdf5::H5Type>(
         .map_err(h5err(file))
 }
 
-/// Writes an f64 dataset of shape `shape` (row-major `data`) with `units` and, when given, the
-/// parameter keys and units of its last axis.
+/// Writes an f64 dataset of shape `shape` (row-major `data`) with its `units` or, for a dataset
+/// whose last axis runs over the parameters, their keys (`parameters`) and units (`units`).
 fn write_array(
     g: &hdf5::Group,
     name: &str,
@@ -255,12 +255,13 @@ fn write_array(
         .with_data(&array)
         .create(name)
         .map_err(h5err(file))?;
-    string_attr(&ds, "units", units, file)?;
-    if let Some((keys, units)) = columns {
-        strings_attr(&ds, "parameters", keys, file)?;
-        strings_attr(&ds, "units", units, file)?;
+    match columns {
+        Some((keys, units)) => {
+            strings_attr(&ds, "parameters", keys, file)?;
+            strings_attr(&ds, "units", units, file)
+        }
+        None => string_attr(&ds, "units", units, file),
     }
-    Ok(())
 }
 
 /// Writes the fit file of `r` to `path` in the layout of this module (with `/provenance` when
@@ -622,11 +623,11 @@ pub fn corner_figure(path: &Path, force: bool, r: &FitReport) -> Result<()> {
         })
         .collect();
     let title = format!(
-        "posterior of {} parameters ({} samples after {} burn-in steps of {} walkers)",
-        r.parameters.len(),
+        "posterior: {} samples ({} walkers, steps {} to {})",
         columns.first().map_or(0, Vec::len),
-        r.burn_in,
-        r.walkers
+        r.walkers,
+        r.burn_in + 1,
+        r.steps
     );
     corner_plot(
         path,
@@ -646,11 +647,15 @@ pub fn records_figure(path: &Path, force: bool, r: &FitReport) -> Result<()> {
         .records
         .iter()
         .map(|rec| BandedPanel {
-            title: format!(
-                "{}: {} % of points inside the 90 % band",
-                rec.name,
-                crate::plot::three_digits(100.0 * rec.inside_band)
-            ),
+            title: if rec.band_low.is_empty() {
+                format!("{}: best fit (no band)", rec.name)
+            } else {
+                format!(
+                    "{}: {} % of points inside the 90 % band",
+                    rec.name,
+                    crate::plot::three_digits(100.0 * rec.inside_band)
+                )
+            },
             x_name_unit: (&rec.x_label, &rec.x_unit),
             y_name_unit: (&rec.y_label, &rec.y_unit),
             x: &rec.x,
@@ -882,11 +887,51 @@ mod tests {
         bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 1000
     }
 
+    /// How many pixels of the PNG at `path` are within 6 of `colour` in each channel.
+    fn pixels_of(path: &Path, colour: [u8; 3]) -> usize {
+        let img = image::open(path).unwrap().to_rgb8();
+        img.pixels()
+            .filter(|p| (0..3).all(|c| p.0[c].abs_diff(colour[c]) <= 6))
+            .count()
+    }
+
+    #[test]
+    fn the_figures_draw_histograms_scatters_points_line_and_band() {
+        let dir = tempfile::tempdir().unwrap();
+        let r = report();
+        let corner = dir.path().join("corner.png");
+        corner_figure(&corner, false, &r).unwrap();
+        // Histogram bars (blue at 0.6 on white), the best fit's dashed line and crosses (red).
+        assert!(pixels_of(&corner, [120, 156, 222]) > 500, "histograms");
+        assert!(pixels_of(&corner, [200, 30, 30]) > 50, "best fit marks");
+        let records = dir.path().join("records.png");
+        records_figure(&records, false, &r).unwrap();
+        // The band (blue at 0.25 on white) is a fill a reader tells from the black line; the
+        // record's points are dark red.
+        let band = pixels_of(&records, [199, 214, 241]);
+        assert!(band > 2000, "band fill: {band} pixels");
+        assert!(pixels_of(&records, [170, 20, 20]) > 100, "points");
+        // One parameter, a band the sampler could not give (NaN): still a figure.
+        let mut one = r.clone();
+        one.parameters[0].band_90 = [f64::NAN, f64::NAN];
+        one.parameters.truncate(1);
+        one.chain = r.samples_of(0);
+        one.chain.splice(0..0, vec![1.9e9; 4 * 3]);
+        one.correlations = vec![vec![1.0]];
+        corner_figure(&dir.path().join("one.png"), false, &one).unwrap();
+        let mut bare = r.clone();
+        bare.records[0].band_low.clear();
+        bare.records[0].band_high.clear();
+        records_figure(&records, true, &bare).unwrap();
+        assert_eq!(pixels_of(&records, [199, 214, 241]), 0, "no band drawn");
+    }
+
     #[test]
     fn the_figures_are_pngs_that_refuse_to_clobber() {
         let dir = tempfile::tempdir().unwrap();
         let r = report();
-        let writers: [(&str, fn(&Path, bool, &FitReport) -> Result<()>); 2] = [
+        type Figure = fn(&Path, bool, &FitReport) -> Result<()>;
+        let writers: [(&str, Figure); 2] = [
             ("corner.png", corner_figure),
             ("records.png", records_figure),
         ];

@@ -1490,8 +1490,9 @@ mod tests {
 }
 
 /// The display scale and unit text of an axis in engineering notation (a power of 1000): an SI
-/// prefix for the units that take one (`1.9e9 Pa` → × 1e-9, `GPa`), otherwise the power written
-/// out (`0.00035 1/s` → × 1e6, `×1e-6 1/s`); `max_abs` is the largest magnitude shown.
+/// prefix for the units that take one (`1.9e9 Pa` → × 1e-9, `GPa`); for the others the numbers
+/// as they are from 0.01 to 10⁴ (`0.035`, `250 m/s`), the power written out beyond
+/// (`0.00035 1/s` → × 1e6, `×1e-6 1/s`); `max_abs` is the largest magnitude shown.
 pub fn engineering_axis(max_abs: f64, unit: &str) -> (f64, String) {
     let unit = if unit == "1" { "" } else { unit };
     let power = if max_abs.is_finite() && max_abs > 0.0 {
@@ -1508,16 +1509,17 @@ pub fn engineering_axis(max_abs: f64, unit: &str) -> (f64, String) {
         3 => "k",
         6 => "M",
         9 => "G",
-        _ => "T",
+        12 => "T",
+        _ => "",
     };
-    let text = if power == 0 {
-        unit.to_string()
-    } else if matches!(unit, "s" | "m" | "Pa" | "N" | "J" | "V" | "Hz") {
-        format!("{prefix}{unit}")
+    if matches!(unit, "s" | "m" | "Pa" | "N" | "J" | "V" | "Hz") {
+        (10f64.powi(-power), format!("{prefix}{unit}"))
+    } else if (1e-2..1e4).contains(&max_abs) || power == 0 {
+        (1.0, unit.to_string())
     } else {
-        format!("×1e{power} {unit}").trim_end().to_string()
-    };
-    (10f64.powi(-power), text)
+        let text = format!("×1e{power} {unit}").trim_end().to_string();
+        (10f64.powi(-power), text)
+    }
 }
 
 /// An axis label `name (unit)`, or `name` alone without a unit.
@@ -1543,8 +1545,10 @@ fn finite_range(values: impl IntoIterator<Item = f64>, pad: f64) -> Option<(f64,
     }
     let span = if hi > lo {
         hi - lo
+    } else if lo != 0.0 {
+        lo.abs()
     } else {
-        lo.abs().max(1e-300)
+        1.0
     };
     Some((lo - pad * span, hi + pad * span))
 }
@@ -1576,7 +1580,8 @@ const CORNER_COLOURS: [RGBColor; 4] = [
 /// variable's histogram on the diagonal (its band shaded, its best value a dashed line), the
 /// pairwise scatter below it (at most `max_points` points, thinned evenly, the best values a
 /// cross) and, above it, the correlation `correlations[i][j]` when given. Axes in engineering
-/// notation ([`engineering_axis`]); 400 × 400 pixels a cell; PNG written atomically.
+/// notation ([`engineering_axis`]); 400 × 400 pixels a cell (800 for one variable); PNG written
+/// atomically. Non-finite samples and marks are left out.
 pub fn corner_plot(
     path: &Path,
     force: bool,
@@ -1586,7 +1591,8 @@ pub fn corner_plot(
     max_points: usize,
 ) -> Result<()> {
     let p = variables.len().max(1);
-    let cell = 400u32;
+    // 400 pixels a cell, 800 across at least (room for the title).
+    let cell = (800 / p as u32).max(400);
     // Each variable's display range, scale and label.
     let axes: Vec<((f64, f64), f64, String)> = variables
         .iter()
@@ -1615,13 +1621,9 @@ pub fn corner_plot(
                 let area = &cells[i * p + j];
                 if j > i {
                     if let Some(r) = correlations.and_then(|c| c.get(i)?.get(j).copied()) {
-                        let text = format!(
-                            "r({}, {}) = {}",
-                            vj.name,
-                            vi.name,
-                            tick((r * 100.0).round() / 100.0,)
-                        );
-                        area.draw(&Text::new(text, (20, cell as i32 / 2), ("sans-serif", 17)))
+                        let text = format!("correlation {}", tick((r * 100.0).round() / 100.0));
+                        let middle = cell as i32 / 2;
+                        area.draw(&Text::new(text, (middle - 90, middle), ("sans-serif", 22)))
                             .map_err(perr(path))?;
                     }
                 } else if i == j {
@@ -1660,13 +1662,14 @@ fn corner_histogram(
         }
     }
     let top = counts.iter().copied().max().unwrap_or(0).max(1) as f64 * 1.1;
-    let three = |x: f64| three_digits(x * scale);
-    let mut caption = match v.best {
-        Some(b) => format!("best {}", three(b)),
+    let unit = if v.unit == "1" { "" } else { v.unit.as_str() };
+    let si = |x: f64| shpb_core::error::format_si(x, unit);
+    let mut caption = match v.best.filter(|b| b.is_finite()) {
+        Some(b) => format!("best {}", si(b)),
         None => String::new(),
     };
-    if let Some((a, b)) = v.band {
-        caption = format!("{caption}, 90 % {} to {}", three(a), three(b));
+    if let Some((a, b)) = v.band.filter(|(a, b)| a.is_finite() && b.is_finite()) {
+        caption = format!("{caption}, 90 %: {} to {}", si(a), si(b));
     }
     if values.is_empty() {
         caption = format!("{caption} (no samples)");
@@ -1690,7 +1693,7 @@ fn corner_histogram(
         .draw()
         .map_err(perr(path))?;
     let [blue, green, red, _] = CORNER_COLOURS;
-    if let Some((a, b)) = v.band {
+    if let Some((a, b)) = v.band.filter(|(a, b)| a.is_finite() && b.is_finite()) {
         chart
             .draw_series(std::iter::once(Rectangle::new(
                 [(a * scale, 0.0), (b * scale, top)],
@@ -1704,7 +1707,7 @@ fn corner_histogram(
             Rectangle::new([(x0, 0.0), (x0 + width, c as f64)], blue.mix(0.6).filled())
         }))
         .map_err(perr(path))?;
-    if let Some(b) = v.best {
+    if let Some(b) = v.best.filter(|b| b.is_finite()) {
         chart
             .draw_series(DashedLineSeries::new(
                 [(b * scale, 0.0), (b * scale, top)],
@@ -1757,7 +1760,10 @@ fn corner_scatter(
                 .map(|p| Circle::new(p, 1, ink.mix(0.35).filled())),
         )
         .map_err(perr(path))?;
-    if let (Some(a), Some(b)) = (x.best, y.best) {
+    if let (Some(a), Some(b)) = (x.best, y.best)
+        && a.is_finite()
+        && b.is_finite()
+    {
         chart
             .draw_series(std::iter::once(Cross::new(
                 (a * xs, b * ys),
@@ -1925,4 +1931,21 @@ fn draw_banded(area: &Area, path: &Path, p: &BandedPanel) -> Result<()> {
         .draw()
         .map_err(perr(path))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod engineering_tests {
+    use super::*;
+
+    #[test]
+    fn engineering_axes_use_powers_of_a_thousand() {
+        assert_eq!(engineering_axis(1.93e9, "Pa"), (1e-9, "GPa".to_string()));
+        assert_eq!(engineering_axis(45e-6, "s"), (1e6, "µs".to_string()));
+        assert_eq!(engineering_axis(0.045, "1"), (1.0, String::new()));
+        assert_eq!(engineering_axis(0.0045, "1"), (1e3, "×1e-3".to_string()));
+        assert_eq!(engineering_axis(2e4, "1/s"), (1e-3, "×1e3 1/s".to_string()));
+        assert_eq!(engineering_axis(5.3, "m/s"), (1.0, "m/s".to_string()));
+        assert_eq!(engineering_axis(0.0, "N"), (1.0, "N".to_string()));
+        assert_eq!(with_unit("strain", ""), "strain");
+    }
 }
