@@ -13,6 +13,7 @@ pub mod calibrate;
 pub mod convergence;
 pub mod design;
 pub mod file;
+pub mod fit;
 pub mod identity;
 pub mod strain_factor;
 pub mod sweep;
