@@ -106,7 +106,8 @@ pub fn stream_seed(seed: u64, step: u64, half: u64) -> u64 {
 /// form, Foreman-Mackey et al. 2013 Algorithm 3). `start`: walkers initial points
 /// (walkers x dim) used only when `resume` is None (or a chain with no step). `log_prob_batch`
 /// evaluates a batch of points at once (the caller evaluates them in parallel, e.g. rayon) and
-/// returns ln p (f64::NEG_INFINITY outside the support; NaN is rejected like −∞).
+/// returns ln p (f64::NEG_INFINITY outside the support; NaN is taken as −∞, so a walker
+/// started there moves to the first proposal with a finite ln p).
 /// `after_step(&Chain) -> bool` is called after each full step (checkpointing, progress,
 /// Ctrl-C): returning false stops early, the Chain so far is returned.
 ///
@@ -141,13 +142,21 @@ pub fn sample(
             points.len(),
             "log_prob_batch returned a wrong length"
         );
-        lp
+        lp.into_iter()
+            .map(|l| if l.is_nan() { f64::NEG_INFINITY } else { l })
+            .collect::<Vec<f64>>()
     };
     let (mut chain, mut current, mut current_lp) = match resume {
         Some(chain) if chain.steps_done > 0 => {
             assert_eq!(
                 chain.walkers, walkers,
                 "resumed chain has another walker count"
+            );
+            assert!(
+                chain.positions.len() == chain.steps_done * walkers * chain.dim
+                    && chain.log_prob.len() == chain.steps_done * walkers
+                    && chain.accepted.len() == walkers,
+                "resumed chain's arrays do not match its steps, walkers and dimension"
             );
             let last = chain.steps_done - 1;
             let current: Vec<Vec<f64>> = (0..walkers)
@@ -276,12 +285,13 @@ pub fn integrated_autocorr_time(chain: &Chain, burn: usize) -> Vec<f64> {
                     *m += r / chain.walkers as f64;
                 }
             }
-            let mut tau = 2.0 * mean_acf[0] - 1.0;
-            for (m, r) in mean_acf.iter().enumerate().skip(1) {
-                if (m as f64) >= C * tau {
+            // τ(M) = 2 Σ_{t=0..M} ρ̄(t) − 1 (ρ̄(0) = 1); the first M with M ≥ c τ(M).
+            let mut tau = -1.0;
+            for (m, r) in mean_acf.iter().enumerate() {
+                tau += 2.0 * r;
+                if m as f64 >= C * tau {
                     break;
                 }
-                tau += 2.0 * r;
             }
             tau
         })
@@ -524,6 +534,29 @@ mod tests {
             let w = hi[d] - lo[d];
             assert!(band_90(&v)[0] < lo[d] + 0.2 * w && band_90(&v)[1] > hi[d] - 0.2 * w);
         }
+    }
+
+    #[test]
+    fn mcmc_takes_nan_as_outside_and_brings_a_stray_walker_in() {
+        // ln p: 0 on (0, 1)², NaN left of it, −∞ elsewhere. One walker starts in the NaN
+        // region: it is moved by the first proposal that lands inside, and stays inside.
+        let lp = batch(|p: &[f64]| {
+            if p[0] < 0.0 {
+                f64::NAN
+            } else if p[0] < 1.0 && p[1] > 0.0 && p[1] < 1.0 {
+                0.0
+            } else {
+                f64::NEG_INFINITY
+            }
+        });
+        let mut start = initial_ball(&[0.5, 0.5], &[0.1, 0.1], 8, 5, &|_| true);
+        start[0] = vec![-0.5, 0.5];
+        let chain = sample(&settings(8, 300, 2), &start, None, &lp, &mut |_| true);
+        assert!(chain.log_prob.iter().all(|l| !l.is_nan()));
+        let moved = (0..chain.steps_done).find(|&s| chain.log_prob_at(s, 0) == 0.0);
+        let moved = moved.expect("the stray walker came in");
+        assert!((moved..chain.steps_done).all(|s| chain.log_prob_at(s, 0) == 0.0));
+        assert!((moved..chain.steps_done).all(|s| chain.sample(s, 0)[0] > 0.0));
     }
 
     #[test]
