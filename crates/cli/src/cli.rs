@@ -449,6 +449,10 @@ pub enum Command {
         #[arg(short = 'j', long = "jobs", allow_hyphen_values = true,
               value_parser = whole_number::<usize>("1 up to 4 worker threads per core of the machine"))]
         jobs: Option<usize>,
+        /// Continue a stopped fit from its checkpoint (FIT.h5.partial.h5, kept with -o every
+        /// twentieth of the steps): the same command line with --resume.
+        #[arg(long)]
+        resume: bool,
         /// Overwrite existing output files.
         #[arg(long)]
         force: bool,
@@ -1079,6 +1083,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
             burn_in,
             seed,
             jobs,
+            resume,
             force,
         } => cmd::fit::fit(
             &scene,
@@ -1091,6 +1096,7 @@ pub fn dispatch(cli: Cli) -> Result<()> {
                 plot: plot.as_deref(),
                 corner: corner.as_deref(),
                 force,
+                resume,
                 settings: shpb_study::fit::Settings {
                     walkers: walkers.unwrap_or(0),
                     steps,

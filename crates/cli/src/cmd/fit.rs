@@ -27,6 +27,8 @@ pub struct FitOptions<'a> {
     pub corner: Option<&'a Path>,
     /// `--force`.
     pub force: bool,
+    /// `--resume`: continue the checkpoint `<FIT.h5>.partial.h5` of a stopped fit.
+    pub resume: bool,
     /// Sampler and fit settings.
     pub settings: Settings,
 }
@@ -70,14 +72,61 @@ pub fn fit(scene: &Path, o: &FitOptions) -> Result<()> {
         };
         line.update(f.min(1.0));
     };
+    // With -o, the chain so far is kept every twentieth of the steps in `<FIT.h5>.partial.h5`,
+    // which `--resume` continues (a stopped fit says so).
+    let checkpoint = o.output.map(shpb_study::fit::checkpoint_path);
+    let resume = match (&checkpoint, o.resume) {
+        (None, true) => {
+            return Err(shpb_study::api::input_err(
+                "--resume",
+                "given without -o",
+                "--resume with the -o FIT.h5 of the stopped fit (its checkpoint is FIT.h5.partial.h5)",
+            ));
+        }
+        (Some(c), true) if c.is_file() => {
+            let r = shpb_output::fit::read_fit_hdf5(c)?;
+            shpb_study::fit::check_resume(&problem, &o.settings, &r, c)?;
+            Some(r)
+        }
+        (Some(c), true) => {
+            return Err(shpb_study::api::input_err(
+                "--resume",
+                format!("no checkpoint {}", c.display()),
+                "--resume after a fit with the same -o was stopped",
+            ));
+        }
+        (Some(c), false) if c.is_file() && !o.force => {
+            return Err(shpb_study::api::input_err(
+                "-o",
+                format!("a stopped fit left its checkpoint {}", c.display()),
+                "--resume to continue it, or --force to start again",
+            ));
+        }
+        _ => None,
+    };
+    if let Some(c) = checkpoint.clone() {
+        crate::interrupt::set_message(move || {
+            format!(
+                "the chain so far is in {}; continue with: {}",
+                c.display(),
+                crate::interrupt::resume_command()
+            )
+        });
+    }
     let started = std::time::Instant::now();
-    let r = shpb_study::fit::fit(
+    let r = shpb_study::fit::fit_resumable(
         &problem,
         &o.settings,
         &super::common::command_line(),
         &mut progress,
         &|| true,
+        resume.as_ref(),
+        &mut |partial| match &checkpoint {
+            Some(c) => shpb_output::fit::write_fit_hdf5(c, true, partial, None),
+            None => Ok(()),
+        },
     )?;
+    crate::interrupt::clear_message();
     line.finish();
     let seconds = started.elapsed().as_secs_f64();
     for w in &r.warnings {
@@ -95,6 +144,10 @@ pub fn fit(scene: &Path, o: &FitOptions) -> Result<()> {
         }
         Ok(())
     })?;
+    if let Some(c) = &checkpoint {
+        // The fit is whole in its file: the checkpoint has served.
+        let _ = std::fs::remove_file(c);
+    }
     report(&text(&r, seconds), || {
         let mut j = shpb_output::fit::fit_json(&r);
         j["seconds"] = finite(seconds);

@@ -240,7 +240,7 @@ pub fn sample(
 /// The normalised autocorrelation function ρ(t) = C(t)/C(0) of one series by FFT
 /// (Wiener–Khinchin, zero-padded to ≥ 2n so it is the linear, not circular, one; emcee's
 /// `function_1d`). A constant series has no variance: returned as ρ ≡ 1 (fully correlated).
-fn autocorrelation(x: &[f64]) -> Vec<f64> {
+pub fn autocorrelation(x: &[f64]) -> Vec<f64> {
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
     let len = fast_fft_length(2 * n);
@@ -269,7 +269,6 @@ fn autocorrelation(x: &[f64]) -> Vec<f64> {
 /// "Monte Carlo methods in statistical mechanics", §3; Goodman & Weare 2010 §5): the smallest M
 /// with M ≥ c τ(M), c = 5 (the last lag when none). NaN with fewer than 2 steps after `burn`.
 pub fn integrated_autocorr_time(chain: &Chain, burn: usize) -> Vec<f64> {
-    const C: f64 = 5.0;
     let n = chain.steps_done.saturating_sub(burn);
     if n < 2 {
         return vec![f64::NAN; chain.dim];
@@ -285,17 +284,23 @@ pub fn integrated_autocorr_time(chain: &Chain, burn: usize) -> Vec<f64> {
                     *m += r / chain.walkers as f64;
                 }
             }
-            // τ(M) = 2 Σ_{t=0..M} ρ̄(t) − 1 (ρ̄(0) = 1); the first M with M ≥ c τ(M).
-            let mut tau = -1.0;
-            for (m, r) in mean_acf.iter().enumerate() {
-                tau += 2.0 * r;
-                if m as f64 >= C * tau {
-                    break;
-                }
-            }
-            tau
+            windowed_time(&mean_acf)
         })
         .collect()
+}
+
+/// τ = 2 Σ_{t=0..M} ρ(t) − 1 of a normalised autocorrelation function ρ (ρ(0) = 1) with Sokal's
+/// automatic window: the first M with M ≥ c τ(M), c = 5 (the last lag when none).
+pub fn windowed_time(acf: &[f64]) -> f64 {
+    const C: f64 = 5.0;
+    let mut tau = -1.0;
+    for (m, r) in acf.iter().enumerate() {
+        tau += 2.0 * r;
+        if m as f64 >= C * tau {
+            break;
+        }
+    }
+    tau
 }
 
 /// The effective number of independent samples of each parameter after `burn`:

@@ -217,12 +217,26 @@ impl Problem {
         for f in &free {
             for x in [f.min, f.max] {
                 if let Some(o) = f.value(x) {
-                    Params::from_file_overridden(scene, &[o]).map_err(|e| {
-                        input_err(
+                    Params::from_file_overridden(scene, &[o]).map_err(|e| match e {
+                        Error::Input {
+                            file,
+                            problem,
+                            allowed,
+                            ..
+                        } => input_err(
                             &format!("--free {}", f.key),
-                            format!("{} {}: {e}", x, f.unit),
-                            "bounds the scene accepts for that key",
-                        )
+                            format!(
+                                "{} refuses the bound {x}{}: {problem}",
+                                file,
+                                if f.unit == "1" {
+                                    String::new()
+                                } else {
+                                    format!(" {}", f.unit)
+                                }
+                            ),
+                            allowed,
+                        ),
+                        other => other,
                     })?;
                 }
             }
@@ -238,7 +252,12 @@ impl Problem {
                     "one --record FILE or more (a raw gauge record, a run file, a reduced curve as CSV), or a force-driven scene whose CSV has displacement_m",
                 )
             })?;
-            series.extend(observe::series_of("scene", &own, residual, force_driven)?);
+            series.extend(observe::series_of(
+                "the scene's own record",
+                &own,
+                residual,
+                force_driven,
+            )?);
         }
         let mut reducer = None;
         for r in records {
@@ -422,12 +441,206 @@ pub fn fit(
     progress: Progress,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Result<FitReport> {
+    fit_resumable(
+        problem,
+        settings,
+        command_line,
+        progress,
+        keep_going,
+        None,
+        &mut |_| Ok(()),
+    )
+}
+
+/// The checkpoint of a fit writing `output`: `<output>.partial.h5` (a fit file of the steps so
+/// far, without the predictive bands).
+pub fn checkpoint_path(output: &Path) -> PathBuf {
+    let mut name = output.as_os_str().to_owned();
+    name.push(".partial.h5");
+    PathBuf::from(name)
+}
+
+/// Checks a checkpoint against this fit (the same scene, residual, keys, bounds, priors,
+/// walkers and records): a resumed chain continues only the fit it was made for.
+pub fn check_resume(
+    problem: &Problem,
+    settings: &Settings,
+    r: &FitReport,
+    file: &Path,
+) -> Result<()> {
+    let walkers = resolved_walkers(problem, settings);
+    let same = r.scene == problem.scene.display().to_string()
+        && r.residual == problem.residual.name()
+        && r.walkers == walkers
+        && r.parameters.len() == problem.free.len()
+        && r.parameters.iter().zip(&problem.free).all(|(p, f)| {
+            p.key == f.key
+                && p.min == f.min
+                && p.max == f.max
+                && p.prior_normal
+                    == problem
+                        .priors
+                        .iter()
+                        .find(|q| q.key == f.key)
+                        .map(|q| (q.mean, q.sd))
+        })
+        && r.records.len() == problem.series.len()
+        && r.records
+            .iter()
+            .zip(&problem.series)
+            .all(|(a, b)| a.name == b.record && a.y == b.y);
+    if same && r.steps <= settings.steps {
+        return Ok(());
+    }
+    Err(Error::Input {
+        file: file.display().to_string(),
+        key: "--resume".into(),
+        problem: format!(
+            "the checkpoint is of another fit (scene {}, residual {}, {} walkers, keys {}, {} steps done)",
+            r.scene,
+            r.residual,
+            r.walkers,
+            r.parameters.iter().map(|p| p.key.as_str()).collect::<Vec<_>>().join(", "),
+            r.steps
+        ),
+        allowed: "the command line that wrote it, with --steps at least the steps done (or remove the checkpoint)".into(),
+    })
+}
+
+fn resolved_walkers(problem: &Problem, settings: &Settings) -> usize {
+    match settings.walkers {
+        0 => (4 * problem.free.len()).max(16),
+        w => w,
+    }
+}
+
+/// The sampler's chain stored in a fit report (the accepted moves counted as the steps where a
+/// walker moved: a rejected move keeps its position exactly).
+fn chain_of(r: &FitReport) -> mcmc::Chain {
+    let (dim, walkers) = (r.parameters.len(), r.walkers);
+    let accepted = chain_moves(&r.chain, dim, walkers, r.steps);
+    mcmc::Chain {
+        dim,
+        walkers,
+        positions: r.chain.clone(),
+        log_prob: r.log_prob.clone(),
+        accepted,
+        steps_done: r.steps,
+    }
+}
+
+/// The fraction of accepted moves, counted as the steps where a walker moved from step 1 on (a
+/// rejected move keeps its position exactly; the move into step 0 is not stored), so that a
+/// resumed chain reports what the uninterrupted one does.
+fn moved_fraction(chain: &mcmc::Chain) -> f64 {
+    let moves: u64 = chain_moves(&chain.positions, chain.dim, chain.walkers, chain.steps_done)
+        .iter()
+        .sum();
+    moves as f64 / (chain.walkers * chain.steps_done.saturating_sub(1)).max(1) as f64
+}
+
+/// Per walker, the steps (from step 1 on) at which it moved.
+fn chain_moves(positions: &[f64], dim: usize, walkers: usize, steps: usize) -> Vec<u64> {
+    let mut accepted = vec![0u64; walkers];
+    for step in 1..steps {
+        for (w, a) in accepted.iter_mut().enumerate() {
+            let at = |s: usize| &positions[(s * walkers + w) * dim..(s * walkers + w + 1) * dim];
+            if at(step) != at(step - 1) {
+                *a += 1;
+            }
+        }
+    }
+    accepted
+}
+
+/// The least-squares best fit on the unit cube of the bounds: the best of a start design (the
+/// centre and 4d points of a seeded Latin hypercube), then argmin's Nelder–Mead from it.
+/// Returns the best point, its cost, the model there and the runs made.
+fn least_squares(
+    problem: &Problem,
+    settings: &Settings,
+    pool: &rayon::ThreadPool,
+    scales: &[f64],
+    progress: Progress,
+) -> Result<(Vec<f64>, f64, Vec<Vec<f64>>, usize)> {
+    let d = problem.free.len();
+    let to_x = |u: &[f64]| -> Vec<f64> {
+        problem
+            .free
+            .iter()
+            .zip(u)
+            .map(|(f, &u)| f.min + u.clamp(0.0, 1.0) * (f.max - f.min))
+            .collect()
+    };
+    let mut starts = vec![vec![0.5; d]];
+    starts.extend(crate::uq::latin_hypercube(
+        4 * d,
+        d,
+        &mut crate::uq::Rng::new(settings.seed),
+    ));
+    let start_x: Vec<Vec<f64>> = starts.iter().map(|u| to_x(u)).collect();
+    progress("least squares", 0, starts.len());
+    let start_costs: Vec<f64> = models(problem, pool, &start_x)
+        .iter()
+        .map(|m| cost(problem, scales, m))
+        .collect();
+    let mut runs = starts.len();
+    let (i0, c0) =
+        start_costs.iter().enumerate().fold(
+            (0, f64::INFINITY),
+            |b, (i, &c)| if c < b.1 { (i, c) } else { b },
+        );
+    let failed = |what: &str| Error::Input {
+        file: problem.scene.display().to_string(),
+        key: "--free".into(),
+        problem: what.into(),
+        allowed: "bounds within which the scene runs".into(),
+    };
+    if !c0.is_finite() {
+        return Err(failed("no run of the start design succeeded"));
+    }
+    let budget = match settings.max_least_squares_runs {
+        0 => 60 * d + 40,
+        n => n,
+    };
+    let mut evals = 0usize;
+    let mut objective = |u: &[f64]| {
+        evals += 1;
+        progress("least squares", evals, budget);
+        let outside: f64 = u.iter().map(|v| (v.clamp(0.0, 1.0) - v).abs()).sum();
+        let m = problem.model(&to_x(u));
+        cost(problem, scales, &m) + 1e3 * outside
+    };
+    let (u_best, best_cost, used) = crate::calibrate::optimise::nelder_mead(
+        &mut objective,
+        &starts[i0],
+        &vec![0.1; d],
+        budget,
+        1e-10 * c0.max(1e-300),
+    );
+    runs += used + 1;
+    let best = to_x(&u_best);
+    let best_model = problem
+        .model(&best)
+        .ok_or_else(|| failed("the best fit's run failed"))?;
+    Ok((best, best_cost, best_model, runs))
+}
+
+/// [`fit`] that continues the chain of `resume` (a checkpoint, [`check_resume`]: its best fit and
+/// noise model are kept, the sampler continues from its last step bit for bit) and hands a
+/// report of the steps so far to `checkpoint` every twentieth of the steps.
+pub fn fit_resumable(
+    problem: &Problem,
+    settings: &Settings,
+    command_line: &str,
+    progress: Progress,
+    keep_going: &(dyn Fn() -> bool + Sync),
+    resume: Option<&FitReport>,
+    checkpoint: &mut dyn FnMut(&FitReport) -> Result<()>,
+) -> Result<FitReport> {
     let d = problem.free.len();
     let pool = crate::sweep::thread_pool(settings.jobs)?;
-    let walkers = match settings.walkers {
-        0 => (4 * d).max(16),
-        w => w,
-    };
+    let walkers = resolved_walkers(problem, settings);
     if walkers % 2 != 0 || walkers < 2 * d {
         return Err(input_err(
             "--walkers",
@@ -458,80 +671,38 @@ pub fn fit(
             if rms > 0.0 { rms } else { 1.0 }
         })
         .collect();
-    let mut runs = 0usize;
 
-    // 1. Least squares on the unit cube of the bounds: the best of a start design (the centre
-    // and 4d points of a seeded Latin hypercube), then Nelder–Mead from it.
-    let to_x = |u: &[f64]| -> Vec<f64> {
-        problem
-            .free
-            .iter()
-            .zip(u)
-            .map(|(f, &u)| f.min + u.clamp(0.0, 1.0) * (f.max - f.min))
-            .collect()
+    // 1. The least-squares best fit, and 2. the noise model of each series from its residuals
+    // (a resumed fit keeps its checkpoint's).
+    let (best, best_cost, best_model, mut runs, noise) = match resume {
+        Some(r) => {
+            let best: Vec<f64> = r.parameters.iter().map(|p| p.best).collect();
+            let noise = r
+                .records
+                .iter()
+                .map(|rec| noise::Noise {
+                    sd: rec.noise_sd,
+                    correlation_points: rec.noise_correlation,
+                })
+                .collect();
+            let best_model = r.records.iter().map(|rec| rec.best.clone()).collect();
+            (best, r.best_cost, best_model, r.evaluations, noise)
+        }
+        None => {
+            let (best, best_cost, best_model, runs) =
+                least_squares(problem, settings, &pool, &scales, progress)?;
+            let noise: Vec<noise::Noise> = problem
+                .series
+                .iter()
+                .zip(&best_model)
+                .map(|(s, m)| {
+                    let r: Vec<f64> = s.y.iter().zip(m).map(|(y, m)| y - m).collect();
+                    noise::Noise::of_residuals(&r, d, problem.series.len())
+                })
+                .collect();
+            (best, best_cost, best_model, runs, noise)
+        }
     };
-    let mut starts = vec![vec![0.5; d]];
-    let lhs = crate::uq::latin_hypercube(4 * d, d, &mut crate::uq::Rng::new(settings.seed));
-    starts.extend(lhs);
-    let start_x: Vec<Vec<f64>> = starts.iter().map(|u| to_x(u)).collect();
-    progress("least squares", 0, starts.len());
-    let start_costs: Vec<f64> = models(problem, &pool, &start_x)
-        .iter()
-        .map(|m| cost(problem, &scales, m))
-        .collect();
-    runs += starts.len();
-    let (i0, c0) =
-        start_costs.iter().enumerate().fold(
-            (0, f64::INFINITY),
-            |b, (i, &c)| if c < b.1 { (i, c) } else { b },
-        );
-    if !c0.is_finite() {
-        return Err(Error::Input {
-            file: problem.scene.display().to_string(),
-            key: "--free".into(),
-            problem: "no run of the start design succeeded".into(),
-            allowed: "bounds within which the scene runs".into(),
-        });
-    }
-    let budget = match settings.max_least_squares_runs {
-        0 => 60 * d + 40,
-        n => n,
-    };
-    let mut evals = 0usize;
-    let mut objective = |u: &[f64]| {
-        evals += 1;
-        progress("least squares", evals, budget);
-        let outside: f64 = u.iter().map(|v| (v.clamp(0.0, 1.0) - v).abs()).sum();
-        let m = problem.model(&to_x(u));
-        cost(problem, &scales, &m) + 1e3 * outside
-    };
-    let (u_best, best_cost, used) = crate::calibrate::optimise::nelder_mead(
-        &mut objective,
-        &starts[i0],
-        &vec![0.1; d],
-        budget,
-        1e-10 * c0.max(1e-300),
-    );
-    runs += used;
-    let best = to_x(&u_best);
-    let best_model = problem.model(&best).ok_or_else(|| Error::Input {
-        file: problem.scene.display().to_string(),
-        key: "--free".into(),
-        problem: "the best fit's run failed".into(),
-        allowed: "bounds within which the scene runs".into(),
-    })?;
-    runs += 1;
-
-    // 2. The noise model of each series from the best fit's residuals.
-    let noise: Vec<noise::Noise> = problem
-        .series
-        .iter()
-        .zip(&best_model)
-        .map(|(s, m)| {
-            let r: Vec<f64> = s.y.iter().zip(m).map(|(y, m)| y - m).collect();
-            noise::Noise::of_residuals(&r, d, problem.series.len())
-        })
-        .collect();
     let log_prob = |theta: &[f64], m: &Option<Vec<Vec<f64>>>| -> f64 {
         let lp = problem.log_prior(theta);
         if !lp.is_finite() {
@@ -547,15 +718,104 @@ pub fn fit(
             .sum::<f64>()
     };
 
-    // 3. The posterior: an ensemble in a small ball around the best fit.
+    // A report of the chain so far (the bands left empty until the end).
+    let assemble = |chain: &mcmc::Chain,
+                    runs: usize,
+                    warnings: Vec<String>,
+                    bands: Option<&[(Vec<f64>, Vec<f64>)]>|
+     -> FitReport {
+        let burn = burn.min(chain.steps_done.saturating_sub(1));
+        let samples = chain.flat_after(burn);
+        let tau = mcmc::integrated_autocorr_time(chain, burn);
+        let ess = mcmc::effective_sample_size(chain, burn);
+        let records = problem
+            .series
+            .iter()
+            .enumerate()
+            .map(|(j, s)| {
+                let (xl, xu, yl, yu) = s.quantity.labels();
+                let (low, high) = bands.map_or((Vec::new(), Vec::new()), |b| b[j].clone());
+                let inside = if low.is_empty() {
+                    f64::NAN
+                } else {
+                    s.y.iter()
+                        .zip(low.iter().zip(&high))
+                        .filter(|(y, (l, h))| *y >= *l && *y <= *h)
+                        .count() as f64
+                        / s.y.len() as f64
+                };
+                FitRecord {
+                    name: s.record.clone(),
+                    x_label: xl.into(),
+                    x_unit: xu.into(),
+                    y_label: yl.into(),
+                    y_unit: yu.into(),
+                    x: s.x.clone(),
+                    y: s.y.clone(),
+                    best: best_model[j].clone(),
+                    band_low: low,
+                    band_high: high,
+                    noise_sd: noise[j].sd,
+                    noise_correlation: noise[j].correlation_points,
+                    inside_band: inside,
+                }
+            })
+            .collect();
+        let parameters = problem
+            .free
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let values: Vec<f64> = samples.iter().map(|s| s[i]).collect();
+                FitParameter {
+                    key: f.key.clone(),
+                    unit: f.unit.to_string(),
+                    min: f.min,
+                    max: f.max,
+                    prior_normal: problem
+                        .priors
+                        .iter()
+                        .find(|p| p.key == f.key)
+                        .map(|p| (p.mean, p.sd)),
+                    best: best[i],
+                    median: mcmc::quantile(&values, 0.5),
+                    band_90: mcmc::band_90(&values),
+                    tau_steps: tau[i],
+                    ess: ess[i],
+                }
+            })
+            .collect();
+        FitReport {
+            scene: problem.scene.display().to_string(),
+            residual: problem.residual.name().to_string(),
+            command_line: command_line.to_string(),
+            parameters,
+            walkers,
+            steps: chain.steps_done,
+            burn_in: burn,
+            chain: chain.positions.clone(),
+            log_prob: chain.log_prob.clone(),
+            correlations: mcmc::correlations(&samples),
+            acceptance: moved_fraction(chain),
+            evaluations: runs,
+            best_cost,
+            records,
+            warnings,
+        }
+    };
+
+    // 3. The posterior: an ensemble started in a small ball around the best fit.
     let scale: Vec<f64> = problem
         .free
         .iter()
         .map(|f| 1e-3 * (f.max - f.min))
         .collect();
-    let start = mcmc::initial_ball(&best, &scale, walkers, settings.seed, &|x| {
-        problem.inside(x)
-    });
+    let start = match resume {
+        Some(_) => Vec::new(),
+        None => mcmc::initial_ball(&best, &scale, walkers, settings.seed, &|x| {
+            problem.inside(x)
+        }),
+    };
     let sampler = mcmc::Settings {
         walkers,
         steps: settings.steps,
@@ -573,19 +833,24 @@ pub fn fit(
             .collect()
     };
     let mut stopped = false;
-    let chain = mcmc::sample(&sampler, &start, None, &batch, &mut |c| {
+    let mut saved: Result<()> = Ok(());
+    let every = (settings.steps / 20).max(1);
+    let chain = mcmc::sample(&sampler, &start, resume.map(chain_of), &batch, &mut |c| {
         progress("posterior", c.steps_done, settings.steps);
-        let go = keep_going();
+        if c.steps_done % every == 0 && c.steps_done < settings.steps && saved.is_ok() {
+            let so_far = runs + evaluated.load(std::sync::atomic::Ordering::Relaxed);
+            saved = checkpoint(&assemble(c, so_far, Vec::new(), None));
+        }
+        let go = keep_going() && saved.is_ok();
         stopped = !go;
         go
     });
+    saved?;
     runs += evaluated.into_inner();
     let steps_done = chain.steps_done;
-    let burn = burn.min(steps_done.saturating_sub(1));
-    let samples = chain.flat_after(burn);
-    let tau = mcmc::integrated_autocorr_time(&chain, burn);
-    let ess = mcmc::effective_sample_size(&chain, burn);
-    let correlations = mcmc::correlations(&samples);
+    let kept_burn = burn.min(steps_done.saturating_sub(1));
+    let samples = chain.flat_after(kept_burn);
+    let tau = mcmc::integrated_autocorr_time(&chain, kept_burn);
     let mut warnings = Vec::new();
     if stopped {
         warnings.push(format!(
@@ -593,7 +858,7 @@ pub fn fit(
             settings.steps
         ));
     }
-    let kept = steps_done - burn;
+    let kept = steps_done - kept_burn;
     if let Some(t) = tau
         .iter()
         .cloned()
@@ -621,82 +886,17 @@ pub fn fit(
         .flatten()
         .collect();
     runs += draws.len();
-    let records = problem
+    let bands: Vec<(Vec<f64>, Vec<f64>)> = problem
         .series
         .iter()
         .enumerate()
         .map(|(j, s)| {
-            let (xl, xu, yl, yu) = s.quantity.labels();
-            let (low, high) = noise[j].predictive_band(
+            noise[j].predictive_band(
                 predicted.iter().map(|m| m[j].as_slice()),
                 s.y.len(),
                 settings.seed.wrapping_add(j as u64),
-            );
-            let inside = if low.is_empty() {
-                f64::NAN
-            } else {
-                s.y.iter()
-                    .zip(low.iter().zip(&high))
-                    .filter(|(y, (l, h))| *y >= *l && *y <= *h)
-                    .count() as f64
-                    / s.y.len() as f64
-            };
-            FitRecord {
-                name: s.record.clone(),
-                x_label: xl.into(),
-                x_unit: xu.into(),
-                y_label: yl.into(),
-                y_unit: yu.into(),
-                x: s.x.clone(),
-                y: s.y.clone(),
-                best: best_model[j].clone(),
-                band_low: low,
-                band_high: high,
-                noise_sd: noise[j].sd,
-                noise_correlation: noise[j].correlation_points,
-                inside_band: inside,
-            }
+            )
         })
         .collect();
-    let parameters = problem
-        .free
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let values: Vec<f64> = samples.iter().map(|s| s[i]).collect();
-            FitParameter {
-                key: f.key.clone(),
-                unit: f.unit.to_string(),
-                min: f.min,
-                max: f.max,
-                prior_normal: problem
-                    .priors
-                    .iter()
-                    .find(|p| p.key == f.key)
-                    .map(|p| (p.mean, p.sd)),
-                best: best[i],
-                median: mcmc::quantile(&values, 0.5),
-                band_90: mcmc::band_90(&values),
-                tau_steps: tau[i],
-                ess: ess[i],
-            }
-        })
-        .collect();
-    Ok(FitReport {
-        scene: problem.scene.display().to_string(),
-        residual: problem.residual.name().to_string(),
-        command_line: command_line.to_string(),
-        parameters,
-        walkers,
-        steps: steps_done,
-        burn_in: burn,
-        chain: chain.positions.clone(),
-        log_prob: chain.log_prob.clone(),
-        correlations,
-        acceptance: chain.acceptance_fraction(),
-        evaluations: runs,
-        best_cost,
-        records,
-        warnings,
-    })
+    Ok(assemble(&chain, runs, warnings, Some(&bands)))
 }

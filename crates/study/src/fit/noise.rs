@@ -15,33 +15,14 @@ pub struct Noise {
     pub correlation_points: f64,
 }
 
-/// Integrated autocorrelation time of a series, in samples: τ = 1 + 2 Σ_{k=1}^{M} ρ(k), the
-/// window M the first with M ≥ c τ(M), c = 5 (Sokal 1997, "Monte Carlo methods in statistical
-/// mechanics", §3); at least 1.
+/// Integrated autocorrelation time of a series, in samples: τ = 1 + 2 Σ_{k=1}^{M} ρ(k) with
+/// Sokal's automatic window (the sampler's estimator, [`super::mcmc::windowed_time`]); at least
+/// 1 (anticorrelated residuals are not counted as more than independent).
 pub fn autocorrelation_time(x: &[f64]) -> f64 {
-    let n = x.len();
-    if n < 4 {
+    if x.len() < 4 {
         return 1.0;
     }
-    let mean = x.iter().sum::<f64>() / n as f64;
-    let c0: f64 = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-    if c0 <= 0.0 {
-        return 1.0;
-    }
-    let mut tau = 1.0;
-    for k in 1..n / 2 {
-        let ck: f64 = x[..n - k]
-            .iter()
-            .zip(&x[k..])
-            .map(|(a, b)| (a - mean) * (b - mean))
-            .sum::<f64>()
-            / n as f64;
-        tau += 2.0 * ck / c0;
-        if k as f64 >= 5.0 * tau {
-            break;
-        }
-    }
-    tau.max(1.0)
+    super::mcmc::windowed_time(&super::mcmc::autocorrelation(x)).max(1.0)
 }
 
 impl Noise {
