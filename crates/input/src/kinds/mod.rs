@@ -308,7 +308,7 @@ const SPECIMEN: Key = Key {
     key: "specimen",
     unit: "",
     default: "required",
-    meaning: "the two spheres: pair = \"ss440c\" (a built-in material's 6.35 mm pair, or a pair .toml file), or [specimen.sphere1] and [specimen.sphere2] tables with material, diameter_m or radius_m, optional mass_kg",
+    meaning: "the two spheres: pair = \"ss440c\" (a built-in material's 6.35 mm pair, or a pair .toml file), or [specimen.sphere1] and [specimen.sphere2] tables with material, diameter_m or radius_m, optional mass_kg; yield_stress_pa (Pa), jc_c and jc_reference_rate_per_s (1/s) replace both spheres' material constants (σy, C, ε̇0 of paper Eq. 2)",
 };
 
 /// `[specimen]` of a scene with a chain of spheres (`chain`, `shpb`).
@@ -316,7 +316,7 @@ const CHAIN_SPECIMEN: Key = Key {
     key: "specimen",
     unit: "",
     default: "required",
-    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2)",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2); yield_stress_pa (Pa), jc_c and jc_reference_rate_per_s (1/s) replace every sphere's material constants (σy, C, ε̇0 of paper Eq. 2)",
 };
 
 /// `law = "..."`.

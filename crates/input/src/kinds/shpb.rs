@@ -41,7 +41,7 @@ const SPECIMEN: Key = Key {
     key: "specimen",
     unit: "",
     default: "required",
-    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2), each contact seated touching (default), across gap_m (m, to 1 mm) or pressed by preload_n (N, to 10 kN); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio)",
+    meaning: "the spheres in a line, sphere 1 first: count = N (2 to 100000) with material (built-in or .toml) and diameter_m, or one [[specimen.sphere]] table per sphere (material, diameter_m or radius_m, optional mass_kg), or a pair as in the other scenes (pair = \"ss440c\", or sphere1/sphere2), each contact seated touching (default), across gap_m (m, to 1 mm) or pressed by preload_n (N, to 10 kN), yield_stress_pa (Pa), jc_c and jc_reference_rate_per_s (1/s) replacing every sphere's material constants (σy, C, ε̇0 of paper Eq. 2); or an elastic cylinder: shape = \"cylinder\" with length_m and diameter_m (m, each at most 0.1) and material (built-in name, material .toml, or a table of density_kg_m3, youngs_modulus_pa, poisson_ratio), its flow by [specimen.johnson_cook] (a_pa, b_pa, n, c, …; a table without a_pa, b_pa and n is merged over the material's)",
 };
 
 fn parse(
