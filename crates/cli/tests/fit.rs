@@ -155,7 +155,7 @@ fn a_stopped_fit_resumed_gives_the_chain_of_the_fit_never_stopped() {
     assert!(shpb(dir.path(), &whole).status.success());
     // The same fit stopped by SIGINT once its checkpoint is written, then resumed.
     let args = fit_args(&scene, rec, &["-q", "-o", "part.h5"]);
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_shpb"))
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_shpb"))
         .args(&args)
         .current_dir(dir.path())
         .stderr(std::process::Stdio::piped())

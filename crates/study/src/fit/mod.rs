@@ -553,6 +553,9 @@ fn chain_moves(positions: &[f64], dim: usize, walkers: usize, steps: usize) -> V
     accepted
 }
 
+/// The least-squares best fit: the point, its cost, the model's series there, the runs made.
+type BestFit = (Vec<f64>, f64, Vec<Vec<f64>>, usize);
+
 /// The least-squares best fit on the unit cube of the bounds: the best of a start design (the
 /// centre and 4d points of a seeded Latin hypercube), then argmin's Nelder–Mead from it.
 /// Returns the best point, its cost, the model there and the runs made.
@@ -562,7 +565,7 @@ fn least_squares(
     pool: &rayon::ThreadPool,
     scales: &[f64],
     progress: Progress,
-) -> Result<(Vec<f64>, f64, Vec<Vec<f64>>, usize)> {
+) -> Result<BestFit> {
     let d = problem.free.len();
     let to_x = |u: &[f64]| -> Vec<f64> {
         problem
@@ -641,7 +644,7 @@ pub fn fit_resumable(
     let d = problem.free.len();
     let pool = crate::sweep::thread_pool(settings.jobs)?;
     let walkers = resolved_walkers(problem, settings);
-    if walkers % 2 != 0 || walkers < 2 * d {
+    if !walkers.is_multiple_of(2) || walkers < 2 * d {
         return Err(input_err(
             "--walkers",
             format!("{walkers} walkers for {d} free keys"),
@@ -837,7 +840,7 @@ pub fn fit_resumable(
     let every = (settings.steps / 20).max(1);
     let chain = mcmc::sample(&sampler, &start, resume.map(chain_of), &batch, &mut |c| {
         progress("posterior", c.steps_done, settings.steps);
-        if c.steps_done % every == 0 && c.steps_done < settings.steps && saved.is_ok() {
+        if c.steps_done.is_multiple_of(every) && c.steps_done < settings.steps && saved.is_ok() {
             let so_far = runs + evaluated.load(std::sync::atomic::Ordering::Relaxed);
             saved = checkpoint(&assemble(c, so_far, Vec::new(), None));
         }
