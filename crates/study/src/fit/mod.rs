@@ -162,8 +162,24 @@ pub fn read_record(
             diameter_m: c.diameter_m,
         });
     let bars = scene_bars(scene)?;
+    // Like is compared with like: the model's gauges are reduced as the record is, so the
+    // dispersion correction follows the model's bars. Elementary bars (the fast and standard
+    // presets) carry no dispersion, which a correction would wrongly take out of the model;
+    // the record is then reduced without it too, and what dispersion a real record has is the
+    // model's misfit (counted in the noise, §12.3). Dispersive bars: `shpb reduce`'s default.
+    let dispersive = match &params.params {
+        SceneParams::Pulse { options, .. } => {
+            options.dispersion != shpb_core::bar::Dispersion::None
+        }
+        _ => true,
+    };
     let choices = crate::api::RecordOptions {
         cylinder,
+        dispersion: if dispersive {
+            shpb_core::reduce::DispersionCorrection::default()
+        } else {
+            shpb_core::reduce::DispersionCorrection::None
+        },
         ..crate::api::RecordOptions::default()
     };
     // A run file carries its own set-up: given no --bars, as `shpb reduce` reads it.
@@ -603,25 +619,45 @@ fn least_squares(
         return Err(failed("no run of the start design succeeded"));
     }
     let budget = match settings.max_least_squares_runs {
-        0 => 60 * d + 40,
+        0 => 100 * d + 60,
         n => n,
     };
-    let mut evals = 0usize;
+    let evals = std::cell::Cell::new(0usize);
     let mut objective = |u: &[f64]| {
-        evals += 1;
-        progress("least squares", evals, budget);
+        evals.set(evals.get() + 1);
+        progress("least squares", evals.get(), budget);
         let outside: f64 = u.iter().map(|v| (v.clamp(0.0, 1.0) - v).abs()).sum();
         let m = problem.model(&to_x(u));
         cost(problem, scales, &m) + 1e3 * outside
     };
-    let (u_best, best_cost, used) = crate::calibrate::optimise::nelder_mead(
-        &mut objective,
-        &starts[i0],
-        &vec![0.1; d],
-        budget,
-        1e-10 * c0.max(1e-300),
-    );
-    runs += used + 1;
+    // Nelder–Mead restarted from its best point with a fresh simplex (half the steps each time)
+    // while a restart still lowers the cost by more than 1e-6 of it: a simplex stalls on the
+    // long curved valleys correlated constants make (A, B and n of Johnson–Cook).
+    let (mut u_best, mut best_cost) = (starts[i0].clone(), c0);
+    let mut step = 0.1;
+    for _ in 0..4 {
+        let left = budget.saturating_sub(evals.get());
+        if left <= d + 1 {
+            break;
+        }
+        let (u, c, used) = crate::calibrate::optimise::nelder_mead(
+            &mut objective,
+            &u_best,
+            &vec![step; d],
+            left,
+            1e-10 * c0.max(1e-300),
+        );
+        runs += used;
+        let gained = best_cost - c;
+        if c < best_cost {
+            (u_best, best_cost) = (u, c);
+        }
+        if gained <= 1e-6 * best_cost {
+            break;
+        }
+        step *= 0.5;
+    }
+    runs += 1;
     let best = to_x(&u_best);
     let best_model = problem
         .model(&best)
