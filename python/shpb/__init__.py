@@ -21,6 +21,7 @@ import contextlib
 import errno
 import functools
 import html
+import json
 import os
 import time
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
@@ -43,6 +44,8 @@ __all__ = [
     "sweep",
     "study",
     "Study",
+    "fit",
+    "Fit",
     "__version__",
 ]
 
@@ -725,3 +728,259 @@ def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List
         e.parts = [f.result() for f in futures if f.done() and f.status == "finished"]
         raise
     return list(client.gather(futures))
+
+
+class Fit:
+    """What :func:`fit` found (``shpb fit``; docs/physics.md §11): each free key's best fit and
+    posterior, the sampler's chain and each record with the model and its predictive band::
+
+        f = shpb.fit("scenes/force-driven-ss440c-10psi.toml",
+                     {"specimen.yield_stress_pa": ("1.2GPa", "2.6GPa"), "specimen.jc_c": (0, 0.1)})
+        f.parameters["specimen.yield_stress_pa"]["value"]     # Pa, the least-squares best fit
+        f.parameters["specimen.yield_stress_pa"]["band_90"]   # [5 %, 95 %] posterior quantiles
+        f.samples                                             # numpy [n, keys], after burn-in
+    """
+
+    def __init__(self, data: "_shpb.FitData") -> None:
+        self._data = data
+        self._json: Dict[str, Any] = json.loads(data.json())
+        self.keys: List[str] = list(data.keys())
+        """The free keys, in the order of the last axis of :attr:`samples` and :attr:`chain`."""
+        self.parameters: Dict[str, Dict[str, Any]] = {
+            k: self._json["parameters"][k] for k in self.keys
+        }
+        """Key → ``value`` (least-squares best fit), ``unit``, ``band_90`` ``[low, high]``
+        (5 % and 95 % posterior quantiles), ``median``, ``min``, ``max`` (the bounds),
+        ``prior_normal`` (``[mean, sd]`` or None), ``tau_steps`` (integrated autocorrelation
+        time) and ``ess`` (effective sample size): the ``parameters`` of ``shpb fit --json``
+        (None for a number that is not finite)."""
+        steps, walkers, p = data.shape()
+        self.chain: np.ndarray = data.chain().reshape(steps, walkers, p)
+        """Every walker's position at every step, ``[steps, walkers, keys]`` (SI units)."""
+        self.log_prob: np.ndarray = data.log_prob().reshape(steps, walkers)
+        """The log posterior of each position of :attr:`chain`, ``[steps, walkers]``."""
+        self.samples: np.ndarray = data.samples().reshape(-1, p)
+        """The chain after the burn-in, ``[(steps − burn_in) × walkers, keys]``, step by step."""
+        self.burn_in: int = data.burn_in
+        """Steps of :attr:`chain` dropped as burn-in."""
+        self.correlations: np.ndarray = np.asarray(data.correlations(), dtype=np.float64).reshape(p, p)
+        """The posterior Pearson correlations ``[keys, keys]`` (after the burn-in)."""
+        self.records: List[Dict[str, Any]] = list(data.records())
+        """Each record fitted: ``name``, ``x_label``, ``x_unit``, ``y_label``, ``y_unit``, numpy
+        ``x``, ``y`` (the record), ``best`` (the model at the best fit), ``band_low``,
+        ``band_high`` (the 90 % posterior-predictive band, empty when none), ``noise_sd`` (y
+        units), ``noise_correlation`` (points) and ``inside_band`` (fraction of points)."""
+        self.warnings: List[str] = list(data.warnings())
+        """What the fit warned about (as ``shpb fit`` prints them): a chain shorter than 10
+        autocorrelation times, an interrupted sampler, …"""
+
+    def to_json(self) -> Dict[str, Any]:
+        """The object ``shpb fit --json`` prints (a new dict each call)."""
+        return json.loads(self._data.json())
+
+    def save(self, path: PathLike, force: bool = False) -> None:
+        """Writes the fit file of ``shpb fit -o PATH`` (HDF5); an existing file is refused unless
+        ``force``, the scene and records never overwritten."""
+        self._data.save(os.fspath(path), bool(force))
+
+    def _repr_html_(self) -> str:
+        rows = "".join(
+            f"<tr><td>{html.escape(k)}</td><td>{_g(p['value'])}</td><td>{_g(p['median'])}</td>"
+            f"<td>{_g(p['band_90'][0])} – {_g(p['band_90'][1])}</td>"
+            f"<td>{html.escape(p['unit'])}</td><td>{_g(p['ess'])}</td></tr>"
+            for k, p in self.parameters.items()
+        )
+        warnings = "".join(f"<li>{html.escape(w)}</li>" for w in self.warnings)
+        return (
+            f"<b>shpb.Fit</b> ({self._json['walkers']} walkers × {self._json['steps']} steps)"
+            "<table><tr><th>key</th><th>best</th><th>median</th><th>90 % interval</th>"
+            f"<th>unit</th><th>ESS</th></tr>{rows}</table>"
+            + (f"<ul>{warnings}</ul>" if warnings else "")
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"<shpb.Fit of {', '.join(self.keys)}: {self._json['walkers']} walkers × "
+            f"{self._json['steps']} steps>"
+        )
+
+
+def _g(v: Any) -> str:
+    return "–" if v is None else f"{v:.6g}"
+
+
+def _bound(key: str, v: Any) -> str:
+    """One bound of a free key as ``--free`` reads it: text with units as written, a number in
+    SI units (its shortest exact form)."""
+    if isinstance(v, str):
+        return v.strip()
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)):
+        raise InputError(
+            f"python: `free {key}`: {v!r} is not a bound; allowed: a number in SI units or text "
+            "with units, e.g. (1.2e9, 2.6e9) or ('8psi', '12psi')"
+        )
+    return repr(float(v))
+
+
+def _free_specs(free: Any) -> List[str]:
+    """``free`` as ``--free KEY=MIN:MAX`` texts: a dict {key: (min, max)}, a list of texts, or
+    one text."""
+    allowed = (
+        "{KEY: (MIN, MAX)} or ['KEY=MIN:MAX', …], e.g. {'specimen.yield_stress_pa': (1.2e9, 2.6e9)}"
+    )
+    if isinstance(free, str):
+        return [free]
+    if isinstance(free, Mapping):
+        specs = []
+        for key, bounds in free.items():
+            if not isinstance(key, str):
+                raise InputError(f"python: `free`: key {key!r} is not a string; allowed: {allowed}")
+            if isinstance(bounds, (str, bytes)) or not isinstance(bounds, Sequence) or len(bounds) != 2:
+                raise InputError(
+                    f"python: `free {key}`: {bounds!r} is not a (MIN, MAX) pair; allowed: {allowed}"
+                )
+            specs.append(f"{key}={_bound(key, bounds[0])}:{_bound(key, bounds[1])}")
+        return specs
+    if isinstance(free, Sequence) and all(isinstance(f, str) for f in free):
+        return list(free)
+    raise InputError(f"python: `free`: {free!r}; allowed: {allowed}")
+
+
+def _prior_specs(prior: Any) -> List[str]:
+    """``prior`` as ``--prior KEY=normal:MEAN:SD`` texts: a dict {key: ("normal", mean, sd)} (or
+    {key: "normal:MEAN:SD"}), a list of texts, or one text."""
+    allowed = "{KEY: ('normal', MEAN, SD)} or ['KEY=normal:MEAN:SD', …] (SI units, SD > 0)"
+    if prior is None:
+        return []
+    if isinstance(prior, str):
+        return [prior]
+    if isinstance(prior, Mapping):
+        specs = []
+        for key, p in prior.items():
+            if isinstance(p, str):
+                specs.append(f"{key}={p}")
+                continue
+            if not isinstance(p, Sequence) or len(p) != 3:
+                raise InputError(
+                    f"python: `prior {key}`: {p!r} is not ('normal', MEAN, SD); allowed: {allowed}"
+                )
+            kind, mean, sd = p
+            parts = [str(kind)] + [
+                repr(_number(f"prior {key}", x, allowed)) if not isinstance(x, str) else x
+                for x in (mean, sd)
+            ]
+            specs.append(f"{key}={':'.join(parts)}")
+        return specs
+    if isinstance(prior, Sequence) and all(isinstance(p, str) for p in prior):
+        return list(prior)
+    raise InputError(f"python: `prior`: {prior!r}; allowed: {allowed}")
+
+
+def fit(
+    scene: PathLike,
+    free: Union[Mapping[str, Tuple[Any, Any]], Sequence[str], str],
+    *,
+    prior: Union[Mapping[str, Any], Sequence[str], str, None] = None,
+    record: Union[PathLike, Sequence[PathLike], None] = None,
+    residual: Optional[str] = None,
+    walkers: Optional[int] = None,
+    steps: int = 200,
+    burn_in: Optional[int] = None,
+    seed: int = 1,
+    jobs: Optional[int] = None,
+    output: Optional[PathLike] = None,
+    plot: Optional[PathLike] = None,
+    corner: Optional[PathLike] = None,
+    force: bool = False,
+) -> Fit:
+    """Fits free scene keys to records as ``shpb fit`` does (docs/physics.md §11): least
+    squares, a noise model from the best fit's residuals, then the posterior sampled by an
+    affine-invariant ensemble sampler; returns the :class:`Fit`. For the same arguments and
+    ``seed`` the result is the command line's, whatever ``jobs``.
+
+    ``scene``: a scene ``.toml`` file (a dict scene is not taken: the fit reruns the file).
+    ``free``: ``{KEY: (MIN, MAX)}`` (numbers in SI units, or text with units as ``--free`` takes
+    it: ``("8psi", "12psi")``) or a list of ``"KEY=MIN:MAX"`` (``--free``); keys as ``--set``
+    names them, and the fit's own ``time_shift_s``. ``prior``: ``{KEY: ("normal", MEAN, SD)}`` or
+    a list of ``"KEY=normal:MEAN:SD"`` (``--prior``, SI units). ``record``: a file or a list of
+    files (``--record``: raw gauge records or run files reduced through the scene's set-up, or
+    reduced curves as CSV); None: the scene's own record. ``residual``: ``"force-time"``,
+    ``"force-approach"``, ``"stress-strain"`` or ``"strains"`` (``--residual``; default by the
+    scene). ``walkers`` (even, ≥ 2 × keys; default max(16, 4 × keys)), ``steps``, ``burn_in``
+    (default a quarter of ``steps``), ``seed``, ``jobs`` (threads; default one per core): the
+    sampler's settings. ``output`` (``.h5``), ``plot`` and ``corner`` (``.png``): the files of
+    ``-o``, ``--plot``, ``--corner``, checked before the fit and written after it; an existing
+    file is refused (:class:`InputError`) unless ``force``.
+
+    Bad input raises :class:`InputError` (a ``ValueError``) naming the key or argument, a
+    missing scene or record ``FileNotFoundError``. The GIL is released during the fit. Ctrl-C
+    stops the sampler between steps (within one step's runs; the least squares before it runs
+    to its end) and raises ``KeyboardInterrupt`` with the fit of the steps done as ``e.fit`` (a
+    :class:`Fit` with a warning saying so); no output file is written then.
+    """
+    if isinstance(scene, Mapping):
+        raise TypeError(
+            "fit: `scene` must be a scene file path (the fit reruns the file with each value; a "
+            "dict scene is not taken)"
+        )
+    scene = os.fspath(scene)
+    specs = _free_specs(free)
+    priors = _prior_specs(prior)
+    if record is None:
+        records: List[str] = []
+    elif isinstance(record, (str, os.PathLike)):
+        records = [os.fspath(record)]
+    else:
+        records = [os.fspath(r) for r in record]
+    for r in records:
+        if os.path.isdir(r):
+            raise IsADirectoryError(errno.EISDIR, f"record {r}: a directory, not a file", r)
+        if not os.path.exists(r):
+            raise FileNotFoundError(errno.ENOENT, f"record {r}: {os.strerror(errno.ENOENT)}", r)
+    walkers = 0 if walkers is None else _whole("walkers", walkers, "an even number ≥ 2 × keys")
+    steps = _whole("steps", steps, "4 sampler steps or more")
+    if burn_in is not None:
+        burn_in = _whole("burn_in", burn_in, "fewer burn-in steps than steps")
+    seed = _whole("seed", seed, "a whole number from 0 to 18446744073709551615")
+    if jobs is not None:
+        jobs = _whole("jobs", jobs, "1 up to 4 worker threads per core of the machine")
+    paths = [None if p is None else os.fspath(p) for p in (output, plot, corner)]
+    line = _call(
+        "fit",
+        scene,
+        free=specs,
+        prior=priors or None,
+        record=records or None,
+        residual=residual,
+        walkers=walkers or None,
+        steps=steps,
+        burn_in=burn_in,
+        seed=seed,
+        jobs=jobs,
+        output=paths[0],
+        plot=paths[1],
+        corner=paths[2],
+        **({"force": True} if force else {}),
+    )
+    try:
+        data = _shpb.fit(
+            scene,
+            specs,
+            priors,
+            records,
+            residual,
+            walkers,
+            steps,
+            burn_in,
+            seed,
+            jobs,
+            *paths,
+            bool(force),
+            line,
+        )
+    except KeyboardInterrupt as e:
+        partial = getattr(e, "fit", None)
+        if partial is not None and not isinstance(partial, Fit):
+            e.fit = Fit(partial)
+        raise
+    return Fit(data)

@@ -26,6 +26,8 @@ use shpb_study::api::{self, Scene};
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
+mod fit;
+
 create_exception!(
     shpb,
     InputError,
@@ -989,6 +991,7 @@ fn _shpb(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", m.py().get_type::<InputError>())?;
     m.add("InstabilityError", m.py().get_type::<InstabilityError>())?;
     m.add_class::<RunData>()?;
+    m.add_class::<fit::FitData>()?;
     for f in [
         wrap_pyfunction!(run, m)?,
         wrap_pyfunction!(study_runs, m)?,
@@ -1001,6 +1004,7 @@ fn _shpb(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(sweep_table, m)?,
         wrap_pyfunction!(version, m)?,
         wrap_pyfunction!(is_hdf5, m)?,
+        wrap_pyfunction!(fit::fit, m)?,
     ] {
         m.add_function(f)?;
     }

@@ -88,7 +88,11 @@ pub fn parse_free(spec: &str) -> Result<Free> {
             Value::Float(v) => Ok((*v, crate::sweep::key_units(&axis.key), Reach::Number)),
             Value::Integer(v) => Ok((*v as f64, crate::sweep::key_units(&axis.key), Reach::Number)),
             Value::String(s) => match input_si(&axis.key, s) {
-                Some((v, "Pa")) => Ok((v, "Pa", Reach::Pressure)),
+                Some((v, "Pa")) if axis.key == "pressure" => Ok((v, "Pa", Reach::Pressure)),
+                // A number of the scene written with its unit (`1500MPa` for a `_pa` key).
+                Some((v, u)) if u == crate::sweep::key_units(&axis.key) => {
+                    Ok((v, u, Reach::Number))
+                }
                 _ => Err(input_err(
                     &flag,
                     format!("`{s}` is not a number"),
@@ -250,6 +254,14 @@ mod tests {
         assert!((g.min - 1e-4).abs() < 1e-12 && (g.max - 3e-4).abs() < 1e-12);
         let s = parse_free("specimen.yield_stress_pa=1.5e9:2.3e9").unwrap();
         assert_eq!((s.unit, s.reach), ("Pa", Reach::Number));
+        // A stress with its unit is still a number of the scene (only the gun's pressure is
+        // text in a scene).
+        let t = parse_free("specimen.yield_stress_pa=1500MPa:2300MPa").unwrap();
+        assert_eq!(
+            (t.min, t.max, t.unit, t.reach),
+            (1.5e9, 2.3e9, "Pa", Reach::Number)
+        );
+        assert!(parse_free("specimen.jc_c=1MPa:2MPa").is_err());
         assert_eq!(
             parse_free("time_shift_s=-1e-6:1e-6").unwrap().reach,
             Reach::TimeShift
