@@ -3,7 +3,7 @@
 use crate::error::{Error, Result, Validator};
 pub use shpb_core::striker::PSI_PA;
 
-/// Parses a pressure with unit: `10psi`, `68.9kPa`, `68948Pa`, `0.1MPa`, `1bar` (gauge pressure), to Pa.
+/// Parses a pressure with unit: `10psi`, `68.9kPa`, `68948Pa`, `0.1MPa`, `1.9GPa`, `1bar` (gauge pressure), to Pa.
 pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
     let t = text.trim();
     // The unit is the trailing run of letters (so exponents such as 1e5Pa stay in the number).
@@ -26,6 +26,8 @@ pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
         "Pa" => 1.0,
         "kPa" => 1e3,
         "MPa" => 1e6,
+        // Material constants (a yield stress, a modulus) are given in GPa too.
+        "GPa" => 1e9,
         "bar" => 1e5,
         "" => return Err(format!("`{text}` has no unit")),
         u => {
@@ -33,8 +35,8 @@ pub fn parse_pressure(text: &str) -> std::result::Result<f64, String> {
                 "mpa" if u == "mPa" => {
                     " (`mPa` is the millipascal; the megapascal is `MPa`, case matters)".to_string()
                 }
-                l @ ("psi" | "pa" | "kpa" | "mpa" | "bar") => {
-                    let exact = ["psi", "Pa", "kPa", "MPa", "bar"]
+                l @ ("psi" | "pa" | "kpa" | "mpa" | "gpa" | "bar") => {
+                    let exact = ["psi", "Pa", "kPa", "MPa", "GPa", "bar"]
                         .into_iter()
                         .find(|e| e.to_ascii_lowercase() == l)
                         .unwrap_or("");

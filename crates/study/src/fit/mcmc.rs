@@ -309,7 +309,9 @@ pub fn effective_sample_size(chain: &Chain, burn: usize) -> Vec<f64> {
     let n = (chain.walkers * chain.steps_done.saturating_sub(burn)) as f64;
     integrated_autocorr_time(chain, burn)
         .into_iter()
-        .map(|tau| n / tau)
+        // τ below 1 (a short chain's estimate, or anticorrelated steps) would claim more
+        // independent samples than were drawn: at most the samples kept.
+        .map(|tau| n / tau.max(1.0))
         .collect()
 }
 

@@ -96,7 +96,7 @@ pub fn parse_free(spec: &str) -> Result<Free> {
                 _ => Err(input_err(
                     &flag,
                     format!("`{s}` is not a number"),
-                    "a number, or a pressure with its unit (psi, kPa, MPa, bar)",
+                    "a number, or a pressure with its unit (psi, Pa, kPa, MPa, GPa, bar)",
                 )),
             },
             other => Err(input_err(
