@@ -659,7 +659,10 @@ fn main() -> Result<()> {
         w,
         "Per record: `fig4-fits.csv` and `fig4-predictions.csv`.\n"
     );
-    let _ = writeln!(w, "<!-- FINDINGS -->");
+    let _ = writeln!(
+        w,
+        "What the records support, and why the coverage is what it is: docs/physics.md §11.x \"Coverage of the intervals (sphere pair)\"."
+    );
     write(&dir.join("REPORT.md"), &md)?;
     eprintln!("wrote {} ({total_s:.0} s)", dir.join("REPORT.md").display());
     Ok(())
