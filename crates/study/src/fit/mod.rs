@@ -86,8 +86,11 @@ pub fn default_residual(params: &Params) -> Residual {
     }
 }
 
-/// The scene's own record: a force-driven scene whose CSV carries the measured approach.
-fn scene_record(params: &Params) -> Option<Observables> {
+/// The scene's own record: a force-driven scene whose CSV carries the measured approach, counted
+/// from its first sample (the model's approach starts at 0 under the drive's zero force; the
+/// Fig. 4 records start at an offset δ(0) of 5–58 µm, removed alike by `fig4-force-driven`,
+/// docs/physics.md §5).
+pub fn scene_record(params: &Params) -> Option<Observables> {
     match &params.params {
         SceneParams::ForceDriven {
             setup,
@@ -95,7 +98,7 @@ fn scene_record(params: &Params) -> Option<Observables> {
         } => Some(Observables {
             time_s: setup.drive.time_s.clone(),
             force_n: Some(setup.drive.force_n.clone()),
-            approach_m: Some(d.clone()),
+            approach_m: Some(d.iter().map(|v| v - d[0]).collect()),
             force_is_drive: true,
             ..Observables::default()
         }),
