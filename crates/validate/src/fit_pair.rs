@@ -1,5 +1,5 @@
 //! Coverage of the intervals of a sphere pair fit and the cross-prediction of the authors' Fig. 4
-//! records (issue 44; docs/physics.md §11.x "Coverage of the intervals (sphere pair)"): simulated
+//! records (issue 44; docs/physics.md §12.8 "Coverage of the intervals (sphere pair)"): simulated
 //! records (the model's approach at known constants plus Gaussian AR(1) noise, [`ar1_noise`])
 //! fitted by `shpb fit`'s engine ([`shpb_study::fit`]), and a fit's posterior draws run on the
 //! same material's other records ([`predict`]).
