@@ -2,7 +2,7 @@
 //! [`write_fit_hdf5`], read back by [`read_fit_hdf5`] to resume a fit or from Python), the
 //! `--json` object ([`fit_json`]), the corner plot of the posterior ([`corner_figure`]) and the
 //! records with the posterior-predictive band ([`records_figure`]). The statistics themselves
-//! (least squares, ensemble sampler, noise model) are docs/physics.md §11.
+//! (least squares, ensemble sampler, noise model) are docs/physics.md §12.
 //!
 //! Layout of the fit file (every number in SI units, `units` attributes on the datasets):
 //! - `/` attribute `shpb_version`.
@@ -34,7 +34,7 @@ use serde_json::{Value, json};
 use shpb_input::{Error, Result};
 use std::path::Path;
 
-/// One free parameter of a fit (docs/physics.md §11 once written).
+/// One free parameter of a fit (docs/physics.md §12.1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitParameter {
     /// Scene key, e.g. `specimen.yield_stress_pa`.

@@ -1,4 +1,4 @@
-//! `shpb._shpb.fit`: the binding of `shpb fit` (issue 44; docs/physics.md §11). The same steps as
+//! `shpb._shpb.fit`: the binding of `shpb fit` (issue 44; docs/physics.md §12). The same steps as
 //! `crates/cli/src/cmd/fit.rs`: the `--free`/`--prior`/`--residual` texts parsed by
 //! `shpb_study::fit::spec`, the outputs checked before the fit (`shpb_output::plan`), the
 //! `shpb_study::fit::Problem` and `shpb_study::fit::fit`, the outputs written by `shpb_output::fit`;

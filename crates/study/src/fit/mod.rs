@@ -1,4 +1,4 @@
-//! `shpb fit` (issue 44; docs/physics.md §11): the constants a record implies, with their
+//! `shpb fit` (issue 44; docs/physics.md §12): the constants a record implies, with their
 //! uncertainty. The free scene keys ([`spec::Free`]) are fitted by least squares (argmin's
 //! Nelder–Mead, [`crate::calibrate::optimise`]) to the records' series ([`observe`]); a noise
 //! model is then estimated from the best fit's residuals (each series' standard deviation and

@@ -1,4 +1,4 @@
-//! The noise model of a fit (docs/physics.md §11.3), estimated from the records: each series'
+//! The noise model of a fit (docs/physics.md §12.3), estimated from the records: each series'
 //! residual at the least-squares best fit gives the standard deviation of one point and the
 //! noise's correlation length (its integrated autocorrelation time in points, Sokal's automatic
 //! window), so that N correlated points weigh as N/τ independent ones in the Gaussian likelihood.

@@ -1,4 +1,4 @@
-//! What a record and a model run are compared on (docs/physics.md §11.2): the observables of
+//! What a record and a model run are compared on (docs/physics.md §12.2): the observables of
 //! either (times, force, approach, stress and strain, face strains), and the series of one
 //! residual: the record's points and the model's values at the same abscissae.
 

@@ -1,4 +1,4 @@
-//! What `shpb fit` is asked (docs/physics.md §11): the free keys with their bounds
+//! What `shpb fit` is asked (docs/physics.md §12): the free keys with their bounds
 //! (`--free KEY=MIN:MAX`), their priors (`--prior KEY=normal:MEAN:SD`) and the residual
 //! (`--residual`), checked once into these types.
 
