@@ -731,7 +731,7 @@ def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List
 
 
 class Fit:
-    """What :func:`fit` found (``shpb fit``; docs/physics.md §11): each free key's best fit and
+    """What :func:`fit` found (``shpb fit``; docs/physics.md §12): each free key's best fit and
     posterior, the sampler's chain and each record with the model and its predictive band::
 
         f = shpb.fit("scenes/force-driven-ss440c-10psi.toml",
@@ -893,7 +893,7 @@ def fit(
     corner: Optional[PathLike] = None,
     force: bool = False,
 ) -> Fit:
-    """Fits free scene keys to records as ``shpb fit`` does (docs/physics.md §11): least
+    """Fits free scene keys to records as ``shpb fit`` does (docs/physics.md §12): least
     squares, a noise model from the best fit's residuals, then the posterior sampled by an
     affine-invariant ensemble sampler; returns the :class:`Fit`. For the same arguments and
     ``seed`` the result is the command line's, whatever ``jobs``.
