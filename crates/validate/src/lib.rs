@@ -14,6 +14,7 @@ mod fig4_force;
 mod fig4_virtual;
 pub mod figure;
 pub mod fit_pair;
+pub mod fit_yao;
 pub mod gauge_records;
 mod hertz;
 mod inputs;

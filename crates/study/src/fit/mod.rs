@@ -41,6 +41,11 @@ pub struct Problem {
     /// How the gauge records were reduced: the model's virtual gauges are reduced alike
     /// (None: no gauge record; the run's own reduction or contact series is compared).
     pub reducer: Option<Reducer>,
+    /// For each series, the gauge record whose incident wave drives its model run (a scene with
+    /// `[incident_record]` fitted to raw gauge records: each record's model is driven by that
+    /// record's own incident wave, docs/physics.md §6.10); None: the scene's own drive. Series
+    /// of the same drive share one run.
+    pub drives: Vec<Option<PathBuf>>,
 }
 
 /// The reduction a fit's gauge records went through, applied alike to each run's virtual
@@ -132,6 +137,14 @@ fn scene_bars(scene: &Path) -> Result<PathBuf> {
     } else {
         PathBuf::from(bars)
     })
+}
+
+/// Whether a scene file has an `[incident_record]` table (a measured incident wave drives it).
+fn scene_has_incident_record(scene: &Path) -> Result<bool> {
+    let text = shpb_input::csv::read_text(scene)?;
+    Ok(text
+        .parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("incident_record")))
 }
 
 /// Reads one `--record`: a CSV with `time_s` and reduced quantities (a reduced curve), else a raw
@@ -278,12 +291,19 @@ impl Problem {
                 force_driven,
             )?);
         }
+        let mut drives = vec![None; series.len()];
         let mut reducer = None;
+        let record_driven = scene_has_incident_record(scene)?;
         for r in records {
             let (o, red) = read_record(scene, &params, r)?;
+            // A raw gauge record (not a reduced CSV, not a run file) drives its own model.
+            let drive = (record_driven && red.is_some() && !shpb_output::reduction::is_hdf5(r)?)
+                .then(|| std::path::absolute(r).unwrap_or_else(|_| r.clone()));
             reducer = reducer.or(red);
             let name = r.display().to_string();
-            series.extend(observe::series_of(&name, &o, residual, force_driven)?);
+            let s = observe::series_of(&name, &o, residual, force_driven)?;
+            drives.extend(std::iter::repeat_n(drive, s.len()));
+            series.extend(s);
         }
         Ok(Problem {
             scene: scene.to_path_buf(),
@@ -293,6 +313,7 @@ impl Problem {
             series,
             force_driven,
             reducer,
+            drives,
         })
     }
 
@@ -324,7 +345,37 @@ impl Problem {
         theta: &[f64],
         noise_seed: Option<u64>,
     ) -> Option<(RunOutput, Params, f64)> {
-        let (mut params, shift) = self.params_at(theta)?;
+        self.run_driven(theta, noise_seed, None)
+    }
+
+    /// [`Problem::run_at`] with the scene's `[incident_record]` file replaced by `drive` (a
+    /// gauge record, [`Problem::drives`]; None: the scene's own).
+    pub fn run_driven(
+        &self,
+        theta: &[f64],
+        noise_seed: Option<u64>,
+        drive: Option<&Path>,
+    ) -> Option<(RunOutput, Params, f64)> {
+        let (mut params, shift) = match drive {
+            None => self.params_at(theta)?,
+            Some(file) => {
+                let (_, shift) = self.params_at(theta)?;
+                let mut overrides: Vec<_> = self
+                    .free
+                    .iter()
+                    .zip(theta)
+                    .filter_map(|(f, &x)| f.value(x))
+                    .collect();
+                overrides.push((
+                    "incident_record.file".to_string(),
+                    toml::Value::String(file.display().to_string()),
+                ));
+                (
+                    Params::from_file_overridden(&self.scene, &overrides).ok()?,
+                    shift,
+                )
+            }
+        };
         if let SceneParams::Pulse {
             options, apparatus, ..
         } = &mut params.params
@@ -352,9 +403,20 @@ impl Problem {
     /// The model's values on every series at `theta` ([`Problem::run_at`] without noise; None
     /// when the scene refuses the values or the run fails: outside the posterior's support).
     pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
-        let (out, params, shift) = self.run_at(theta, None)?;
-        let m = self.observe(&out, &params)?;
-        self.series.iter().map(|s| s.model(&m, shift)).collect()
+        let mut values: Vec<Option<Vec<f64>>> = vec![None; self.series.len()];
+        for (i, drive) in self.drives.iter().enumerate() {
+            if values[i].is_some() {
+                continue;
+            }
+            let (out, params, shift) = self.run_driven(theta, None, drive.as_deref())?;
+            let m = self.observe(&out, &params)?;
+            for (j, s) in self.series.iter().enumerate() {
+                if self.drives[j] == *drive {
+                    values[j] = Some(s.model(&m, shift)?);
+                }
+            }
+        }
+        values.into_iter().collect()
     }
 
     /// Whether `theta` lies inside every bound.
