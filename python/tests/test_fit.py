@@ -89,7 +89,7 @@ def test_arrays_have_the_fit_file_layout(two_threads):
         assert np.all((f.samples[:, i] >= lo) & (f.samples[:, i] <= hi)), key
     assert np.all(np.isfinite(f.log_prob[burn:]))
     (rec,) = f.records
-    assert rec["name"] == "scene"
+    assert rec["name"] == "the scene's own record"
     n = len(rec["x"])
     assert n == j["records"][0]["points"] > 10
     for k in ["y", "best", "band_low", "band_high"]:
