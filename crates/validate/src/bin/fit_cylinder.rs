@@ -537,8 +537,8 @@ fn write_outputs(
          `fidelity = \"fast\"`). Coverage is a property of the statistics (the record's noise, \
          the noise model estimated from the best fit's residuals, the sampler), not of the \
          mesh: at `fast` the model is the exact forward model of the records, as at any \
-         preset when the record is simulated at that preset; the cost is {run_ms:.0} ms a run \
-         instead of ≈ 40 ms at `standard`.\n\n\
+         preset when the record is simulated at that preset. A model run (the run and the \
+         Reducer's reduction) took {run_ms:.0} ms of wall time here, on the shared machine.\n\n\
          Reduction's dispersion correction: {}.\n\n\
          Sampler: {} walkers, {} steps, burn-in {} steps, seeds 1 + i; least squares from the \
          default start design (Nelder–Mead, 280 runs at most). Each parameter's 90 % interval \
