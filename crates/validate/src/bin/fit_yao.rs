@@ -286,7 +286,7 @@ fn main() -> Result<()> {
          - **Free constants** (uniform priors): {}.\n\
          - **Sampler**: {WALKERS} walkers × {STEPS} steps, {BURN_IN} burn-in, seed {SEED}, \
          after a least-squares fit (Nelder–Mead, at most {LEAST_SQUARES_RUNS} runs, from the best of a 17-point start design); noise \
-         model from the best fit's residuals (docs/physics.md §11); the 90 % \
+         model from the best fit's residuals (docs/physics.md §12); the 90 % \
          posterior-predictive band from {DRAWS} posterior draws plus that noise.\n\
          - **Inside the band**: the fraction of the record's loading-branch points (the \
          residual's points, every sample up to the largest strain) whose stress lies inside \
