@@ -404,14 +404,17 @@ impl Problem {
     /// when the scene refuses the values or the run fails: outside the posterior's support).
     pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
         let mut values: Vec<Option<Vec<f64>>> = vec![None; self.series.len()];
-        for (i, drive) in self.drives.iter().enumerate() {
+        // A series without an entry in `drives` is driven by the scene's own drive.
+        let drive_of = |j: usize| self.drives.get(j).cloned().flatten();
+        for i in 0..self.series.len() {
             if values[i].is_some() {
                 continue;
             }
+            let drive = drive_of(i);
             let (out, params, shift) = self.run_driven(theta, None, drive.as_deref())?;
             let m = self.observe(&out, &params)?;
             for (j, s) in self.series.iter().enumerate() {
-                if self.drives[j] == *drive {
+                if drive_of(j) == drive {
                     values[j] = Some(s.model(&m, shift)?);
                 }
             }

@@ -150,6 +150,7 @@ fn base_problem(scene: &Path) -> Result<Problem> {
         series: Vec::new(),
         force_driven: false,
         reducer: Some(reducer),
+        drives: Vec::new(),
     })
 }
 
