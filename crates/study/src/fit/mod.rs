@@ -637,6 +637,98 @@ fn chain_moves(positions: &[f64], dim: usize, walkers: usize, steps: usize) -> V
     accepted
 }
 
+/// The residual vector whose squared norm is [`cost`]: each series' (y − m)/(scale √N).
+fn weighted_residuals(problem: &Problem, scales: &[f64], m: &[Vec<f64>]) -> Vec<f64> {
+    problem
+        .series
+        .iter()
+        .zip(m)
+        .zip(scales)
+        .flat_map(|((s, v), sc)| {
+            let w = 1.0 / (sc * (s.y.len() as f64).sqrt());
+            s.y.iter().zip(v).map(move |(y, v)| (y - v) * w)
+        })
+        .collect()
+}
+
+/// Levenberg–Marquardt (Marquardt 1963, SIAM J. Appl. Math. 11, 431: the damped Gauss–Newton
+/// step (JᵀJ + λ diag JᵀJ) δ = −Jᵀr, λ divided by 3 on success and multiplied by 4 on
+/// failure) on the unit cube, the Jacobian by forward differences of 10⁻³ (away from the
+/// nearer bound), its d runs in parallel on `pool`; at most `iterations` Jacobians. Returns the
+/// best point, its cost |r|² and the runs made. A failed run counts as an infinite cost.
+fn levenberg_marquardt(
+    residuals: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync),
+    pool: &rayon::ThreadPool,
+    u0: &[f64],
+    c0: f64,
+    iterations: usize,
+    progress: &mut dyn FnMut(usize),
+) -> (Vec<f64>, f64, usize) {
+    let d = u0.len();
+    let norm2 = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    let mut runs = 1;
+    let Some(mut r) = residuals(u0) else {
+        return (u0.to_vec(), f64::INFINITY, runs);
+    };
+    let (mut u, mut c) = (u0.to_vec(), norm2(&r).min(c0));
+    let mut lambda = 1e-3;
+    const H: f64 = 1e-3;
+    for _ in 0..iterations {
+        progress(runs);
+        let columns: Vec<Option<(f64, Vec<f64>)>> = pool.install(|| {
+            (0..d)
+                .into_par_iter()
+                .map(|k| {
+                    let h = if u[k] + H <= 1.0 { H } else { -H };
+                    let mut v = u.clone();
+                    v[k] += h;
+                    residuals(&v).map(|rk| (h, rk))
+                })
+                .collect()
+        });
+        runs += d;
+        let Some(columns) = columns.into_iter().collect::<Option<Vec<_>>>() else {
+            break;
+        };
+        let n = r.len();
+        let j = nalgebra::DMatrix::from_fn(n, d, |i, k| (columns[k].1[i] - r[i]) / columns[k].0);
+        let rv = nalgebra::DVector::from_column_slice(&r);
+        let a = j.transpose() * &j;
+        let g = j.transpose() * rv;
+        let mut improved = false;
+        for _ in 0..8 {
+            let mut m = a.clone();
+            for k in 0..d {
+                m[(k, k)] += lambda * a[(k, k)].max(1e-12);
+            }
+            let Some(step) = m.lu().solve(&(-&g)) else {
+                lambda *= 4.0;
+                continue;
+            };
+            let trial: Vec<f64> = u
+                .iter()
+                .zip(step.iter())
+                .map(|(x, s)| (x + s).clamp(0.0, 1.0))
+                .collect();
+            runs += 1;
+            match residuals(&trial) {
+                Some(rt) if norm2(&rt) < c => {
+                    let gain = c - norm2(&rt);
+                    (u, r, c) = (trial, rt.clone(), norm2(&rt));
+                    lambda = (lambda / 3.0).max(1e-9);
+                    improved = gain > 1e-10 * c;
+                    break;
+                }
+                _ => lambda *= 4.0,
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+    (u, c, runs)
+}
+
 /// The least-squares best fit: the point, its cost, the model's series there, the runs made.
 type BestFit = (Vec<f64>, f64, Vec<Vec<f64>>, usize);
 
@@ -690,6 +782,19 @@ fn least_squares(
         0 => 100 * d + 60,
         n => n,
     };
+    // Levenberg–Marquardt on the weighted residuals from the best start (it follows the long
+    // curved valleys correlated constants make, A, B and n of Johnson–Cook, where a simplex
+    // stalls), then Nelder–Mead restarted from its result with a fresh simplex (half the steps
+    // each time) while a restart still lowers the cost by more than 1e-6 of it.
+    let residuals = |u: &[f64]| -> Option<Vec<f64>> {
+        let m = problem.model(&to_x(u))?;
+        Some(weighted_residuals(problem, scales, &m))
+    };
+    let (lm_u, lm_cost, lm_runs) =
+        levenberg_marquardt(&residuals, pool, &starts[i0], c0, 25, &mut |k| {
+            progress("least squares", k, budget)
+        });
+    runs += lm_runs;
     let evals = std::cell::Cell::new(0usize);
     let mut objective = |u: &[f64]| {
         evals.set(evals.get() + 1);
@@ -698,10 +803,11 @@ fn least_squares(
         let m = problem.model(&to_x(u));
         cost(problem, scales, &m) + 1e3 * outside
     };
-    // Nelder–Mead restarted from its best point with a fresh simplex (half the steps each time)
-    // while a restart still lowers the cost by more than 1e-6 of it: a simplex stalls on the
-    // long curved valleys correlated constants make (A, B and n of Johnson–Cook).
-    let (mut u_best, mut best_cost) = (starts[i0].clone(), c0);
+    let (mut u_best, mut best_cost) = if lm_cost < c0 {
+        (lm_u, lm_cost)
+    } else {
+        (starts[i0].clone(), c0)
+    };
     let mut step = 0.1;
     for _ in 0..4 {
         let left = budget.saturating_sub(evals.get());
