@@ -207,15 +207,7 @@ pub fn predict(
             .sum::<f64>()
             / n)
             .sqrt();
-    let inside = if low.is_empty() {
-        f64::NAN
-    } else {
-        s.y.iter()
-            .zip(low.iter().zip(&high))
-            .filter(|(y, (l, h))| *y >= *l && *y <= *h)
-            .count() as f64
-            / n
-    };
+    let inside = shpb_study::fit::noise::inside_fraction(&s.y, &low, &high);
     Ok(Some(Prediction {
         time_s: s.x.clone(),
         measured_m: s.y.clone(),

@@ -948,15 +948,7 @@ pub fn fit_resumable(
             .map(|(j, s)| {
                 let (xl, xu, yl, yu) = s.quantity.labels();
                 let (low, high) = bands.map_or((Vec::new(), Vec::new()), |b| b[j].clone());
-                let inside = if low.is_empty() {
-                    f64::NAN
-                } else {
-                    s.y.iter()
-                        .zip(low.iter().zip(&high))
-                        .filter(|(y, (l, h))| *y >= *l && *y <= *h)
-                        .count() as f64
-                        / s.y.len() as f64
-                };
+                let inside = noise::inside_fraction(&s.y, &low, &high);
                 FitRecord {
                     name: s.record.clone(),
                     x_label: xl.into(),

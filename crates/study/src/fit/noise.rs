@@ -25,6 +25,19 @@ pub fn autocorrelation_time(x: &[f64]) -> f64 {
     super::mcmc::windowed_time(&super::mcmc::autocorrelation(x)).max(1.0)
 }
 
+/// The fraction of a record's points `y` inside a band [`low`, `high`] (NaN without a band):
+/// `inside_band` of a fit's records.
+pub fn inside_fraction(y: &[f64], low: &[f64], high: &[f64]) -> f64 {
+    if low.is_empty() || y.is_empty() {
+        return f64::NAN;
+    }
+    y.iter()
+        .zip(low.iter().zip(high))
+        .filter(|(y, (l, h))| *y >= *l && *y <= *h)
+        .count() as f64
+        / y.len() as f64
+}
+
 impl Noise {
     /// The noise of residuals `r` (record − best model) of one of `series` series of a fit with
     /// `free` free values: SD with the free values' degrees of freedom shared among the series,
