@@ -21,7 +21,8 @@
 //!   walkers, step by step (attributes `parameters` and `units` as on `/fit/chain`).
 //! - `/fit/correlations` `[parameters, parameters]`: the posterior Pearson correlations.
 //! - `/fit/records/<i>` one group per record (i = 0, 1, …), attributes `name`, `x_label`,
-//!   `x_unit`, `y_label`, `y_unit`, `noise_sd` (y units), `noise_correlation` (points) and
+//!   `x_unit`, `y_label`, `y_unit`, `noise_sd` (y units), `noise_correlation` (points),
+//!   `noise_calibration` (factor on the noise's variance from simulated records, 1: none) and
 //!   `inside_band` (fraction); datasets `x`, `y` (the record), `best` (the model at the best
 //!   fit), `band_low`, `band_high` (the 90 % posterior-predictive band, empty when none).
 //! - `/provenance` as a run file has it ([`crate::provenance`]), when given.
@@ -87,6 +88,8 @@ pub struct FitRecord {
     pub noise_sd: f64,
     /// Noise model: correlation length, points.
     pub noise_correlation: f64,
+    /// Noise model: factor on its variance σ²τ from simulated records (1: none).
+    pub noise_calibration: f64,
     /// Fraction of points inside the band.
     pub inside_band: f64,
 }
@@ -368,6 +371,7 @@ pub fn write_fit_hdf5(
             for (name, v) in [
                 ("noise_sd", rec.noise_sd),
                 ("noise_correlation", rec.noise_correlation),
+                ("noise_calibration", rec.noise_calibration),
                 ("inside_band", rec.inside_band),
             ] {
                 number_attr(&rg, name, v, path)?;
@@ -498,6 +502,8 @@ pub fn read_fit_hdf5(path: &Path) -> Result<FitReport> {
                 band_high: d("band_high")?,
                 noise_sd: n("noise_sd")?,
                 noise_correlation: n("noise_correlation")?,
+                // Files written before the calibration existed have none.
+                noise_calibration: n("noise_calibration").unwrap_or(1.0),
                 inside_band: n("inside_band")?,
             })
         })
@@ -579,6 +585,7 @@ pub fn fit_json(r: &FitReport) -> Value {
                 "y": {"label": rec.y_label, "unit": rec.y_unit},
                 "noise_sd": rec.noise_sd,
                 "noise_correlation": rec.noise_correlation,
+                "noise_calibration": rec.noise_calibration,
                 "inside_band": rec.inside_band,
                 "points": rec.x.len(),
             })
@@ -671,6 +678,28 @@ pub fn records_figure(path: &Path, force: bool, r: &FitReport) -> Result<()> {
     band_panels_figure(path, force, panels.len().clamp(1, 2), &panels)
 }
 
+/// The outputs of a fit, each when asked: `output` the fit file ([`write_fit_hdf5`]), `plot`
+/// the records with the best fit and band ([`records_figure`]), `corner` the marginal and
+/// pairwise posterior plots ([`corner_figure`]); refused if a file exists, unless `force`.
+pub fn write_fit_outputs(
+    r: &FitReport,
+    output: Option<&Path>,
+    plot: Option<&Path>,
+    corner: Option<&Path>,
+    force: bool,
+) -> Result<()> {
+    if let Some(p) = output {
+        write_fit_hdf5(p, force, r, None)?;
+    }
+    if let Some(p) = plot {
+        records_figure(p, force, r)?;
+    }
+    if let Some(p) = corner {
+        corner_figure(p, force, r)?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -747,6 +776,7 @@ mod tests {
                 best,
                 noise_sd: 150.0,
                 noise_correlation: 1.5,
+                noise_calibration: 1.7,
                 inside_band: 0.95,
             }],
             warnings: vec!["first warning".into(), "second warning".into()],

@@ -10,8 +10,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use shpb_input::{Error, Result};
 use shpb_output::atomic::{check_not_input, is_stdout};
-use shpb_output::fit::FitReport;
-use shpb_study::fit::spec::{Residual, parse_free, parse_prior};
+use shpb_output::fit::{FitReport, write_fit_outputs};
+use shpb_study::fit::spec::parse_flags;
 use shpb_study::fit::{Problem, Settings};
 use std::path::{Path, PathBuf};
 
@@ -74,7 +74,7 @@ impl FitData {
 
     /// Each record as a dict: `name`, the axes' `x_label`, `x_unit`, `y_label`, `y_unit`, the
     /// numpy arrays `x`, `y`, `best`, `band_low`, `band_high` and the noise model's `noise_sd`,
-    /// `noise_correlation` with `inside_band` (`shpb_output::fit::FitRecord`).
+    /// `noise_correlation`, `noise_calibration` with `inside_band` (`shpb_output::fit::FitRecord`).
     fn records<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         self.report
             .records
@@ -97,6 +97,7 @@ impl FitData {
                 }
                 d.set_item("noise_sd", r.noise_sd)?;
                 d.set_item("noise_correlation", r.noise_correlation)?;
+                d.set_item("noise_calibration", r.noise_calibration)?;
                 d.set_item("inside_band", r.inside_band)?;
                 Ok(d)
             })
@@ -202,15 +203,7 @@ pub fn fit(
         ..Settings::default()
     };
     let ((report, seconds, outputs), signal) = interruptible(py, |keep_going| {
-        let free = free
-            .iter()
-            .map(|f| parse_free(f))
-            .collect::<Result<Vec<_>>>()?;
-        let priors = prior
-            .iter()
-            .map(|p| parse_prior(p, &free))
-            .collect::<Result<Vec<_>>>()?;
-        let residual = residual.as_deref().map(Residual::parse).transpose()?;
+        let (free, priors, residual) = parse_flags(&free, &prior, residual.as_deref())?;
         let named = [
             (output.as_deref(), "output", &["h5", "hdf5"][..]),
             (plot.as_deref(), "plot", &["png"][..]),
@@ -253,16 +246,13 @@ pub fn fit(
         let r = &data.report;
         outputs.write(
             || {
-                if let Some(p) = &output {
-                    shpb_output::fit::write_fit_hdf5(p, force, r, None)?;
-                }
-                if let Some(p) = &plot {
-                    shpb_output::fit::records_figure(p, force, r)?;
-                }
-                if let Some(p) = &corner {
-                    shpb_output::fit::corner_figure(p, force, r)?;
-                }
-                Ok(())
+                write_fit_outputs(
+                    r,
+                    output.as_deref(),
+                    plot.as_deref(),
+                    corner.as_deref(),
+                    force,
+                )
             },
             |_| {},
         )

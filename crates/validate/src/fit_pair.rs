@@ -196,6 +196,7 @@ pub fn predict(
     let noise = Noise {
         sd: noise_sd,
         correlation_points: 1.0,
+        calibration: 1.0,
     };
     let (low, high) = noise.predictive_band(models.iter().map(Vec::as_slice), s.y.len(), seed);
     let peak = s.y.iter().cloned().fold(0.0, f64::max);

@@ -31,6 +31,7 @@ fn a_simulated_record_with_white_noise_gives_back_its_truth_and_noise() {
         jobs: 2,
         predictive_draws: 1,
         max_least_squares_runs: 0,
+        noise_draws: 64,
     };
     let r = fit(&problem, &settings, "test", &mut |_, _, _| {}, &|| true).unwrap();
     // The noise SD from the best fit's residuals: with N = 3844 points its standard error is

@@ -68,6 +68,7 @@ fn a_short_fit_returns_finite_intervals_holding_its_best_fit() {
         jobs: 2,
         predictive_draws: 2,
         max_least_squares_runs: 4,
+        noise_draws: 64,
     };
     let r = fit(&p, &settings, "test", &mut |_, _, _| {}, &|| true).unwrap();
     for q in &r.parameters {

@@ -5,7 +5,7 @@ use super::common::{ProgressLine, finite, report, warn};
 use shpb_input::Result;
 use shpb_output::atomic::check_not_input;
 use shpb_output::fit::FitReport;
-use shpb_study::fit::spec::{Residual, parse_free, parse_prior};
+use shpb_study::fit::spec::parse_flags;
 use shpb_study::fit::{Problem, Settings};
 use std::path::{Path, PathBuf};
 
@@ -35,17 +35,7 @@ pub struct FitOptions<'a> {
 
 /// `shpb fit SCENE --free KEY=MIN:MAX … [--prior …] [--record FILE …] [-o FIT.h5] [--json]`.
 pub fn fit(scene: &Path, o: &FitOptions) -> Result<()> {
-    let free = o
-        .free
-        .iter()
-        .map(|f| parse_free(f))
-        .collect::<Result<Vec<_>>>()?;
-    let priors = o
-        .prior
-        .iter()
-        .map(|p| parse_prior(p, &free))
-        .collect::<Result<Vec<_>>>()?;
-    let residual = o.residual.map(Residual::parse).transpose()?;
+    let (free, priors, residual) = parse_flags(o.free, o.prior, o.residual)?;
     let outputs = super::common::plan(
         o.force,
         &[
@@ -133,16 +123,7 @@ pub fn fit(scene: &Path, o: &FitOptions) -> Result<()> {
         warn(w);
     }
     super::common::write_all(&outputs, || {
-        if let Some(p) = o.output {
-            shpb_output::fit::write_fit_hdf5(p, o.force, &r, None)?;
-        }
-        if let Some(p) = o.plot {
-            shpb_output::fit::records_figure(p, o.force, &r)?;
-        }
-        if let Some(p) = o.corner {
-            shpb_output::fit::corner_figure(p, o.force, &r)?;
-        }
-        Ok(())
+        shpb_output::fit::write_fit_outputs(&r, o.output, o.plot, o.corner, o.force)
     })?;
     if let Some(c) = &checkpoint {
         // The fit is whole in its file: the checkpoint has served.

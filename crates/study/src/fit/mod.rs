@@ -337,8 +337,8 @@ impl Problem {
     }
 
     /// The run at `theta` as a fit makes it (with the set-up it ran with): without the bars' x–t snapshots (nobody reads them)
-    /// and, with `noise_seed` None, without the digitisers' noise (the noise model is the fit's
-    /// own, [`noise`]); with `Some(seed)` every channel's noise drawn from that seed (a
+    /// and, with `noise_seed` None, without the digitisers' noise and quantisation (the model is
+    /// the record's expectation; the noise model is the fit's own, [`noise`]); with `Some(seed)` every channel's noise drawn from that seed (a
     /// simulated record). Also the time shift.
     pub fn run_at(
         &self,
@@ -383,7 +383,13 @@ impl Problem {
             options.snapshot_interval_s = None;
             for (i, ch) in apparatus.gauges.channels.iter_mut().enumerate() {
                 match noise_seed {
-                    None => ch.digitiser.noise_rms_v = 0.0,
+                    // The model of a record is its expectation: no noise, and no quantisation
+                    // (the noise dithers a record's codes; a quantised model would be a
+                    // staircase in θ, rough at the code step, docs/physics.md §12.3).
+                    None => {
+                        ch.digitiser.noise_rms_v = 0.0;
+                        ch.digitiser.bits = 32;
+                    }
                     Some(seed) => ch.digitiser.seed = seed.wrapping_mul(31).wrapping_add(i as u64),
                 }
             }
@@ -403,6 +409,11 @@ impl Problem {
     /// The model's values on every series at `theta` ([`Problem::run_at`] without noise; None
     /// when the scene refuses the values or the run fails: outside the posterior's support).
     pub fn model(&self, theta: &[f64]) -> Option<Vec<Vec<f64>>> {
+        self.model_with(theta, None)
+    }
+
+    /// [`Problem::model`] with the digitisers' noise drawn from `noise_seed` (None: without it).
+    pub fn model_with(&self, theta: &[f64], noise_seed: Option<u64>) -> Option<Vec<Vec<f64>>> {
         let mut values: Vec<Option<Vec<f64>>> = vec![None; self.series.len()];
         // A series without an entry in `drives` is driven by the scene's own drive.
         let drive_of = |j: usize| self.drives.get(j).cloned().flatten();
@@ -411,7 +422,7 @@ impl Problem {
                 continue;
             }
             let drive = drive_of(i);
-            let (out, params, shift) = self.run_driven(theta, None, drive.as_deref())?;
+            let (out, params, shift) = self.run_driven(theta, noise_seed, drive.as_deref())?;
             let m = self.observe(&out, &params)?;
             for (j, s) in self.series.iter().enumerate() {
                 if drive_of(j) == drive {
@@ -468,6 +479,9 @@ pub struct Settings {
     pub predictive_draws: usize,
     /// Most forward runs of the least-squares search.
     pub max_least_squares_runs: usize,
+    /// Draws of the set-up's digitiser noise propagated through the reduction at the best fit
+    /// (gauge records only; 0: none), for the noise's whole-record modes ([`noise`]).
+    pub noise_draws: usize,
 }
 
 impl Default for Settings {
@@ -480,6 +494,7 @@ impl Default for Settings {
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             predictive_draws: 48,
             max_least_squares_runs: 0,
+            noise_draws: 64,
         }
     }
 }
@@ -494,6 +509,113 @@ fn models(
     points: &[Vec<f64>],
 ) -> Vec<Option<Vec<Vec<f64>>>> {
     pool.install(|| points.par_iter().map(|p| problem.model(p)).collect())
+}
+
+/// Relative step of each free value (of its range) for the model's directions of the noise's
+/// calibration: large enough that the reduced model's roughness in θ (its sample-grid steps)
+/// does not dominate the change.
+const CALIBRATION_STEP: f64 = 0.05;
+
+/// The noise model's calibration for gauge records ([`noise::calibration`], docs/physics.md
+/// §12.3): `settings.noise_draws` simulated records at the best fit `best` (the set-up's
+/// digitiser noise, seeds from the fit's seed apart from any record's, reduced and cut like the
+/// records), each one's residual against the noise-free model at its own points, and the
+/// model's directions there (a step of [`CALIBRATION_STEP`] of each free value's range). One
+/// factor per series (None: no gauge records, no digitiser noise in the set-up, or a run
+/// failed), and the runs made.
+fn calibrate_noise(
+    problem: &Problem,
+    settings: &Settings,
+    pool: &rayon::ThreadPool,
+    best: &[f64],
+    progress: Progress,
+) -> (Vec<Option<f64>>, usize) {
+    let none = (vec![None; problem.series.len()], 0);
+    if problem.reducer.is_none() || settings.noise_draws == 0 {
+        return none;
+    }
+    let noisy = problem
+        .params_at(best)
+        .is_some_and(|(p, _)| match &p.params {
+            SceneParams::Pulse { apparatus, .. } => apparatus
+                .gauges
+                .channels
+                .iter()
+                .any(|c| c.digitiser.noise_rms_v > 0.0),
+            _ => false,
+        });
+    if !noisy {
+        return none;
+    }
+    progress("noise model", 0, settings.noise_draws);
+    // The points the model's directions are taken at: the best fit and one step of each value.
+    let mut points = vec![best.to_vec()];
+    for (i, f) in problem.free.iter().enumerate() {
+        let step = CALIBRATION_STEP * (f.max - f.min);
+        let mut p = best.to_vec();
+        p[i] = if p[i] + step <= f.max {
+            p[i] + step
+        } else {
+            p[i] - step
+        };
+        points.push(p);
+    }
+    let drive_of = |j: usize| problem.drives.get(j).cloned().flatten();
+    let mut drives: Vec<Option<PathBuf>> = Vec::new();
+    for j in 0..problem.series.len() {
+        if !drives.contains(&drive_of(j)) {
+            drives.push(drive_of(j));
+        }
+    }
+    let observe = |theta: &[f64], seed: Option<u64>, drive: &Option<PathBuf>| {
+        let (out, params, shift) = problem.run_driven(theta, seed, drive.as_deref())?;
+        Some((problem.observe(&out, &params)?, shift))
+    };
+    let base = settings.seed ^ 0x6e6f_6973_6521_0000;
+    let mut factors = vec![None; problem.series.len()];
+    let mut runs = 0;
+    for drive in &drives {
+        let clean: Vec<Option<(Observables, f64)>> =
+            pool.install(|| points.par_iter().map(|p| observe(p, None, drive)).collect());
+        let simulated: Vec<Option<(Observables, f64)>> = pool.install(|| {
+            (0..settings.noise_draws as u64)
+                .into_par_iter()
+                .map(|k| observe(best, Some(base.wrapping_add(k)), drive))
+                .collect()
+        });
+        runs += points.len() + simulated.len();
+        let Some(clean) = clean.into_iter().collect::<Option<Vec<_>>>() else {
+            continue;
+        };
+        for (j, s) in problem.series.iter().enumerate() {
+            if drive_of(j) != *drive {
+                continue;
+            }
+            let records: Option<Vec<noise::SimulatedRecord>> = simulated
+                .iter()
+                .map(|o| {
+                    let (obs, _) = o.as_ref()?;
+                    let sim =
+                        observe::series_of(&s.record, obs, problem.residual, problem.force_driven)
+                            .ok()?
+                            .into_iter()
+                            .find(|x| x.quantity == s.quantity)?;
+                    let at: Vec<Vec<f64>> = clean
+                        .iter()
+                        .map(|(o, shift)| sim.model(o, *shift))
+                        .collect::<Option<_>>()?;
+                    let r = sim.y.iter().zip(&at[0]).map(|(y, m)| y - m).collect();
+                    let dirs = at[1..]
+                        .iter()
+                        .map(|m| m.iter().zip(&at[0]).map(|(a, b)| a - b).collect())
+                        .collect();
+                    Some((r, dirs))
+                })
+                .collect();
+            factors[j] = records.and_then(|r| noise::calibration(&r, problem.free.len()));
+        }
+    }
+    (factors, runs)
 }
 
 /// The least-squares cost of model values `m` against the series, each series weighted by
@@ -890,30 +1012,36 @@ pub fn fit_resumable(
     let (best, best_cost, best_model, mut runs, noise) = match resume {
         Some(r) => {
             let best: Vec<f64> = r.parameters.iter().map(|p| p.best).collect();
+            let best_model: Vec<Vec<f64>> = r.records.iter().map(|rec| rec.best.clone()).collect();
             let noise = r
                 .records
                 .iter()
                 .map(|rec| noise::Noise {
                     sd: rec.noise_sd,
                     correlation_points: rec.noise_correlation,
+                    calibration: rec.noise_calibration,
                 })
                 .collect();
-            let best_model = r.records.iter().map(|rec| rec.best.clone()).collect();
             (best, r.best_cost, best_model, r.evaluations, noise)
         }
         None => {
             let (best, best_cost, best_model, runs) =
                 least_squares(problem, settings, &pool, &scales, progress)?;
+            let (calibration, draws) = calibrate_noise(problem, settings, &pool, &best, progress);
             let noise: Vec<noise::Noise> = problem
                 .series
                 .iter()
                 .zip(&best_model)
-                .map(|(s, m)| {
+                .zip(&calibration)
+                .map(|((s, m), c)| {
                     let r: Vec<f64> = s.y.iter().zip(m).map(|(y, m)| y - m).collect();
-                    noise::Noise::of_residuals(&r, d, problem.series.len())
+                    noise::Noise {
+                        calibration: c.unwrap_or(1.0),
+                        ..noise::Noise::of_residuals(&r, d, problem.series.len())
+                    }
                 })
                 .collect();
-            (best, best_cost, best_model, runs, noise)
+            (best, best_cost, best_model, runs + draws, noise)
         }
     };
     let log_prob = |theta: &[f64], m: &Option<Vec<Vec<f64>>>| -> f64 {
@@ -962,6 +1090,7 @@ pub fn fit_resumable(
                     band_high: high,
                     noise_sd: noise[j].sd,
                     noise_correlation: noise[j].correlation_points,
+                    noise_calibration: noise[j].calibration,
                     inside_band: inside,
                 }
             })

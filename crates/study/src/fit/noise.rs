@@ -3,6 +3,12 @@
 //! noise's correlation length (its integrated autocorrelation time in points, Sokal's automatic
 //! window), so that N correlated points weigh as N/τ independent ones in the Gaussian likelihood.
 //! What the model cannot reproduce (its own error) is counted as noise: the intervals include it.
+//!
+//! A record reduced from gauges is noisy on both axes (a stress–strain record's strain is
+//! integrated from a noisy wave), which σ and τ of the stress residual alone under-count along
+//! the directions the model moves in. Such fits calibrate the noise on simulated records: the
+//! scene at the best fit run with the set-up's digitiser noise, reduced like the records, and
+//! their residuals projected on the model's directions ([`calibration`], docs/physics.md §12.3).
 
 use crate::uq::{Rng, normal_quantile, percentile};
 
@@ -13,6 +19,40 @@ pub struct Noise {
     pub sd: f64,
     /// Integrated autocorrelation time of the residual, points (1 for white noise).
     pub correlation_points: f64,
+    /// Factor on the likelihood's variance σ²τ from simulated records ([`calibration`]; 1:
+    /// none).
+    pub calibration: f64,
+}
+
+/// A simulated record for [`calibration`]: its residual at the truth and the model's directions
+/// at its points.
+pub type SimulatedRecord = (Vec<f64>, Vec<Vec<f64>>);
+
+/// The noise model's calibration from simulated records: for each record k its residual at the
+/// truth r_k and the model's directions v_i at its points (the change of the model for a step of
+/// each free value), the mean of (v_i·r_k)²/|v_i|² (the noise's variance along v_i) over the
+/// mean σ²τ of the r_k ([`Noise::of_residuals`]): how much more (> 1) or less the noise varies
+/// along the directions that decide the fit than the stationary model says. None without
+/// records or directions.
+pub fn calibration(records: &[SimulatedRecord], free: usize) -> Option<f64> {
+    let mut along = Vec::new();
+    let mut model = Vec::new();
+    for (r, dirs) in records {
+        let n = Noise::of_residuals(r, free, 1);
+        model.push(n.sd * n.sd * n.correlation_points);
+        for v in dirs {
+            let vv: f64 = v.iter().map(|a| a * a).sum();
+            if vv > 0.0 && v.len() == r.len() {
+                along.push(v.iter().zip(r).map(|(a, b)| a * b).sum::<f64>().powi(2) / vv);
+            }
+        }
+    }
+    if along.is_empty() || model.is_empty() {
+        return None;
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let c = mean(&along) / mean(&model);
+    c.is_finite().then_some(c)
 }
 
 /// Integrated autocorrelation time of a series, in samples: τ = 1 + 2 Σ_{k=1}^{M} ρ(k) with
@@ -49,14 +89,15 @@ impl Noise {
         Noise {
             sd: if sd > 0.0 { sd } else { f64::MIN_POSITIVE },
             correlation_points: autocorrelation_time(r),
+            calibration: 1.0,
         }
     }
 
     /// ln L of record `y` given model `m` under this noise, up to a constant:
-    /// −Σ (y − m)² / (2 σ² τ).
+    /// −Σ (y − m)² / (2 c σ² τ), c the calibration.
     pub fn log_likelihood(&self, y: &[f64], m: &[f64]) -> f64 {
         let ss: f64 = y.iter().zip(m).map(|(y, m)| (y - m).powi(2)).sum();
-        -ss / (2.0 * self.sd * self.sd * self.correlation_points)
+        -ss / (2.0 * self.calibration * self.sd * self.sd * self.correlation_points)
     }
 
     /// The 90 % posterior-predictive band (5 % and 95 % quantiles, point by point) of `models`
@@ -120,6 +161,7 @@ mod tests {
         let n = Noise {
             sd: 2.0,
             correlation_points: 1.0,
+            calibration: 1.0,
         };
         let m = vec![0.0; 2000];
         let (lo, hi) = n.predictive_band((0..40).map(|_| m.as_slice()), 2000, 3);
@@ -133,14 +175,44 @@ mod tests {
         let a = Noise {
             sd: 1.0,
             correlation_points: 1.0,
+            calibration: 1.0,
         };
         let b = Noise {
             sd: 1.0,
             correlation_points: 4.0,
+            calibration: 1.0,
         };
         let y = [1.0, 2.0];
         let m = [0.0, 0.0];
         assert_eq!(a.log_likelihood(&y, &m), -2.5);
         assert_eq!(b.log_likelihood(&y, &m), -2.5 / 4.0);
+    }
+
+    #[test]
+    fn the_calibration_finds_noise_the_stationary_model_misses() {
+        // Records of white noise (SD 1) plus a random offset of SD 0.1 over 400 points: along the
+        // constant direction the noise's variance is 1 + 400 × 0.01 = 5 where the stationary model
+        // (σ² ≈ 1.01, τ ≈ 1) says ≈ 1; along a direction orthogonal to constants (a ±1 square
+        // wave) the offset is invisible and the ratio is 1. Mean of 400 records: within 20 %
+        // (the projections are χ²₁: relative SD √2/√400 = 7 %).
+        let mut rng = Rng::new(5);
+        let n = 400;
+        let records = |dir: &[f64], rng: &mut Rng| -> Vec<SimulatedRecord> {
+            (0..400)
+                .map(|_| {
+                    let o = 0.1 * normal_quantile(rng.uniform());
+                    let r: Vec<f64> = (0..n).map(|_| o + normal_quantile(rng.uniform())).collect();
+                    (r, vec![dir.to_vec()])
+                })
+                .collect()
+        };
+        let flat = vec![1.0; n];
+        let c = calibration(&records(&flat, &mut rng), 0).unwrap();
+        assert!((c - 5.0).abs() < 1.0, "{c}");
+        let square: Vec<f64> = (0..n)
+            .map(|i| if (i / 20) % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        let c = calibration(&records(&square, &mut rng), 0).unwrap();
+        assert!((c - 1.0).abs() < 0.2, "{c}");
     }
 }

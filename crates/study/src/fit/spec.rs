@@ -238,6 +238,25 @@ impl Residual {
     }
 }
 
+/// The texts of `--free`, `--prior` and `--residual` parsed, as `shpb fit` and `shpb.fit` take
+/// them: the free keys, their priors and the residual (None: the scene's default).
+pub fn parse_flags(
+    free: &[String],
+    prior: &[String],
+    residual: Option<&str>,
+) -> Result<(Vec<Free>, Vec<Prior>, Option<Residual>)> {
+    let free = free
+        .iter()
+        .map(|f| parse_free(f))
+        .collect::<Result<Vec<_>>>()?;
+    let priors = prior
+        .iter()
+        .map(|p| parse_prior(p, &free))
+        .collect::<Result<Vec<_>>>()?;
+    let residual = residual.map(Residual::parse).transpose()?;
+    Ok((free, priors, residual))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

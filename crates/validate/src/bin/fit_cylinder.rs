@@ -49,6 +49,8 @@ struct Options {
     jobs: usize,
     diagnose: bool,
     no_dispersion: bool,
+    noise_check: bool,
+    truth_check: bool,
 }
 
 fn parse_options() -> Options {
@@ -60,6 +62,8 @@ fn parse_options() -> Options {
         jobs: 2,
         diagnose: false,
         no_dispersion: false,
+        noise_check: false,
+        truth_check: false,
     };
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
@@ -77,6 +81,16 @@ fn parse_options() -> Options {
             "--jobs" => o.jobs = next(i),
             "--diagnose" => {
                 o.diagnose = true;
+                i += 1;
+                continue;
+            }
+            "--truth-check" => {
+                o.truth_check = true;
+                i += 1;
+                continue;
+            }
+            "--noise-check" => {
+                o.noise_check = true;
                 i += 1;
                 continue;
             }
@@ -191,6 +205,7 @@ struct Row {
     acceptance: f64,
     noise_sd_pa: f64,
     noise_corr: f64,
+    noise_calibration: f64,
     wall_s: f64,
     runs: usize,
 }
@@ -233,6 +248,7 @@ fn fit_row(problem: &Problem, truth: [f64; 4], settings: &Settings) -> Result<Ro
         acceptance: report.acceptance,
         noise_sd_pa: report.records[0].noise_sd,
         noise_corr: report.records[0].noise_correlation,
+        noise_calibration: report.records[0].noise_calibration,
         wall_s: t0.elapsed().as_secs_f64(),
         runs: report.evaluations,
     })
@@ -245,6 +261,97 @@ fn show(k: usize, v: f64) -> String {
     } else {
         format!("{v:.4}")
     }
+}
+
+/// What a fit's noise model must describe, measured at the nominal constants (`--noise-check`):
+/// the reduced model's roughness in θ (the change of the model for relative steps of each
+/// constant, and its departure from the change the step of 10⁻³ predicts linearly), and, over
+/// 64 simulated records at the truth, the residual's variance along the model's +5 % directions
+/// against the stationary noise model's σ²τ (the factor the fit's calibration estimates).
+fn noise_check(base: &Problem, clean: &Problem, jobs: usize) -> Result<String> {
+    use rayon::prelude::*;
+    use shpb_study::fit::noise::Noise;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs)
+        .build()
+        .expect("a pool");
+    let m0 = clean
+        .model(&NOMINAL)
+        .expect("the nominal run")
+        .swap_remove(0);
+    let rms_of = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt()
+    };
+    let at = |k: usize, f: f64| {
+        let mut t = NOMINAL;
+        t[k] *= 1.0 + f;
+        clean.model(&t).expect("a run").swap_remove(0)
+    };
+    let mut out = String::new();
+    for (k, name) in NAMES.iter().enumerate() {
+        let m3 = at(k, 1e-3);
+        let line: Vec<String> = [1e-4, 1e-3, 1e-2, 5e-2]
+            .iter()
+            .map(|&f| {
+                let m = at(k, f);
+                let lin: Vec<f64> = m0
+                    .iter()
+                    .zip(&m3)
+                    .map(|(a, b)| a + (b - a) * f / 1e-3)
+                    .collect();
+                format!(
+                    "{f:.0e}: {:.3} MPa (off linear {:.3})",
+                    rms_of(&m, &m0) / 1e6,
+                    rms_of(&m, &lin) / 1e6
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "- The reduced model's change for relative steps of {} (RMS over the loading branch): {}.",
+            name,
+            line.join("; ")
+        );
+    }
+    let per: Vec<(Vec<f64>, f64)> = pool.install(|| {
+        (0..64u64)
+            .into_par_iter()
+            .filter_map(|k| {
+                let rec = record_problem(base, &NOMINAL, Some(7000 + k), "r").ok()?;
+                let y = &rec.series[0].y;
+                let m = rec.model(&NOMINAL)?.swap_remove(0);
+                let r: Vec<f64> = y.iter().zip(&m).map(|(a, b)| a - b).collect();
+                let nz = Noise::of_residuals(&r, 4, 1);
+                let proj: Vec<f64> = (0..4)
+                    .map(|j| {
+                        let mut t = NOMINAL;
+                        t[j] *= 1.05;
+                        let mj = rec.model(&t).expect("a run").swap_remove(0);
+                        let v: Vec<f64> = mj.iter().zip(&m).map(|(a, b)| a - b).collect();
+                        let vv: f64 = v.iter().map(|a| a * a).sum();
+                        v.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>().powi(2) / vv
+                    })
+                    .collect();
+                Some((proj, nz.sd * nz.sd * nz.correlation_points))
+            })
+            .collect()
+    });
+    let s_mean = per.iter().map(|p| p.1).sum::<f64>() / per.len() as f64;
+    let _ = writeln!(
+        out,
+        "- {} simulated records at the nominal constants: the residual's variance along the model's +5 % directions over the stationary noise model's σ²τ (mean {:.1} MPa²): {}.",
+        per.len(),
+        s_mean / 1e12,
+        (0..4)
+            .map(|j| format!(
+                "{} {:.2}",
+                NAMES[j],
+                per.iter().map(|p| p.0[j]).sum::<f64>() / per.len() as f64 / s_mean
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(out)
 }
 
 fn main() -> Result<()> {
@@ -268,8 +375,14 @@ fn main() -> Result<()> {
         jobs: o.jobs,
         predictive_draws: 4,
         max_least_squares_runs: 0,
+        noise_draws: 64,
     };
     let (wall0, cpu0) = (Instant::now(), cpu_s());
+    if o.noise_check {
+        let clean = record_problem(&base, &NOMINAL, None, "noise-free")?;
+        eprint!("{}", noise_check(&base, &clean, o.jobs)?);
+        return Ok(());
+    }
 
     // One run's cost at the nominal constants (noise-free).
     let t = Instant::now();
@@ -376,6 +489,40 @@ fn main() -> Result<()> {
             seed: 1 + i as u64,
             ..settings.clone()
         };
+        if o.truth_check {
+            // Least squares only: how far below the best fit's likelihood the truth's lies
+            // (2 Δln L ~ χ²₄ when the likelihood is right: mean 4, 95 % below 9.5).
+            let quick = Settings {
+                walkers: 8,
+                steps: 4,
+                predictive_draws: 1,
+                ..s.clone()
+            };
+            let row = fit_row(&problem, truth, &quick)?;
+            let y = &problem.series[0].y;
+            let mb = problem.model(&row.best).expect("a run").swap_remove(0);
+            let mt = problem.model(&truth).expect("a run").swap_remove(0);
+            let r: Vec<f64> = y.iter().zip(&mb).map(|(a, b)| a - b).collect();
+            let nz = shpb_study::fit::noise::Noise::of_residuals(&r, 4, 1);
+            let two_dl = 2.0 * (nz.log_likelihood(y, &mb) - nz.log_likelihood(y, &mt));
+            eprintln!(
+                "record {i:2}: 2Δln L(truth) {two_dl:.1} stationary, {:.1} calibrated (σ {:.3} MPa, τ {:.1} points, calibration {:.2}); best {}",
+                two_dl / row.noise_calibration,
+                nz.sd / 1e6,
+                nz.correlation_points,
+                row.noise_calibration,
+                (0..4)
+                    .map(|k| format!(
+                        "{} {} (truth {})",
+                        NAMES[k],
+                        show(k, row.best[k]),
+                        show(k, truth[k])
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            continue;
+        }
         let row = fit_row(&problem, truth, &s)?;
         eprintln!(
             "record {i:2}: inside {:?} τmax {:.1} kept {} {:.0} s",
@@ -385,6 +532,9 @@ fn main() -> Result<()> {
             row.wall_s
         );
         rows.push(row);
+    }
+    if o.truth_check {
+        return Ok(());
     }
     let wall = wall0.elapsed().as_secs_f64();
     let cpu = cpu_s() - cpu0;
@@ -412,7 +562,9 @@ fn write_outputs(
             ",{n}_true,{n}_best,{n}_median,{n}_low,{n}_high,{n}_inside,{n}_tau_steps"
         );
     }
-    csv.push_str(",kept_steps,acceptance,noise_sd_pa,noise_correlation_points,runs,wall_s\n");
+    csv.push_str(
+        ",kept_steps,acceptance,noise_sd_pa,noise_correlation_points,noise_calibration,runs,wall_s\n",
+    );
     for (i, r) in rows.iter().enumerate() {
         let _ = write!(csv, "{i},{}", 1000 + i);
         for k in 0..4 {
@@ -430,8 +582,14 @@ fn write_outputs(
         }
         let _ = writeln!(
             csv,
-            ",{},{:.3},{:e},{:.2},{},{:.1}",
-            r.kept, r.acceptance, r.noise_sd_pa, r.noise_corr, r.runs, r.wall_s
+            ",{},{:.3},{:e},{:.2},{:.3},{},{:.1}",
+            r.kept,
+            r.acceptance,
+            r.noise_sd_pa,
+            r.noise_corr,
+            r.noise_calibration,
+            r.runs,
+            r.wall_s
         );
     }
     std::fs::write(dir.join("records.csv"), csv).map_err(|e| io(e, "records.csv"))?;
@@ -586,10 +744,12 @@ fn write_outputs(
          steps, largest {tau_max:.1}; the chain kept ≥ 10 τ (kept steps after burn-in ≥ 10 × \
          the largest τ) in {ten_tau} of {n} records. Median acceptance {:.2}. Median noise of \
          the stress–strain record (the fit's noise model): SD {:.2} MPa a point, correlation \
-         {:.1} points. Median {:.0} forward runs and {:.0} s a fit.\n",
+         {:.1} points, calibration on 64 simulated records at the best fit (the factor on σ²τ, \
+         docs/physics.md §12.3) {:.2}. Median {:.0} forward runs and {:.0} s a fit.\n",
         med(&|r| r.acceptance),
         med(&|r| r.noise_sd_pa) / 1e6,
         med(&|r| r.noise_corr),
+        med(&|r| r.noise_calibration),
         med(&|r| r.runs as f64),
         med(&|r| r.wall_s),
     );

@@ -127,6 +127,7 @@ fn main() -> Result<()> {
         jobs: 2,
         predictive_draws: 48,
         max_least_squares_runs: 0,
+        noise_draws: 64,
     };
     let cov_settings = Settings {
         walkers: 8,
@@ -136,6 +137,7 @@ fn main() -> Result<()> {
         jobs: 1,
         predictive_draws: 1,
         max_least_squares_runs: 100,
+        noise_draws: 64,
     };
 
     // 1. The Fig. 4 records, each fitted alone.

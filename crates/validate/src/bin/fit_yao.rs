@@ -72,6 +72,7 @@ fn run_case(root: &Path, dir: &Path, samples: Vec<&'static str>) -> Result<Case>
         jobs: JOBS,
         predictive_draws: DRAWS,
         max_least_squares_runs: LEAST_SQUARES_RUNS,
+        noise_draws: 64,
     };
     let started = std::time::Instant::now();
     let mut last = String::new();
