@@ -10,7 +10,8 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// `shpb sweep`: refuses a sweep that cannot finish on the machine, validates every point first,
+/// `shpb sweep`: refuses a sweep that cannot finish on the machine, validates every point first
+/// (in parallel, on the pool of the runs),
 /// runs the unfinished ones with a progress bar and a checkpoint stamped with what the sweep
 /// belongs to, prints and writes the summary table. `--resume` continues the checkpoint of the
 /// same sweep (and refuses another's), and says so when the sweep is already complete.
@@ -24,8 +25,8 @@ pub fn sweep(
     force: bool,
 ) -> Result<()> {
     use shpb_study::sweep::{
-        Checkpoint, Outputs, check_points, checkpoint_path, estimate, parse_axes, parse_shard,
-        run_points, shard_points,
+        Checkpoint, Outputs, check_points_on, checkpoint_path, estimate, parse_axes, parse_shard,
+        run_points_on, shard_points,
     };
     shpb_study::sweep::check_jobs(jobs)?;
     let outputs = [output, csv, plot];
@@ -97,7 +98,9 @@ pub fn sweep(
     ))?;
     let total = plan.runs_total.expect("checked") as u64;
     let points = shard_points(&axes, k, n);
-    let files = check_points(scene, &axes, &points)?;
+    // One pool for the validation and the runs (issue 45: the points are validated in parallel).
+    let pool = shpb_study::sweep::thread_pool(jobs)?;
+    let files = check_points_on(&pool, scene, &axes, &points)?;
     out_plan.not_inputs(&files.iter().map(|f| f.path.clone()).collect::<Vec<_>>())?;
     let stamp = Stamp::new(
         scene,
@@ -229,15 +232,23 @@ pub fn sweep(
         .progress_chars("=> "),
     );
     let failed = std::sync::Mutex::new(None);
-    let new_rows = run_points(scene, &axes, &todo, jobs, |row| {
-        if let Some(c) = &checkpoint
-            && let Err(e) = c.record(row)
-        {
-            *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
-        }
-        done.fetch_add(1, Ordering::SeqCst);
-        bar.inc(1);
-    })?;
+    let new_rows = run_points_on(
+        &pool,
+        scene,
+        &axes,
+        &todo,
+        |row| {
+            if let Some(c) = &checkpoint
+                && let Err(e) = c.record(row)
+            {
+                *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+            }
+            done.fetch_add(1, Ordering::SeqCst);
+            bar.inc(1);
+        },
+        &|| true,
+    )?
+    .rows;
     bar.finish_and_clear();
     if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
