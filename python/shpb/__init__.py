@@ -546,9 +546,10 @@ def sweep(
     ``shpb sweep --set`` (``{"pressure": "5psi:20psi:16"}``).
 
     ``client``: a ``dask.distributed.Client`` (a ``LocalCluster``, a SLURM cluster of
-    dask-jobqueue, Kubernetes, ...). The sweep is then cut into ``shards`` shards (default: one
-    per worker), exactly as ``shpb sweep --shard k/n`` cuts it, each shard runs on a worker
-    (``jobs`` threads there) and the rows are put back in sweep order: the table is the one
+    dask-jobqueue, Kubernetes, ...). The sweep is then cut into ``shards`` shards (default: four
+    per worker requested, or one per 16 runs if more, fixed before any worker registers:
+    :func:`_plan_shards`), exactly as ``shpb sweep --shard k/n`` cuts it, each shard runs on a
+    worker (``jobs`` threads there) and the rows are put back in sweep order: the table is the one
     ``shpb sweep`` gives. Workers must see the scene and the files it names at the same path
     (a shared file system).
 
@@ -580,7 +581,9 @@ def sweep(
         keys, rows = _interruptible(_sweep_shard, path, specs, int(jobs), 1, 1)
     else:
         try:
-            parts = _on_cluster(client, _sweep_shard, shards, path, specs, int(jobs))
+            parts = _on_cluster(
+                client, _sweep_shard, shards, path, specs, int(jobs), points=_sweep_points(specs)
+            )
         except KeyboardInterrupt as e:
             done = getattr(e, "parts", [])
             if done:
@@ -646,8 +649,9 @@ def study(
     run, and the :class:`Study` holds the runs and their statistics.
 
     ``client``: a ``dask.distributed.Client``; the samples are then run in ``shards`` shards
-    (default one per worker, every n-th sample as ``--shard k/n`` cuts a sweep), and the study is
-    the one ``shpb study`` gives, bit for bit. Workers must see the scene at the same path.
+    (default as for :func:`sweep`, :func:`_plan_shards`; every n-th sample as ``--shard k/n``
+    cuts a sweep), and the study is the one ``shpb study`` gives, bit for bit. Workers must see
+    the scene at the same path.
 
     ``fidelity``: ``"fast"``, ``"standard"`` or ``"reference"`` for every run, in place of the
     scene's (``shpb study --fidelity``).
@@ -663,7 +667,7 @@ def study(
         rows = _interruptible(_study_shard, *args, 1, 1)
     else:
         try:
-            parts = _on_cluster(client, _study_shard, shards, *args)
+            parts = _on_cluster(client, _study_shard, shards, *args, points=int(samples))
         except KeyboardInterrupt as e:
             e.finished = sum(len(p) for p in getattr(e, "parts", []))
             raise
@@ -707,11 +711,71 @@ def _sweep_shard(
     return _shpb.sweep_runs(scene, specs, jobs, (k, n))
 
 
-def _on_cluster(client: Any, fn: Any, shards: Optional[int], *args: Any) -> List[Any]:
+#: Runs a shard holds at most by default once the points outnumber four shards a worker
+#: (:func:`_plan_shards`).
+SHARD_CHUNK = 16
+
+
+def _plan_shards(points: int, workers: int, chunk: int = SHARD_CHUNK) -> int:
+    """The default number of shards of ``points`` runs on a cluster of ``workers`` workers
+    requested (issue 45): max(4 × workers, ⌈points / chunk⌉), at most one shard a run and at
+    least one shard. It is fixed by the points and the workers asked for, not by the workers
+    registered when the shards are submitted: a cluster still starting (its workers queued in
+    SLURM, say) gets every worker busy as they arrive, where one shard per registered worker
+    gave a sweep submitted before them one shard on one worker. Four shards a worker balance
+    runs of unequal cost; any number gives the same table (the rows are put back in sweep
+    order)."""
+    points, workers, chunk = int(points), max(int(workers), 1), max(int(chunk), 1)
+    if points < 1:
+        return 1
+    return max(1, min(max(4 * workers, -(-points // chunk)), points))
+
+
+def _workers_requested(client: Any) -> int:
+    """The workers asked of ``client``'s cluster, started or not: the most of its ``plan`` (the
+    workers asked for, ``SpecCluster.plan``: ``LocalCluster``, dask-jobqueue, dask-kubernetes),
+    its ``requested`` (those launched) and the workers registered now (all a client of a
+    scheduler alone knows); at least 1."""
+    cluster = getattr(client, "cluster", None)
+    counts = [0]
+    for name in ("plan", "requested"):
+        try:
+            counts.append(len(getattr(cluster, name)))
+        except Exception:  # noqa: BLE001 (no such attribute, or not a collection)
+            pass
+    try:
+        counts.append(len(client.scheduler_info().get("workers", {})))
+    except Exception:  # noqa: BLE001 (a scheduler that does not answer: counted as none)
+        pass
+    return max(1, *counts)
+
+
+def _sweep_points(specs: Sequence[str]) -> int:
+    """The runs of a sweep of ``--set`` texts, counted as ``shpb sweep`` expands them
+    (``KEY=START:STOP:COUNT`` has COUNT values, ``KEY=V1,V2,…`` one per comma); a text it
+    would refuse counts 1 (the shard then reports the error)."""
+    total = 1
+    for spec in specs:
+        values = spec.split("=", 1)[1] if "=" in spec else ""
+        if ":" in values:
+            try:
+                count = int(values.split(":")[-1].strip())
+            except ValueError:
+                count = 1
+        else:
+            count = len(values.split(","))
+        total *= max(count, 1)
+    return total
+
+
+def _on_cluster(
+    client: Any, fn: Any, shards: Optional[int], *args: Any, points: int = 1
+) -> List[Any]:
     """Runs ``fn(*args, k, n)`` for the shards k = 1..n on a Dask ``client`` and gathers the
-    results (in shard order); ``n`` is ``shards`` or the number of workers."""
+    results (in shard order); ``n`` is ``shards`` or :func:`_plan_shards` of the ``points`` and
+    the workers requested (:func:`_workers_requested`)."""
     if shards is None:
-        shards = max(1, len(client.scheduler_info().get("workers", {})))
+        shards = _plan_shards(points, _workers_requested(client))
     n = int(shards)
     if n < 1:
         raise InputError(f"shards: {shards} (allowed: a whole number ≥ 1)")

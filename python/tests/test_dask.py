@@ -89,3 +89,84 @@ def test_ctrl_c_on_a_cluster_stops_promptly_and_keeps_finished_shards(client):
         p = list(e.table.inputs["pressure"][:3])
         local = shpb.sweep(SCENE, {"pressure": ",".join(f"{float(x)!r}Pa" for x in p)})
         assert np.allclose(local["peak_force"], e.table["peak_force"][:3], rtol=1e-9, atol=0)
+
+
+# Issue 45: the default number of shards is fixed by the points and the workers requested, not
+# by the workers registered when the shards are submitted.
+
+
+def test_the_shard_plan_is_a_function_of_points_and_workers_requested():
+    plan = shpb._plan_shards
+    # Four shards per worker requested while the shards hold at most 16 runs ...
+    assert plan(256, 2) == 16  # ⌈256 / 16⌉ = 16 > 4 × 2
+    assert plan(256, 8) == 32  # 4 × 8 = 32 > 16
+    assert plan(64, 1) == 4
+    # ... one per 16 runs beyond that, so a large sweep spreads over workers that arrive later.
+    assert plan(100_000, 4) == 6250
+    # Never more shards than runs, never fewer than one.
+    assert plan(6, 2) == 6
+    assert plan(1, 64) == 1
+    assert plan(0, 3) == 1
+    # A cluster whose workers are not there yet (0 requested) still gets ⌈points / 16⌉.
+    assert plan(256, 0) == 16
+    for points in range(1, 300):
+        for workers in (1, 2, 3, 64):
+            n = plan(points, workers)
+            assert 1 <= n <= points
+            # Every shard holds at most 16 runs unless 4 per worker already split finer.
+            assert -(-points // n) <= max(16, -(-points // (4 * workers)))
+
+
+def test_the_sweep_points_are_counted_as_shpb_sweep_expands_them():
+    assert shpb._sweep_points(["pressure=8psi:10psi:3", "specimen.pair=ss440c,ss302"]) == 6
+    assert shpb._sweep_points(["pressure=7psi"]) == 1
+    assert shpb._sweep_points(["a=1:2:16", "b=1,2,3,4", "fidelity=fast"]) == 64
+
+
+class _Cluster:
+    def __init__(self, plan):
+        self.plan = plan
+        self.requested = set()  # launched: none yet
+
+
+class _Client:
+    def __init__(self, requested, registered):
+        self.cluster = None if requested is None else _Cluster(requested)
+        self._registered = registered
+
+    def scheduler_info(self):
+        return {"workers": {f"w{i}": {} for i in range(self._registered)}}
+
+
+def test_workers_requested_count_before_they_register():
+    # A SLURM cluster with 8 workers asked for and none launched or registered yet: 8, not 0.
+    assert shpb._workers_requested(_Client({f"w{i}" for i in range(8)}, 0)) == 8
+    # More registered than asked for (workers started by hand): those registered.
+    assert shpb._workers_requested(_Client({"a"}, 3)) == 3
+    # A client of a scheduler alone: the workers registered; none: 1.
+    assert shpb._workers_requested(_Client(None, 3)) == 3
+    assert shpb._workers_requested(_Client(None, 0)) == 1
+    assert shpb._workers_requested(_Client(set(), 0)) == 1
+
+
+def test_a_sweep_submitted_before_its_workers_register_runs_in_planned_shards():
+    # A cluster asked for two workers that have not registered yet when the sweep is submitted:
+    # the sweep is still cut into the planned shards (4 × 2 = 8 for 6 runs → 6), not into one
+    # shard for the one worker or none present, and the table is the local one.
+    local = shpb.sweep(SCENE, SET, jobs=1)
+    with distributed.LocalCluster(
+        n_workers=0, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as c:
+        cluster.scale(2)
+        submitted = []
+        submit = c.submit
+
+        def counting_submit(fn, *args, **kwargs):
+            submitted.append(args[-2:])
+            return submit(fn, *args, **kwargs)
+
+        c.submit = counting_submit
+        table = shpb.sweep(SCENE, SET, client=c)
+    assert sorted(submitted) == [(k, 6) for k in range(1, 7)]
+    for name in local.keys():
+        assert np.array_equal(table[name], local[name]), name

@@ -278,3 +278,71 @@ fn the_fidelity_flag_is_a_one_value_fidelity_axis() {
     assert_eq!(both.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&both.stderr).contains("fidelity"));
 }
+
+/// Issue 45: with the points validated in parallel on the pool of the runs, a sweep on one thread
+/// and on two writes the same files: the CSV byte for byte, the study file's datasets and
+/// attributes bit for bit; and an invalid point late in the product is reported as the first
+/// invalid one in order, the same error at `-j 1` and `-j 2`, before any run.
+#[test]
+fn one_and_two_threads_write_the_same_rows_and_the_same_first_error() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let scene = scene();
+    let scene = scene.to_str().unwrap();
+    let set = [
+        "--set",
+        "fidelity=fast",
+        "--set",
+        "pressure=8psi:16psi:3",
+        "--set",
+        "shaper.thickness=0.35mm,0.5mm",
+    ];
+    for j in ["1", "2"] {
+        let (h5, csv) = (format!("j{j}.h5"), format!("j{j}.csv"));
+        let mut args = vec!["--quiet", "sweep", scene];
+        args.extend(set);
+        args.extend(["-j", j, "-o", &h5, "--csv", &csv]);
+        let o = shpb(dir.path(), &args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+    assert_eq!(read("j1.csv"), read("j2.csv"));
+    assert_eq!(read("j1.csv").iter().filter(|&&b| b == b'\n').count(), 7);
+    // Every dataset and attribute of the two study files, as h5dump prints them.
+    let dump = |name: &str| {
+        let o = std::process::Command::new("h5dump")
+            .arg(dir.path().join(name))
+            .output()
+            .unwrap();
+        assert!(o.status.success());
+        String::from_utf8(o.stdout).unwrap().replace(name, "FILE")
+    };
+    let (one, two) = (dump("j1.h5"), dump("j2.h5"));
+    assert!(one.contains("peak_force"), "{one}");
+    assert_eq!(one, two);
+    // Invalid shaper thicknesses at runs 4 and 5 of 6 (and a valid one after): the error names
+    // the first (-1 mm), at one thread and two, and nothing is written.
+    let mut errors = Vec::new();
+    for j in ["1", "2"] {
+        let o = shpb(
+            dir.path(),
+            &[
+                "--quiet",
+                "sweep",
+                scene,
+                "--set",
+                "fidelity=fast",
+                "--set",
+                "shaper.thickness=0.5mm,0.4mm,0.3mm,-1mm,-2mm,0.2mm",
+                "-j",
+                j,
+                "--csv",
+                "bad.csv",
+            ],
+        );
+        assert_eq!(o.status.code(), Some(2));
+        errors.push(String::from_utf8_lossy(&o.stderr).into_owned());
+        assert!(!dir.path().join("bad.csv").exists());
+    }
+    assert_eq!(errors[0], errors[1]);
+    assert!(errors[0].contains("-1 mm is out of range"), "{}", errors[0]);
+}

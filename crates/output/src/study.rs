@@ -148,83 +148,142 @@ impl StudyTable {
 /// Writes `table` to `path` in the layout of this module, atomically (refusing to replace an
 /// existing file unless `force`). Every column must have one value per run.
 pub fn write_study_hdf5(path: &Path, force: bool, table: &StudyTable) -> Result<()> {
-    if let Some(column) = table.ragged_column() {
-        return Err(Error::Hdf5 {
+    ragged(table, path)?;
+    write_atomically(path, force, |tmp| {
+        let f = crate::h5::create(tmp).map_err(h5err(path))?;
+        write_header_and_summary(&f, table, path)?;
+        let runs = f.create_group("runs").map_err(h5err(path))?;
+        for row in 0..table.len() {
+            write_run_group(&runs, table, row, path)?;
+        }
+        f.close().map_err(h5err(path))
+    })
+}
+
+/// [`write_study_hdf5`] with the `/runs/<index>` groups written while the runs go on (issue 45:
+/// the file's per-run work, HDF5's cost per group and attribute, leaves the serial end of a
+/// sweep). `produce` gets a sink that writes the groups of the rows of a table it is given (one
+/// finished run, its inputs in the form, SI number or text, of the whole table's columns) and
+/// returns the whole table, whose root attributes and `/summary` are then written. The file is
+/// written under a temporary name and appears only complete, as [`write_study_hdf5`]'s; the
+/// same layout, read back the same (groups and attributes are listed by name).
+pub fn write_study_hdf5_streamed<T>(
+    path: &Path,
+    force: bool,
+    produce: impl FnOnce(&mut dyn FnMut(&StudyTable) -> Result<()>) -> Result<(StudyTable, T)>,
+) -> Result<T> {
+    let mut produced = None;
+    write_atomically(path, force, |tmp| {
+        let f = crate::h5::create(tmp).map_err(h5err(path))?;
+        let runs = f.create_group("runs").map_err(h5err(path))?;
+        let mut written = 0usize;
+        let (table, value) = produce(&mut |rows: &StudyTable| {
+            ragged(rows, path)?;
+            for row in 0..rows.len() {
+                write_run_group(&runs, rows, row, path)?;
+            }
+            written += rows.len();
+            Ok(())
+        })?;
+        ragged(&table, path)?;
+        if written != table.len() {
+            return Err(Error::Hdf5 {
+                file: path.display().to_string(),
+                message: format!("{written} run groups written for {} runs", table.len()),
+            });
+        }
+        write_header_and_summary(&f, &table, path)?;
+        f.close().map_err(h5err(path))?;
+        produced = Some(value);
+        Ok(())
+    })?;
+    Ok(produced.expect("set once the file is written"))
+}
+
+/// An error naming the first column of `table` without one value per run.
+fn ragged(table: &StudyTable, path: &Path) -> Result<()> {
+    match table.ragged_column() {
+        Some(column) => Err(Error::Hdf5 {
             file: path.display().to_string(),
             message: format!(
                 "study column `{column}` does not have one value per run ({} runs)",
                 table.len()
             ),
-        });
+        }),
+        None => Ok(()),
     }
-    write_atomically(path, force, |tmp| {
-        let f = crate::h5::create(tmp).map_err(h5err(path))?;
-        string_attr(&f, "shpb_version", &table.shpb_version, path)?;
-        string_attr(&f, "scene", &table.scene, path)?;
-        string_attr(&f, "sweep", &table.sweep.join("\n"), path)?;
-        if let Some(id) = &table.identity {
-            write_identity(&f, id, path)?;
-        }
-        let s = f.create_group("summary").map_err(h5err(path))?;
-        let run: Vec<f64> = table.run.iter().map(|&i| i as f64).collect();
-        write_dataset(&s, "run", &run, "1", path)?;
-        for c in &table.results {
-            write_dataset(&s, &c.name, &c.values, &c.units, path)?;
-        }
-        let inputs = s.create_group("inputs").map_err(h5err(path))?;
-        let written = s.create_group("inputs_as_written").map_err(h5err(path))?;
-        for c in &table.inputs {
-            let text: Vec<VarLenUnicode> = c.values.iter().map(|v| vlu(v)).collect();
-            written
-                .new_dataset_builder()
-                .with_data(&text)
-                .create(c.key.as_str())
-                .map_err(h5err(path))?;
-            match &c.si {
-                Some((values, units)) => write_dataset(&inputs, &c.key, values, units, path)?,
-                None => {
-                    inputs
-                        .new_dataset_builder()
-                        .with_data(&text)
-                        .create(c.key.as_str())
-                        .map_err(h5err(path))?;
-                }
-            }
-        }
-        let warnings: Vec<VarLenUnicode> = (0..table.len())
-            .map(|i| vlu(table.warnings_of(i)))
-            .collect();
-        s.new_dataset_builder()
-            .with_data(&warnings)
-            .create("warnings")
+}
+
+/// The root attributes and `/summary` of a study file.
+fn write_header_and_summary(f: &hdf5::File, table: &StudyTable, path: &Path) -> Result<()> {
+    string_attr(f, "shpb_version", &table.shpb_version, path)?;
+    string_attr(f, "scene", &table.scene, path)?;
+    string_attr(f, "sweep", &table.sweep.join("\n"), path)?;
+    if let Some(id) = &table.identity {
+        write_identity(f, id, path)?;
+    }
+    let s = f.create_group("summary").map_err(h5err(path))?;
+    let run: Vec<f64> = table.run.iter().map(|&i| i as f64).collect();
+    write_dataset(&s, "run", &run, "1", path)?;
+    for c in &table.results {
+        write_dataset(&s, &c.name, &c.values, &c.units, path)?;
+    }
+    let inputs = s.create_group("inputs").map_err(h5err(path))?;
+    let written = s.create_group("inputs_as_written").map_err(h5err(path))?;
+    for c in &table.inputs {
+        let text: Vec<VarLenUnicode> = c.values.iter().map(|v| vlu(v)).collect();
+        written
+            .new_dataset_builder()
+            .with_data(&text)
+            .create(c.key.as_str())
             .map_err(h5err(path))?;
-        string_attr(&inputs, "order", &table.keys().join("\n"), path)?;
-        string_attr(&written, "order", &table.keys().join("\n"), path)?;
-        let runs = f.create_group("runs").map_err(h5err(path))?;
-        for (row, index) in table.run.iter().enumerate() {
-            let g = runs.create_group(&index.to_string()).map_err(h5err(path))?;
-            for c in &table.inputs {
-                match &c.si {
-                    Some((values, _)) => g
-                        .new_attr::<f64>()
-                        .shape(())
-                        .create(c.key.as_str())
-                        .and_then(|at| at.write_scalar(&values[row]))
-                        .map_err(h5err(path))?,
-                    None => string_attr(&g, &c.key, &c.values[row], path)?,
-                }
-            }
-            for c in &table.results {
-                g.new_attr::<f64>()
-                    .shape(())
-                    .create(c.name.as_str())
-                    .and_then(|at| at.write_scalar(&c.values[row]))
+        match &c.si {
+            Some((values, units)) => write_dataset(&inputs, &c.key, values, units, path)?,
+            None => {
+                inputs
+                    .new_dataset_builder()
+                    .with_data(&text)
+                    .create(c.key.as_str())
                     .map_err(h5err(path))?;
             }
-            string_attr(&g, "warnings", table.warnings_of(row), path)?;
         }
-        f.close().map_err(h5err(path))
-    })
+    }
+    let warnings: Vec<VarLenUnicode> = (0..table.len())
+        .map(|i| vlu(table.warnings_of(i)))
+        .collect();
+    s.new_dataset_builder()
+        .with_data(&warnings)
+        .create("warnings")
+        .map_err(h5err(path))?;
+    string_attr(&inputs, "order", &table.keys().join("\n"), path)?;
+    string_attr(&written, "order", &table.keys().join("\n"), path)
+}
+
+/// The group `/runs/<index>` of row `row` of `table`: its inputs (SI numbers, or text) and
+/// results as attributes, and its warnings.
+fn write_run_group(runs: &hdf5::Group, table: &StudyTable, row: usize, path: &Path) -> Result<()> {
+    let g = runs
+        .create_group(&table.run[row].to_string())
+        .map_err(h5err(path))?;
+    for c in &table.inputs {
+        match &c.si {
+            Some((values, _)) => g
+                .new_attr::<f64>()
+                .shape(())
+                .create(c.key.as_str())
+                .and_then(|at| at.write_scalar(&values[row]))
+                .map_err(h5err(path))?,
+            None => string_attr(&g, &c.key, &c.values[row], path)?,
+        }
+    }
+    for c in &table.results {
+        g.new_attr::<f64>()
+            .shape(())
+            .create(c.name.as_str())
+            .and_then(|at| at.write_scalar(&c.values[row]))
+            .map_err(h5err(path))?;
+    }
+    string_attr(&g, "warnings", table.warnings_of(row), path)
 }
 
 /// The root attributes of an [`Identity`].
@@ -566,6 +625,79 @@ mod tests {
         assert_eq!(t.inputs[0].values, ["5psi", "10psi"]);
         assert_eq!(t.inputs[0].si, None);
         assert_eq!(t.result("peak_force").unwrap().values, [1.0, 2.0]);
+    }
+
+    /// The rows of `t` one at a time, as a sweep's sink gets them.
+    fn row_of(t: &StudyTable, i: usize) -> StudyTable {
+        let mut one = t.clone();
+        one.run = vec![t.run[i]];
+        for c in &mut one.inputs {
+            c.values = vec![c.values[i].clone()];
+            if let Some((v, _)) = &mut c.si {
+                *v = vec![v[i]];
+            }
+        }
+        for c in &mut one.results {
+            c.values = vec![c.values[i]];
+        }
+        one.warnings = vec![t.warnings[i].clone()];
+        one
+    }
+
+    #[test]
+    fn a_file_streamed_run_by_run_reads_as_the_file_written_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let (whole, streamed) = (dir.path().join("whole.h5"), dir.path().join("streamed.h5"));
+        let t = table();
+        write_study_hdf5(&whole, false, &t).unwrap();
+        // The runs finish in the other order; no file until the table is complete.
+        let n = write_study_hdf5_streamed(&streamed, false, |sink| {
+            for i in (0..t.len()).rev() {
+                sink(&row_of(&t, i))?;
+                assert!(!streamed.exists(), "no half-written file");
+            }
+            Ok((t.clone(), t.len()))
+        })
+        .unwrap();
+        assert_eq!(n, 2);
+        let dump = |p: &Path| {
+            let o = std::process::Command::new("h5dump")
+                .arg(p)
+                .output()
+                .unwrap();
+            assert!(o.status.success());
+            String::from_utf8(o.stdout)
+                .unwrap()
+                .replace(&p.display().to_string(), "FILE")
+        };
+        assert_eq!(dump(&streamed), dump(&whole));
+        // A run that fails, or a table that is not the runs written: no file, no temporary.
+        let failed = dir.path().join("failed.h5");
+        let e = write_study_hdf5_streamed::<()>(&failed, false, |sink| {
+            sink(&row_of(&t, 0))?;
+            Err(Error::Input {
+                file: "x".into(),
+                key: "k".into(),
+                problem: "a run failed".into(),
+                allowed: "".into(),
+            })
+        });
+        assert!(e.unwrap_err().to_string().contains("a run failed"));
+        let e = write_study_hdf5_streamed(&failed, false, |sink| {
+            sink(&row_of(&t, 0))?;
+            Ok((t.clone(), ()))
+        });
+        assert!(
+            e.unwrap_err()
+                .to_string()
+                .contains("1 run groups written for 2 runs")
+        );
+        assert!(!failed.exists());
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 2, "{names:?}");
     }
 
     #[test]

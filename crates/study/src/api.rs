@@ -1101,8 +1101,10 @@ pub fn sweep_shard_rows_until(
     crate::sweep::estimate(&axes, (k, n), crate::sweep::Outputs::default())
         .check(&crate::sweep::Limits::of_machine(&[]))?;
     let points = crate::sweep::shard_points(&axes, k, n);
-    crate::sweep::check_points(scene, &axes, &points)?;
-    let rows = crate::sweep::run_points_until(scene, &axes, &points, jobs, |_| {}, keep_going)?;
+    // One pool validates the points (in parallel) and runs them.
+    let pool = crate::sweep::thread_pool(jobs)?;
+    crate::sweep::check_points_on(&pool, scene, &axes, &points)?;
+    let rows = crate::sweep::run_points_on(&pool, scene, &axes, &points, |_| {}, keep_going)?;
     Ok((axes, rows))
 }
 

@@ -482,17 +482,104 @@ pub fn summarise(index: usize, inputs: Vec<String>, out: &RunOutput) -> RunSumma
 /// Validates every point's scene before any run (bad values fail fast, naming the value) and
 /// returns the files the scene resolved for them, each once with its SHA-256 (the scene file
 /// first): what the sweep's checkpoint and study file record it belongs to. The first run of the
-/// whole sweep is validated too, so a shard without runs still names its files.
+/// whole sweep is validated too, so a shard without runs still names its files. Serial
+/// ([`check_points_on`] on one thread).
 pub fn check_points(scene: &Path, axes: &[Axis], points: &[Point]) -> Result<Vec<InputFile>> {
-    let (checked, files) = shpb_input::provenance::recording(|| -> Result<()> {
-        Params::from_file_overridden(scene, &overrides(axes, &point_at(axes, 0)))?;
-        for p in points {
-            Params::from_file_overridden(scene, &overrides(axes, p))?;
-        }
-        Ok(())
+    check_points_on(&thread_pool(1)?, scene, axes, points)
+}
+
+/// [`check_points`] in parallel on `pool` (the pool of the runs, issue 45: a serial validation
+/// capped a 64-core sweep near 23× by Amdahl's law). The outcome is the serial one: the error of
+/// the first invalid point in order (the sweep's first run, then `points`; the points after an
+/// invalid one are skipped), else the files in the order the serial loop first read them (by
+/// point, then by the order within the point), each with the text first read.
+pub fn check_points_on(
+    pool: &rayon::ThreadPool,
+    scene: &Path,
+    axes: &[Axis],
+    points: &[Point],
+) -> Result<Vec<InputFile>> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    // Item 0 is the sweep's first run, item i ≥ 1 is points[i − 1].
+    let first_bad = AtomicUsize::new(usize::MAX);
+    let checked = pool.install(|| {
+        (0..=points.len())
+            .into_par_iter()
+            .map(|i| {
+                if i > first_bad.load(Ordering::Relaxed) {
+                    return Checked::default();
+                }
+                let first;
+                let p = match i {
+                    0 => {
+                        first = point_at(axes, 0);
+                        &first
+                    }
+                    _ => &points[i - 1],
+                };
+                let (parsed, read) = shpb_input::files::capture(|| {
+                    Params::from_file_overridden(scene, &overrides(axes, p)).map(drop)
+                });
+                match parsed {
+                    Ok(()) => Checked {
+                        error: None,
+                        files: read
+                            .into_iter()
+                            .enumerate()
+                            .map(|(k, f)| ((i, k), f))
+                            .collect(),
+                    },
+                    Err(e) => {
+                        first_bad.fetch_min(i, Ordering::Relaxed);
+                        Checked {
+                            error: Some((i, e)),
+                            files: Vec::new(),
+                        }
+                    }
+                }
+            })
+            .reduce(Checked::default, Checked::merge)
     });
-    checked?;
-    Ok(files)
+    if let Some((_, e)) = checked.error {
+        return Err(e);
+    }
+    let mut files = checked.files;
+    files.sort_by_key(|(at, _)| *at);
+    Ok(files
+        .into_iter()
+        .filter(|(_, f)| !f.name.starts_with("built-in:"))
+        .map(|(_, f)| InputFile {
+            path: f.name.into(),
+            sha256: shpb_input::provenance::sha256_hex(f.text.as_bytes()),
+        })
+        .collect())
+}
+
+/// What the validation of some points found ([`check_points_on`]): the first error by item and
+/// each file read with the first (item, read) that read it.
+#[derive(Default)]
+struct Checked {
+    error: Option<(usize, Error)>,
+    files: Vec<((usize, usize), shpb_input::files::InputFile)>,
+}
+
+impl Checked {
+    /// The union of two validations: the earlier error; each file once, from its earliest read.
+    fn merge(mut self, other: Checked) -> Checked {
+        if let Some((j, e)) = other.error
+            && self.error.as_ref().is_none_or(|(i, _)| j < *i)
+        {
+            self.error = Some((j, e));
+        }
+        for (at, f) in other.files {
+            match self.files.iter_mut().find(|(_, g)| g.name == f.name) {
+                Some(kept) if at < kept.0 => *kept = (at, f),
+                Some(_) => {}
+                None => self.files.push((at, f)),
+            }
+        }
+        self
+    }
 }
 
 /// The scene overrides of one point.
@@ -513,7 +600,7 @@ pub fn run_points(
     threads: usize,
     done: impl Fn(&RunSummary) + Sync,
 ) -> Result<Vec<RunSummary>> {
-    run_points_until(scene, axes, points, threads, done, &|| true).map(|p| p.rows)
+    run_points_on(&thread_pool(threads)?, scene, axes, points, done, &|| true).map(|p| p.rows)
 }
 
 /// The rows of many runs that a caller may stop: those finished, in order, and whether the
@@ -569,8 +656,26 @@ pub fn run_points_until(
     done: impl Fn(&RunSummary) + Sync,
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Result<Finished<RunSummary>> {
-    let pool = thread_pool(threads)?;
-    run_until(&pool, points, keep_going, |p, progress| {
+    run_points_on(
+        &thread_pool(threads)?,
+        scene,
+        axes,
+        points,
+        done,
+        keep_going,
+    )
+}
+
+/// [`run_points_until`] on a given `pool` (the one [`check_points_on`] validated the points on).
+pub fn run_points_on(
+    pool: &rayon::ThreadPool,
+    scene: &Path,
+    axes: &[Axis],
+    points: &[Point],
+    done: impl Fn(&RunSummary) + Sync,
+    keep_going: &(dyn Fn() -> bool + Sync),
+) -> Result<Finished<RunSummary>> {
+    run_until(pool, points, keep_going, |p, progress| {
         let params = Params::from_file_overridden(scene, &overrides(axes, p))?;
         // The scene's warnings first, as `shpb run` prints them (api::run_scene).
         let mut out = params.run_with_progress(progress)?;
@@ -583,6 +688,74 @@ pub fn run_points_until(
         let row = summarise(p.index, inputs, &out);
         done(&row);
         Ok(row)
+    })
+}
+
+/// The study file of a sweep ([`crate::file::write_sweep_hdf5`]) with each run's
+/// `/runs/<index>` group written as `run` hands over its finished row, on this thread, while the
+/// other runs go on (issue 45: that work leaves the serial end of the sweep). `points` are all
+/// the sweep's rows-to-be (this shard's points, finished or not): their labels fix before any
+/// run which input columns are SI numbers, as [`input_columns`] of the finished table decides.
+/// `run` gets the sink and returns the rows; they come back in index order. The file appears
+/// only complete (written under a temporary name, [`shpb_output::study::write_study_hdf5_streamed`]).
+#[allow(clippy::too_many_arguments)]
+pub fn write_sweep_hdf5_streamed(
+    path: &Path,
+    force: bool,
+    scene_text: &str,
+    spec: &[String],
+    identity: Option<&shpb_output::study::Identity>,
+    (axes, points): (&[Axis], &[Point]),
+    run: impl FnOnce(&mut dyn FnMut(&RunSummary) -> Result<()>) -> Result<Vec<RunSummary>>,
+) -> Result<Vec<RunSummary>> {
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    let numeric: Vec<bool> = {
+        let labelled: Vec<RunSummary> = points
+            .iter()
+            .map(|p| {
+                let inputs = axes
+                    .iter()
+                    .zip(&p.coords)
+                    .map(|(a, &c)| a.labels[c].clone())
+                    .collect();
+                RunSummary::from_values(p.index, inputs, [f64::NAN; 5])
+            })
+            .collect();
+        input_columns(&keys, &labelled)
+            .iter()
+            .map(|c| c.si.is_some())
+            .collect()
+    };
+    shpb_output::study::write_study_hdf5_streamed(path, force, |sink| {
+        let mut rows = run(&mut |row: &RunSummary| {
+            let mut one = crate::file::sweep_table(
+                scene_text,
+                spec,
+                &keys,
+                std::slice::from_ref(row),
+                identity,
+            );
+            for (c, &si) in one.inputs.iter_mut().zip(&numeric) {
+                if !si {
+                    c.si = None;
+                }
+            }
+            sink(&one)
+        })?;
+        rows.sort_by_key(|r| r.index);
+        let table = crate::file::sweep_table(scene_text, spec, &keys, &rows, identity);
+        let same_columns = table
+            .inputs
+            .iter()
+            .zip(&numeric)
+            .all(|(c, &si)| c.si.is_some() == si);
+        if !same_columns {
+            return Err(Error::Hdf5 {
+                file: path.display().to_string(),
+                message: "the runs finished are not the points of the sweep".into(),
+            });
+        }
+        Ok((table, rows))
     })
 }
 
@@ -1163,6 +1336,85 @@ mod tests {
         assert!(row_line(&none).ends_with(",\n"));
         assert_eq!(parse_row(row_line(&none).trim_end(), 1).unwrap(), none);
         assert_eq!(split_csv_line("a,\"b, c\",\"\""), ["a", "b, c", ""]);
+    }
+
+    fn shipped_scene(name: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes")
+            .join(name)
+    }
+
+    /// The validation before issue 45, one point after the other on this thread: the
+    /// definition the parallel one must reproduce.
+    fn serial_check(scene: &Path, axes: &[Axis], points: &[Point]) -> Result<Vec<InputFile>> {
+        let (checked, files) = shpb_input::provenance::recording(|| -> Result<()> {
+            Params::from_file_overridden(scene, &overrides(axes, &point_at(axes, 0)))?;
+            for p in points {
+                Params::from_file_overridden(scene, &overrides(axes, p))?;
+            }
+            Ok(())
+        });
+        checked.map(|()| files)
+    }
+
+    #[test]
+    fn points_validated_in_parallel_give_the_serial_files_and_first_error() {
+        let scene = shipped_scene("shpb-ss440c-10psi.toml");
+        let pools = [thread_pool(1).unwrap(), thread_pool(2).unwrap()];
+        // Valid points: the same files (scene first, then the set-up and gauge files as first
+        // read, the second set-up from the second point on), with the same SHA-256, on one
+        // thread or two.
+        let good = parse_axes(&specs(&[
+            "pressure=8psi:12psi:5",
+            "bars=../bars/authors.toml,../bars/authors-20cm-striker.toml",
+        ]))
+        .unwrap();
+        let points = product(&good);
+        let want = serial_check(&scene, &good, &points).unwrap();
+        assert!(want.len() >= 3, "{want:?}");
+        assert_eq!(want[0].path, scene);
+        assert!(
+            want[want.len() - 1]
+                .path
+                .ends_with("bars/authors-20cm-striker.toml")
+        );
+        for pool in &pools {
+            assert_eq!(check_points_on(pool, &scene, &good, &points).unwrap(), want);
+        }
+        assert_eq!(check_points(&scene, &good, &points).unwrap(), want);
+        // A shard without runs still names the files of the sweep's first run.
+        let none = shard_points(&good, 25, 30);
+        assert!(none.is_empty());
+        assert_eq!(
+            check_points_on(&pools[1], &scene, &good, &none).unwrap(),
+            serial_check(&scene, &good, &none).unwrap()
+        );
+        // Several invalid points, the first late in the product: the error of the first one in
+        // order, exactly (text and exit code), whichever thread met which point first.
+        let bad = parse_axes(&specs(&[
+            "shaper.thickness=0.5mm,0.4mm,0.3mm,-1mm,0.2mm,-2mm,-3mm",
+        ]))
+        .unwrap();
+        let points = product(&bad);
+        let want = serial_check(&scene, &bad, &points).unwrap_err();
+        assert!(want.to_string().contains("-1 mm is out of range"), "{want}");
+        for pool in &pools {
+            for _ in 0..3 {
+                let e = check_points_on(pool, &scene, &bad, &points).unwrap_err();
+                assert_eq!(
+                    (e.to_string(), e.exit_code()),
+                    (want.to_string(), want.exit_code())
+                );
+            }
+        }
+        // An invalid first run of the sweep is reported for any shard, as before.
+        let shard = shard_points(&bad, 2, 3);
+        let e = check_points_on(&pools[1], &scene, &bad, &shard);
+        let want = serial_check(&scene, &bad, &shard);
+        assert_eq!(
+            e.map_err(|e| e.to_string()),
+            want.map_err(|e| e.to_string())
+        );
     }
 
     #[test]

@@ -543,11 +543,17 @@ fn study_draw(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Sample
 }
 
 /// [`study_draw`] with every sample validated before the first run (a bad draw fails fast,
-/// naming its value).
-fn study_samples(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Samples)> {
+/// naming its value), in parallel on `pool` (the pool of the runs, issue 45); the error is the
+/// first invalid sample's, as a serial loop gives it.
+fn study_samples(
+    scene: &Path,
+    plan: &StudyPlan,
+    pool: &rayon::ThreadPool,
+) -> Result<(Vec<StudyInput>, Samples)> {
+    use rayon::prelude::*;
     let (inputs, samples) = study_draw(scene, plan)?;
     let keys: Vec<&str> = inputs.iter().map(|input| input.key.as_str()).collect();
-    for (i, o) in samples.overrides.iter().enumerate() {
+    let check = |i: usize, o: &Vec<(String, shpb_input::scene::Value)>| -> Result<()> {
         // A drawn value of the wrong type (a number where the key takes a quantity with its
         // unit): name the inputs and the sample, not the line of a scene text nobody wrote nor
         // a command line that did not set it.
@@ -562,15 +568,29 @@ fn study_samples(scene: &Path, plan: &StudyPlan) -> Result<(Vec<StudyInput>, Sam
                       one (pressure = { mean = \"12.5psi\", sd = \"0.6psi\" })"
                 .into(),
         };
-        Params::from_file_overridden(scene, o).map_err(|e| match e {
-            Error::Parse { message, .. } => drawn(&message),
-            Error::Input { key, problem, .. } if keys.contains(&key.as_str()) => drawn(
-                problem
-                    .split_once(" on the command line: ")
-                    .map_or(problem.as_str(), |(_, reason)| reason),
-            ),
-            other => other,
-        })?;
+        Params::from_file_overridden(scene, o)
+            .map(drop)
+            .map_err(|e| match e {
+                Error::Parse { message, .. } => drawn(&message),
+                Error::Input { key, problem, .. } if keys.contains(&key.as_str()) => drawn(
+                    problem
+                        .split_once(" on the command line: ")
+                        .map_or(problem.as_str(), |(_, reason)| reason),
+                ),
+                other => other,
+            })
+    };
+    // The first failure in sample order (`find_first` stops the samples after one found).
+    let first_bad = pool.install(|| {
+        samples
+            .overrides
+            .par_iter()
+            .enumerate()
+            .map(|(i, o)| check(i, o))
+            .find_first(Result::is_err)
+    });
+    if let Some(e) = first_bad {
+        e?;
     }
     Ok((inputs, samples))
 }
@@ -606,7 +626,7 @@ pub fn study_shard_rows_until(
     let (k, m) = crate::sweep::check_shard(k, m)?;
     let n = plan.samples;
     let pool = crate::sweep::thread_pool(jobs)?;
-    let (inputs, samples) = study_samples(scene, plan)?;
+    let (inputs, samples) = study_samples(scene, plan, &pool)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
     let finished = crate::sweep::run_until(&pool, &indices, keep_going, |&i, progress| {
         let params = Params::from_file_overridden(scene, &samples.overrides[i])?;

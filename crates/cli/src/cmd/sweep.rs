@@ -10,7 +10,8 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// `shpb sweep`: refuses a sweep that cannot finish on the machine, validates every point first,
+/// `shpb sweep`: refuses a sweep that cannot finish on the machine, validates every point first
+/// (in parallel, on the pool of the runs),
 /// runs the unfinished ones with a progress bar and a checkpoint stamped with what the sweep
 /// belongs to, prints and writes the summary table. `--resume` continues the checkpoint of the
 /// same sweep (and refuses another's), and says so when the sweep is already complete.
@@ -24,8 +25,8 @@ pub fn sweep(
     force: bool,
 ) -> Result<()> {
     use shpb_study::sweep::{
-        Checkpoint, Outputs, check_points, checkpoint_path, estimate, parse_axes, parse_shard,
-        run_points, shard_points,
+        Checkpoint, Outputs, check_points_on, checkpoint_path, estimate, parse_axes, parse_shard,
+        run_points_on, shard_points,
     };
     shpb_study::sweep::check_jobs(jobs)?;
     let outputs = [output, csv, plot];
@@ -97,7 +98,9 @@ pub fn sweep(
     ))?;
     let total = plan.runs_total.expect("checked") as u64;
     let points = shard_points(&axes, k, n);
-    let files = check_points(scene, &axes, &points)?;
+    // One pool for the validation and the runs (issue 45: the points are validated in parallel).
+    let pool = shpb_study::sweep::thread_pool(jobs)?;
+    let files = check_points_on(&pool, scene, &axes, &points)?;
     out_plan.not_inputs(&files.iter().map(|f| f.path.clone()).collect::<Vec<_>>())?;
     let stamp = Stamp::new(
         scene,
@@ -185,11 +188,12 @@ pub fn sweep(
         }
     }
     let took_over = resumed.is_some();
-    let mut rows = resumed.unwrap_or_default();
+    let rows = resumed.unwrap_or_default();
     let finished: std::collections::HashSet<usize> = rows.iter().map(|r| r.index).collect();
     let todo: Vec<Point> = points
-        .into_iter()
+        .iter()
         .filter(|p| !finished.contains(&p.index))
+        .cloned()
         .collect();
     if resume {
         match took_over {
@@ -228,42 +232,104 @@ pub fn sweep(
         .expect("valid template")
         .progress_chars("=> "),
     );
-    let failed = std::sync::Mutex::new(None);
-    let new_rows = run_points(scene, &axes, &todo, jobs, |row| {
-        if let Some(c) = &checkpoint
-            && let Err(e) = c.record(row)
-        {
-            *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+    // The runs: every row, the resumed ones first, is handed to `sink` on this thread as it
+    // finishes (issue 45: with `-o`, the study file's `/runs/<index>` groups are written while
+    // the other runs go on, not after the last one); the rows come back in index order.
+    let run_all = |sink: &mut dyn FnMut(&RunSummary) -> Result<()>| -> Result<Vec<RunSummary>> {
+        let mut rows = rows;
+        for r in &rows {
+            sink(r)?;
         }
-        done.fetch_add(1, Ordering::SeqCst);
-        bar.inc(1);
-    })?;
-    bar.finish_and_clear();
-    if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
-        return Err(e);
-    }
-    rows.extend(new_rows);
-    rows.sort_by_key(|r| r.index);
-    let table = shpb_study::sweep::summary_csv_keys(&keys, &rows);
-    report_unless_stdout(&out_plan, &table, || sweep_json(&keys, &rows))?;
+        let failed = std::sync::Mutex::new(None);
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let (tx, rx) = std::sync::mpsc::channel::<RunSummary>();
+        let (new_rows, sunk) = std::thread::scope(|s| {
+            let runs = s.spawn(|| {
+                let tx = tx;
+                run_points_on(
+                    &pool,
+                    scene,
+                    &axes,
+                    &todo,
+                    |row| {
+                        if let Some(c) = &checkpoint
+                            && let Err(e) = c.record(row)
+                        {
+                            *failed.lock().unwrap_or_else(|e| e.into_inner()) = Some(e);
+                        }
+                        done.fetch_add(1, Ordering::SeqCst);
+                        bar.inc(1);
+                        // The receiver is gone only once a write has failed (the runs stop).
+                        let _ = tx.send(row.clone());
+                    },
+                    &|| !stop.load(Ordering::SeqCst),
+                )
+            });
+            let mut sunk = Ok(());
+            for row in rx {
+                if sunk.is_ok() {
+                    sunk = sink(&row);
+                    if sunk.is_err() {
+                        stop.store(true, Ordering::SeqCst);
+                    }
+                }
+            }
+            let new_rows = match runs.join() {
+                Ok(r) => r,
+                Err(panic) => std::panic::resume_unwind(panic),
+            };
+            (new_rows, sunk)
+        });
+        bar.finish_and_clear();
+        let new_rows = new_rows?;
+        sunk?;
+        if let Some(e) = failed.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            return Err(e);
+        }
+        rows.extend(new_rows.rows);
+        rows.sort_by_key(|r| r.index);
+        Ok(rows)
+    };
     // The outputs were checked before the runs; a resumed sweep owns the ones it left.
     let replace = force || took_over;
-    write_all(&out_plan, || {
+    // The table, the CSV and the plot of the finished rows.
+    let finish = |rows: &[RunSummary]| -> Result<()> {
+        let table = shpb_study::sweep::summary_csv_keys(&keys, rows);
+        report_unless_stdout(&out_plan, &table, || sweep_json(&keys, rows))?;
         write_study(
             &scene_text,
             &spec,
             Some(&stamp.identity),
             &keys,
-            &rows,
+            rows,
             &table,
-            (output, csv),
+            (None, csv),
             replace,
         )?;
         if let Some(p) = plot {
-            sweep_plot(p, replace || resume, &axes, &rows)?;
+            sweep_plot(p, replace || resume, &axes, rows)?;
         }
         Ok(())
-    })?;
+    };
+    match output {
+        // The study file is written as the runs finish, the other outputs once they all have.
+        Some(out) => write_all(&out_plan, || {
+            let rows = shpb_study::sweep::write_sweep_hdf5_streamed(
+                out,
+                replace,
+                &scene_text,
+                &spec,
+                Some(&stamp.identity),
+                (&axes, &points),
+                run_all,
+            )?;
+            finish(&rows)
+        })?,
+        None => {
+            let rows = run_all(&mut |_| Ok(()))?;
+            write_all(&out_plan, || finish(&rows))?;
+        }
+    }
     if let Some(c) = checkpoint {
         c.finish()?;
     }
