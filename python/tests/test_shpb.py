@@ -32,14 +32,27 @@ def h5_datasets(path):
 
 
 def h5_summary(path):
+    """The summary of a run file as a script reads it with h5py (README, HDF5 layout): the number
+    attributes of /summary, and the items a dataset holds one per element (its attribute
+    ``summary_key`` = ``NAME_<k>``: element k - 1 is ``NAME_k``, as ``/chain/final_velocity``
+    holds a chain's ``final_velocity_<k>``, issue 45)."""
     with h5py.File(path, "r") as f:
         s = f["summary"]
         # Numbers only: the text attributes (units, warnings, alignment, verdict) are not items.
-        return {
+        out = {
             k: float(v)
             for k, v in s.attrs.items()
             if not isinstance(v, (str, bytes)) and k not in ("units", "warnings")
         }
+
+        def per_element(name, obj):
+            if isinstance(obj, h5py.Dataset) and "summary_key" in obj.attrs:
+                key = obj.attrs["summary_key"]
+                stem = (key.decode() if isinstance(key, bytes) else key).removesuffix("<k>")
+                out.update({f"{stem}{k}": float(x) for k, x in enumerate(obj[()], 1)})
+
+        f.visititems(per_element)
+        return out
 
 
 def same(a, b):

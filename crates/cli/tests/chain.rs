@@ -262,3 +262,119 @@ fn the_chain_run_file_has_the_documented_layout() {
     assert_eq!(csv.lines().count(), nt + 1);
     assert!(dir.path().join("c.png").is_file());
 }
+
+/// Issue 45: the shipped chain's file keeps each sphere's final velocity once, in
+/// `/chain/final_velocity` (marked `summary_key`), not as a `/summary` attribute and dataset per
+/// sphere; the summary `shpb run --json` prints still has every `final_velocity_<k>`, equal to
+/// its element k − 1, and `output_every` = 1 (the scene fits the budget: no warning).
+#[test]
+fn a_chain_s_final_velocities_are_one_dataset() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = repo_path("scenes/chain-ss440c-10.toml");
+    let out = shpb(dir.path(), &["run", &scene, "-o", "c.h5", "--json"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    assert!(!common::stderr(&out).contains("output_every"));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let printed = &json["summary"];
+    let f = hdf5::File::open(dir.path().join("c.h5")).unwrap();
+    let final_velocity = f
+        .dataset("chain/final_velocity")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    assert_eq!(final_velocity.len(), 10);
+    for (k, v) in final_velocity.iter().enumerate() {
+        assert_eq!(printed[format!("final_velocity_{}", k + 1)]["value"], *v);
+    }
+    assert_eq!(printed["output_every"]["value"], 1.0);
+    let s = f.group("summary").unwrap();
+    let names = s.member_names().unwrap();
+    assert!(
+        names.iter().all(|n| !n.starts_with("final_velocity")),
+        "{names:?}"
+    );
+    assert!(s.attr("final_velocity_1").is_err());
+    let back = shpb_output::run_file::read_run_file(&dir.path().join("c.h5")).unwrap();
+    let keys: Vec<&str> = back.summary.iter().map(|(k, _, _)| k.as_str()).collect();
+    assert_eq!(keys.len(), printed.as_object().unwrap().len());
+    assert!(keys.contains(&"final_velocity_10") && keys.contains(&"output_every"));
+}
+
+/// Issue 45: a chain whose every step would not fit the budget (3000 spheres, 3760 steps:
+/// 9007 numbers a step, 3.4e7 in all) keeps one step in 2 (1881 samples, 1.7e7 numbers), says so
+/// in a warning and in its summary, and its samples are those of the every-step run at the
+/// steps kept; `output_every` set in the scene is obeyed.
+#[test]
+fn a_chain_beyond_the_output_budget_keeps_fewer_steps_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = repo_path("scenes/chain-ss440c-10.toml");
+    let sets = [
+        "specimen.count=3000",
+        "velocity1_m_s=20",
+        "end_time_s=2e-6",
+        "steps_per_contact=20000",
+    ];
+    let run = |name: &str, extra: &[&str]| {
+        let mut args = vec!["run", scene.as_str(), "-q", "-o", name];
+        for s in sets.iter().chain(extra) {
+            args.extend(["--set", s]);
+        }
+        let out = shpb(dir.path(), &args);
+        assert!(out.status.success(), "{}", common::stderr(&out));
+        let file = shpb_output::run_file::read_run_file(&dir.path().join(name)).unwrap();
+        (common::stderr(&out), file)
+    };
+    let get = |f: &shpb_output::run_file::RunFile, p: &str| {
+        f.datasets
+            .iter()
+            .find(|d| d.path == p)
+            .unwrap_or_else(|| panic!("no {p}"))
+            .clone()
+    };
+    let (warned, some) = run("some.h5", &[]);
+    assert!(
+        warned.contains("output_every = 2 (the scene does not set it)"),
+        "{warned}"
+    );
+    let every = some
+        .summary
+        .iter()
+        .find(|(k, _, _)| k == "output_every")
+        .unwrap()
+        .1;
+    assert_eq!(every, 2.0);
+    let velocity = get(&some, "chain/velocity");
+    let (spheres, kept) = (velocity.shape[0], velocity.shape[1]);
+    assert_eq!(spheres, 3000);
+    assert!((kept * (3 * spheres + 7)) as f64 <= 2e7, "{kept} samples");
+    let (quiet, all) = run("all.h5", &["output_every=1"]);
+    assert!(!quiet.contains("output_every"), "{quiet}");
+    let steps = get(&all, "chain/time").shape[0] - 1;
+    assert!(
+        ((3 * spheres + 7) * (steps + 1)) as f64 > 2e7,
+        "{steps} steps fit"
+    );
+    let picked: Vec<usize> = (0..=steps).filter(|n| n % 2 == 0 || *n == steps).collect();
+    assert_eq!(kept, picked.len());
+    for p in [
+        "chain/velocity",
+        "chain/contact_force",
+        "chain/contact_approach",
+    ] {
+        let (a, s) = (get(&all, p), get(&some, p));
+        let rows = a.shape[0];
+        for r in [0, 1, rows / 2, rows - 1] {
+            for (j, &n) in picked.iter().enumerate() {
+                assert_eq!(
+                    s.data[r * kept + j],
+                    a.data[r * (steps + 1) + n],
+                    "{p}[{r}, {n}]"
+                );
+            }
+        }
+    }
+    assert_eq!(
+        get(&some, "chain/final_velocity").data,
+        get(&all, "chain/final_velocity").data
+    );
+}

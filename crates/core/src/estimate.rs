@@ -148,7 +148,7 @@ impl Params {
                 let steps = (setup.end_time_s / setup.dt_s).ceil();
                 let samples = (steps / setup.output_every as f64).floor() + 2.0;
                 let n = setup.chain.len() as f64;
-                let columns = 3.0 * n + 7.0;
+                let columns = setup.numbers_per_sample() as f64;
                 let bodies = n + 2.0;
                 RunEstimate {
                     steps,

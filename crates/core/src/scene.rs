@@ -893,6 +893,21 @@ fn run_free_chain(
         ));
     }
     summary.push(item("time_step", setup.dt_s, "s"));
+    summary.push(item("output_every", setup.output_every as f64, "1"));
+    if setup.output_every_by_budget && setup.output_every > 1 {
+        warnings.push(format!(
+            "output_every = {} (the scene does not set it): one step in {} of the {} is kept, \
+             {} samples of {} numbers, within the budget of {:e} numbers ({}) a chain's series \
+             keep; set output_every to keep more",
+            setup.output_every,
+            setup.output_every,
+            setup.steps(),
+            r.time_s.len(),
+            setup.numbers_per_sample(),
+            solver::spheres::CHAIN_OUTPUT_BUDGET_NUMBERS,
+            format_si(8.0 * solver::spheres::CHAIN_OUTPUT_BUDGET_NUMBERS, "B"),
+        ));
+    }
     let final_velocity: Vec<f64> = r.final_velocity_m_s[first..].to_vec();
     for (k, v) in final_velocity.iter().enumerate() {
         summary.push(item(&format!("final_velocity_{}", k + 1), *v, "m/s"));

@@ -32,40 +32,87 @@ pub fn contact_columns(s: &ContactSeries) -> Vec<(&'static str, &[f64], &'static
     cols
 }
 
-/// The `/chain` datasets of a chain run: (name, shape, data row-major, units). 2-D ones have
-/// one row per contact (`contact_force`, `contact_approach`: contact k between spheres k and
-/// k + 1) or per sphere (`velocity`), one column per time of `time`.
-pub fn chain_datasets(c: &ChainSeries) -> Vec<(String, Vec<usize>, Vec<f64>, &'static str)> {
-    let two_d = |rows: &[Vec<f64>]| -> (Vec<usize>, Vec<f64>) {
-        (
-            vec![rows.len(), c.time_s.len()],
-            rows.iter().flatten().copied().collect(),
-        )
-    };
-    let mut v = vec![(
-        "time".to_string(),
-        vec![c.time_s.len()],
-        c.time_s.clone(),
-        "s",
-    )];
-    for (name, rows, units) in [
-        ("contact_force", &c.contact_force_n, "N"),
-        ("contact_approach", &c.contact_approach_m, "m"),
-        ("velocity", &c.velocity_m_s, "m/s"),
-    ] {
-        let (shape, data) = two_d(rows);
-        v.push((name.to_string(), shape, data, units));
+/// The values of one `/chain` dataset: a series, or rows of one length (a 2-D dataset, row-major).
+#[derive(Debug, Clone, Copy)]
+pub enum ChainValues<'a> {
+    /// A 1-D dataset.
+    Series(&'a [f64]),
+    /// A 2-D dataset: one row per contact or sphere, one column per time of `/chain/time`.
+    Rows(&'a [Vec<f64>]),
+}
+
+impl ChainValues<'_> {
+    /// The dataset's shape (rows first).
+    pub fn shape(&self) -> Vec<usize> {
+        match self {
+            ChainValues::Series(d) => vec![d.len()],
+            ChainValues::Rows(r) => vec![r.len(), r.first().map_or(0, Vec::len)],
+        }
     }
-    v.push((
-        "final_velocity".to_string(),
-        vec![c.final_velocity_m_s.len()],
-        c.final_velocity_m_s.clone(),
-        "m/s",
-    ));
+
+    /// The values, row-major (a copy of one dataset: the writer holds one at a time).
+    pub fn flat(&self) -> Vec<f64> {
+        match self {
+            ChainValues::Series(d) => d.to_vec(),
+            ChainValues::Rows(r) => r.concat(),
+        }
+    }
+}
+
+/// The `/chain` datasets of a chain run, borrowed: (name, values, units). 2-D ones have one row
+/// per contact (`contact_force`, `contact_approach`: contact k between spheres k and k + 1) or
+/// per sphere (`velocity`), one column per time of `time`; `final_velocity` has one value per
+/// sphere (issue 45: per-sphere values as one dataset each, not a value per sphere).
+pub fn chain_columns(c: &ChainSeries) -> Vec<(&str, ChainValues<'_>, &'static str)> {
+    let mut v = vec![
+        ("time", ChainValues::Series(&c.time_s), "s"),
+        ("contact_force", ChainValues::Rows(&c.contact_force_n), "N"),
+        (
+            "contact_approach",
+            ChainValues::Rows(&c.contact_approach_m),
+            "m",
+        ),
+        ("velocity", ChainValues::Rows(&c.velocity_m_s), "m/s"),
+        (
+            "final_velocity",
+            ChainValues::Series(&c.final_velocity_m_s),
+            "m/s",
+        ),
+    ];
     for (name, data, units) in &c.extra {
-        v.push((name.clone(), vec![data.len()], data.clone(), units));
+        v.push((name.as_str(), ChainValues::Series(data), *units));
     }
     v
+}
+
+/// The summary items a chain run's summary holds one per sphere (`final_velocity_<k>`, k from
+/// 1), which its file keeps as the elements of `/chain/final_velocity` (attribute
+/// `summary_key` = [`FINAL_VELOCITY_SUMMARY_KEY`]) instead of an attribute and a dataset each:
+/// true for the item `key` = `final_velocity_<k>` whose value is element k − 1 of the chain's
+/// final velocities (issue 45: HDF5 attribute insertion is quadratic in their number).
+pub fn is_per_sphere_item(out: &RunOutput, key: &str, value: f64) -> bool {
+    let Some(c) = &out.chain else { return false };
+    key.strip_prefix("final_velocity_")
+        .and_then(|k| k.parse::<usize>().ok())
+        .and_then(|k| c.final_velocity_m_s.get(k.checked_sub(1)?))
+        .is_some_and(|v| v.to_bits() == value.to_bits())
+}
+
+/// The `summary_key` attribute of `/chain/final_velocity`: element k − 1 is the summary item
+/// `final_velocity_<k>` ([`is_per_sphere_item`]; [`crate::run_file::read_run_file`] lists them).
+pub const FINAL_VELOCITY_SUMMARY_KEY: &str = "final_velocity_<k>";
+
+/// True when `out`'s summary holds every sphere's `final_velocity_<k>` (a `chain` scene): its
+/// file then marks `/chain/final_velocity` with [`FINAL_VELOCITY_SUMMARY_KEY`].
+pub fn summary_has_final_velocities(out: &RunOutput) -> bool {
+    let Some(c) = &out.chain else { return false };
+    !c.final_velocity_m_s.is_empty()
+        && out
+            .summary
+            .iter()
+            .filter(|it| is_per_sphere_item(out, &it.key, it.value))
+            .count()
+            == c.final_velocity_m_s.len()
 }
 
 /// Origin of `/time` and `/contact/time` (both on the simulation clock).
@@ -106,35 +153,47 @@ pub fn write_hdf5(
         }
         if let Some(c) = &out.chain {
             let g = f.create_group("chain").map_err(h5err(path))?;
-            for (name, shape, data, units) in chain_datasets(c) {
-                if let [rows, cols] = shape[..] {
-                    let field =
-                        ndarray::Array2::from_shape_vec((rows, cols), data).map_err(|e| {
-                            Error::Hdf5 {
-                                file: path.display().to_string(),
-                                message: e.to_string(),
-                            }
-                        })?;
-                    let ds = g
-                        .new_dataset_builder()
-                        .with_data(&field)
-                        .create(name.as_str())
-                        .map_err(h5err(path))?;
-                    string_attr(&ds, "units", units, path)?;
-                    let rows = if name == "velocity" {
-                        "sphere"
-                    } else {
-                        "contact (k: spheres k and k + 1)"
-                    };
-                    string_attr(
-                        &ds,
-                        "description",
-                        &format!("rows: {rows}, columns: /chain/time"),
-                        path,
-                    )?;
-                } else {
-                    write_dataset(&g, &name, &data, units, path)?;
+            for (name, values, units) in chain_columns(c) {
+                match values {
+                    ChainValues::Rows(_) => {
+                        let shape = values.shape();
+                        let field =
+                            ndarray::Array2::from_shape_vec((shape[0], shape[1]), values.flat())
+                                .map_err(|e| Error::Hdf5 {
+                                    file: path.display().to_string(),
+                                    message: format!("/chain/{name}: {e}"),
+                                })?;
+                        let ds = g
+                            .new_dataset_builder()
+                            .with_data(&field)
+                            .create(name)
+                            .map_err(h5err(path))?;
+                        string_attr(&ds, "units", units, path)?;
+                        let what = if name == "velocity" {
+                            "sphere"
+                        } else {
+                            "contact (k: spheres k and k + 1)"
+                        };
+                        string_attr(
+                            &ds,
+                            "description",
+                            &format!("rows: {what}, columns: /chain/time"),
+                            path,
+                        )?;
+                    }
+                    ChainValues::Series(data) => write_dataset(&g, name, data, units, path)?,
                 }
+            }
+            if summary_has_final_velocities(out) {
+                let ds = g.dataset("final_velocity").map_err(h5err(path))?;
+                string_attr(&ds, "summary_key", FINAL_VELOCITY_SUMMARY_KEY, path)?;
+                string_attr(
+                    &ds,
+                    "description",
+                    "each sphere's velocity at the end (sphere k at index k - 1): the summary \
+                     items final_velocity_<k>",
+                    path,
+                )?;
             }
             origin(&g, "time", TIME_ORIGIN, 0.0)?;
         }
@@ -234,7 +293,13 @@ pub fn write_hdf5(
             }
         }
         let s = f.create_group("summary").map_err(h5err(path))?;
-        for it in &out.summary {
+        // The scalar items: each sphere's `final_velocity_<k>` is in `/chain/final_velocity`.
+        let scalars: Vec<_> = out
+            .summary
+            .iter()
+            .filter(|it| !is_per_sphere_item(out, &it.key, it.value))
+            .collect();
+        for it in &scalars {
             let a = s
                 .new_attr::<f64>()
                 .shape(())
@@ -252,7 +317,7 @@ pub fn write_hdf5(
         string_attr(
             &s,
             "units",
-            &out.summary
+            &scalars
                 .iter()
                 .map(|i| format!("{}={}", i.key, i.unit))
                 .collect::<Vec<_>>()

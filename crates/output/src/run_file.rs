@@ -37,7 +37,8 @@ fn one_d<'a>(path: String, data: &'a [f64], units: &'a str) -> Dataset<'a> {
 /// The numeric datasets [`crate::io::write_hdf5`] writes for `out`, in the order written:
 /// `contact/*`, `chain/*`, `drive/{time,force}`, `time`, `gauges/<name>/{strain,voltage}`,
 /// `bars/<name>/{x,time,snapshots}`,
-/// `reduction/*`, `energy/*`, `summary/<key>` (scalars), `summary/bands/<key>` ([low, high]).
+/// `reduction/*`, `energy/*`, `summary/<key>` (scalars; a chain's `final_velocity_<k>` are the
+/// elements of `chain/final_velocity`), `summary/bands/<key>` ([low, high]).
 pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
     let mut v = Vec::new();
     if let Some(contact) = &out.contact {
@@ -46,11 +47,14 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
         }
     }
     if let Some(c) = &out.chain {
-        for (name, shape, data, units) in crate::io::chain_datasets(c) {
+        for (name, values, units) in crate::io::chain_columns(c) {
             v.push(Dataset {
                 path: format!("chain/{name}"),
-                shape,
-                data: Cow::Owned(data),
+                shape: values.shape(),
+                data: match values {
+                    crate::io::ChainValues::Series(d) => Cow::Borrowed(d),
+                    rows => Cow::Owned(rows.flat()),
+                },
                 units: Cow::Borrowed(units),
             });
         }
@@ -95,7 +99,11 @@ pub fn run_datasets(out: &RunOutput) -> Vec<Dataset<'_>> {
     for (name, data) in &out.energy {
         v.push(one_d(format!("energy/{name}"), data, "J"));
     }
+    // Each sphere's `final_velocity_<k>` is an element of `chain/final_velocity`, not a scalar.
     for it in &out.summary {
+        if crate::io::is_per_sphere_item(out, &it.key, it.value) {
+            continue;
+        }
         v.push(Dataset {
             path: format!("summary/{}", it.key),
             shape: vec![],
@@ -146,7 +154,9 @@ pub struct RunFile {
     pub scene: String,
     /// Every numeric (f64) dataset, in path order.
     pub datasets: Vec<Dataset<'static>>,
-    /// The `/summary` values (key, value, units), in the order of the `units` attribute.
+    /// The `/summary` values (key, value, units), in the order of the `units` attribute, then
+    /// those a dataset holds one per element (attribute `summary_key` = `NAME_<k>`: element
+    /// k − 1 is `NAME_k`, as `/chain/final_velocity` holds `final_velocity_<k>`).
     pub summary: Vec<(String, f64, String)>,
     /// The `/summary` attribute `warnings`, one per line.
     pub warnings: Vec<String>,
@@ -168,6 +178,7 @@ pub fn read_run_file(path: &Path) -> Result<RunFile> {
         scene: text_attr(&f, "scene").unwrap_or_default(),
         ..RunFile::default()
     };
+    let mut per_element = Vec::new();
     let mut groups = vec![(String::new(), f.group("/").map_err(h5err(path))?)];
     while let Some((prefix, g)) = groups.pop() {
         for name in g.member_names().map_err(h5err(path))? {
@@ -181,11 +192,18 @@ pub fn read_run_file(path: &Path) -> Result<RunFile> {
                 continue;
             }
             let data = ds.read_raw::<f64>().map_err(h5err(path))?;
+            let units = text_attr(&ds, "units").unwrap_or_default();
+            if let Some(name) = text_attr(&ds, "summary_key")
+                .as_deref()
+                .and_then(|k| k.strip_suffix("<k>"))
+            {
+                per_element.push((full.clone(), name.to_string(), data.clone(), units.clone()));
+            }
             file.datasets.push(Dataset {
                 path: full,
                 shape: ds.shape(),
                 data: Cow::Owned(data),
-                units: Cow::Owned(text_attr(&ds, "units").unwrap_or_default()),
+                units: Cow::Owned(units),
             });
         }
     }
@@ -198,6 +216,14 @@ pub fn read_run_file(path: &Path) -> Result<RunFile> {
                 file.summary
                     .push((key.to_string(), value, unit.to_string()));
             }
+        }
+        per_element.sort_by(|a, b| a.0.cmp(&b.0));
+        for (_, name, data, units) in per_element {
+            file.summary.extend(
+                data.iter()
+                    .enumerate()
+                    .map(|(k, &x)| (format!("{name}{}", k + 1), x, units.clone())),
+            );
         }
         file.warnings = text_attr(&s, "warnings")
             .unwrap_or_default()
@@ -270,5 +296,131 @@ mod tests {
         assert_eq!(back.warnings, vec!["a warning".to_string()]);
         assert_eq!(back.scene, "kind = \"x\"\n");
         assert!(back.provenance.is_none());
+    }
+
+    /// A chain run of `n` spheres over `nt` times (values are only labels: force k·t, …).
+    fn chain_run(n: usize, nt: usize) -> RunOutput {
+        let t: Vec<f64> = (0..nt).map(|i| i as f64 * 1e-9).collect();
+        let rows = |m: usize, scale: f64| -> Vec<Vec<f64>> {
+            (0..m)
+                .map(|k| t.iter().map(|x| scale * (k + 1) as f64 * x).collect())
+                .collect()
+        };
+        let final_velocity: Vec<f64> = (0..n).map(|k| 0.5 + k as f64 * 1e-3).collect();
+        let mut summary = vec![item("peak_force", 7.5, "N"), item("output_every", 1.0, "1")];
+        for (k, v) in final_velocity.iter().enumerate() {
+            summary.push(item(&format!("final_velocity_{}", k + 1), *v, "m/s"));
+        }
+        RunOutput {
+            chain: Some(shpb_core::run::ChainSeries {
+                contact_force_n: rows(n - 1, 1e9),
+                contact_approach_m: rows(n - 1, 1.0),
+                velocity_m_s: rows(n, 1e3),
+                final_velocity_m_s: final_velocity,
+                extra: vec![("wall_contact_force".into(), t.clone(), "N")],
+                time_s: t,
+            }),
+            ..RunOutput::contact_only(
+                ContactSeries {
+                    time_s: Some(vec![0.0, 1e-9]),
+                    displacement_m: vec![0.0, 1e-9],
+                    force_n: vec![0.0, 1.0],
+                    yield_stress_pa: None,
+                    strain_rate_per_s: Some(vec![0.0, 1.0]),
+                },
+                summary,
+            )
+        }
+    }
+
+    /// Issue 45: a chain's per-sphere values are one dataset each, not an attribute and a
+    /// dataset per sphere: `/summary` holds the same objects whatever the number of spheres,
+    /// each sphere's `final_velocity_<k>` is element k − 1 of `/chain/final_velocity` (marked
+    /// `summary_key`), and the file reads back as the run: same datasets, same summary.
+    #[test]
+    fn a_chain_s_per_sphere_values_are_datasets_not_attributes() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut objects = Vec::new();
+        for n in [3, 2000] {
+            let out = chain_run(n, 5);
+            let path = dir.path().join(format!("chain{n}.h5"));
+            crate::io::write_hdf5(&path, false, "kind = \"chain\"\n", None, &out).unwrap();
+            let back = read_run_file(&path).unwrap();
+            let mut expected = run_datasets(&out);
+            expected.sort_by(|a, b| a.path.cmp(&b.path));
+            assert_eq!(back.datasets, expected);
+            let summary: Vec<(String, f64, String)> = out
+                .summary
+                .iter()
+                .map(|i| (i.key.clone(), i.value, i.unit.to_string()))
+                .collect();
+            assert_eq!(back.summary, summary);
+            let f = hdf5::File::open(&path).unwrap();
+            let s = f.group("summary").unwrap();
+            objects.push((s.attr_names().unwrap(), s.member_names().unwrap()));
+            assert!(s.attr("final_velocity_1").is_err());
+            let fv = f.dataset("chain/final_velocity").unwrap();
+            assert_eq!(fv.shape(), vec![n]);
+            let key = fv.attr("summary_key").unwrap();
+            assert_eq!(
+                key.read_scalar::<VarLenUnicode>().unwrap().as_str(),
+                "final_velocity_<k>"
+            );
+            assert_eq!(
+                f.dataset("chain/velocity").unwrap().shape(),
+                vec![n, 5],
+                "sphere × time"
+            );
+        }
+        assert_eq!(
+            objects[0], objects[1],
+            "/summary independent of the sphere count"
+        );
+        let (attrs, members) = &objects[0];
+        assert_eq!(attrs.len(), 4, "{attrs:?}: two values, units and warnings");
+        assert_eq!(members.len(), 2, "{members:?}");
+    }
+
+    /// Files written before issue 45 keep each `final_velocity_<k>` as a `/summary` attribute
+    /// (listed in `units`) and a scalar dataset, and `/chain/final_velocity` unmarked: they read
+    /// as they did, the summary from the attributes alone (not twice).
+    #[test]
+    fn a_chain_file_of_the_old_layout_reads_as_before() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("old.h5");
+        let f = hdf5::File::create(&path).unwrap();
+        let c = f.create_group("chain").unwrap();
+        crate::h5::write_dataset(&c, "final_velocity", &[0.25, 0.5], "m/s", &path).unwrap();
+        let s = f.create_group("summary").unwrap();
+        let mut units = Vec::new();
+        for (key, value, unit) in [
+            ("restitution", 0.9, "1"),
+            ("final_velocity_1", 0.25, "m/s"),
+            ("final_velocity_2", 0.5, "m/s"),
+        ] {
+            let a = s.new_attr::<f64>().shape(()).create(key).unwrap();
+            a.write_scalar(&value).unwrap();
+            let ds = s.new_dataset::<f64>().shape(()).create(key).unwrap();
+            ds.write_scalar(&value).unwrap();
+            crate::h5::string_attr(&ds, "units", unit, &path).unwrap();
+            units.push(format!("{key}={unit}"));
+        }
+        crate::h5::string_attr(&s, "units", &units.join(", "), &path).unwrap();
+        crate::h5::string_attr(&s, "warnings", "", &path).unwrap();
+        f.close().unwrap();
+        let back = read_run_file(&path).unwrap();
+        assert_eq!(
+            back.summary,
+            vec![
+                ("restitution".to_string(), 0.9, "1".to_string()),
+                ("final_velocity_1".to_string(), 0.25, "m/s".to_string()),
+                ("final_velocity_2".to_string(), 0.5, "m/s".to_string()),
+            ]
+        );
+        assert!(
+            back.datasets
+                .iter()
+                .any(|d| d.path == "summary/final_velocity_2")
+        );
     }
 }

@@ -100,6 +100,7 @@ fn strike_free(material: &Material, speed_m_s: f64) -> Result<(f64, f64, f64, f6
         dt_s: t_c / STEPS_PER_CONTACT,
         end_time_s: 37.0 * 0.5 * t_c,
         output_every: 1,
+        output_every_by_budget: false,
     };
     let r = free_chain(&setup)?;
     let peak_time = |k: usize| r.time_s[shpb_core::numeric::argmax(&r.contact_force_n[k])];

@@ -69,7 +69,17 @@ pub struct FreeChainSetup {
     pub end_time_s: f64,
     /// Keep every n-th step in the output series.
     pub output_every: usize,
+    /// True when the scene did not set `output_every` and it was chosen by
+    /// [`FreeChainSetup::output_every_within`] for [`CHAIN_OUTPUT_BUDGET_NUMBERS`]; the run
+    /// then says so in its warnings.
+    pub output_every_by_budget: bool,
 }
+
+/// Numbers a chain run keeps in its series (`/chain`, `/contact`) when its scene does not set
+/// `output_every`: 2e7, 8 bytes each, so at most 160 MB held during the run and written to
+/// its HDF5 file (README, `chain` scenes; issue 45: a 10 000-sphere chain kept every step,
+/// 5.75 GB).
+pub const CHAIN_OUTPUT_BUDGET_NUMBERS: f64 = 2e7;
 
 /// The bodies and contacts of a setup: masses (infinite for the wall), the contact properties
 /// and the centre distance at touch of each contact, in order along the line.
@@ -80,6 +90,37 @@ struct Layout {
 }
 
 impl FreeChainSetup {
+    /// Time steps of the run, ⌈end_time_s/Δt⌉.
+    pub fn steps(&self) -> usize {
+        (self.end_time_s / self.dt_s).ceil() as usize
+    }
+
+    /// Numbers recorded per sample, an upper count: the time, N − 1 contact forces and
+    /// approaches, N velocities, the first contact's 5 series and the striker's and wall's 3.
+    pub fn numbers_per_sample(&self) -> usize {
+        3 * self.chain.len() + 7
+    }
+
+    /// Samples a run keeps at `output_every = every`: the start, every `every`-th step and the
+    /// last step, at most ⌊steps/every⌋ + 2.
+    pub fn samples_kept(&self, every: usize) -> usize {
+        self.steps() / every.max(1) + 2
+    }
+
+    /// The smallest `output_every` whose samples ([`FreeChainSetup::samples_kept`]) times
+    /// [`FreeChainSetup::numbers_per_sample`] stay within `budget_numbers`; when even the start
+    /// and the end alone exceed it, every step but the last is skipped (`steps`).
+    pub fn output_every_within(&self, budget_numbers: f64) -> usize {
+        let steps = self.steps().max(1);
+        let samples = (budget_numbers / self.numbers_per_sample() as f64).floor();
+        if samples < 3.0 {
+            return steps;
+        }
+        // ⌊steps/n⌋ + 2 ≤ S  ⇔  steps/n < S − 1  ⇔  n > steps/(S − 1).
+        let s = samples as usize;
+        (steps / (s - 1) + 1).min(steps)
+    }
+
     /// Index of sphere 1 among the bodies (1 with a striker).
     pub fn first_sphere(&self) -> usize {
         usize::from(self.striker.is_some())
@@ -423,6 +464,47 @@ impl Stepper {
     }
 }
 
+/// Series of many rows (one per contact or sphere) recorded time-major: each sample appends
+/// one contiguous line of every row's value, so recording writes memory in order; turned into
+/// one `Vec` per row once, at the end ([`TimeMajor::into_rows`]).
+struct TimeMajor {
+    width: usize,
+    data: Vec<f64>,
+}
+
+impl TimeMajor {
+    /// Room for `samples` lines of `width` values, allocated once.
+    fn new(width: usize, samples: usize) -> TimeMajor {
+        TimeMajor {
+            width,
+            data: Vec::with_capacity(width * samples),
+        }
+    }
+
+    /// Appends one sample: the value of every row, in row order.
+    fn push(&mut self, line: impl Iterator<Item = f64>) {
+        self.data.extend(line);
+    }
+
+    /// One `Vec` per row (columns: the samples), transposed by blocks of rows so that reads
+    /// and writes both stay in cache; the time-major copy is freed on return.
+    fn into_rows(self) -> Vec<Vec<f64>> {
+        const BLOCK: usize = 64;
+        let w = self.width;
+        let samples = self.data.len().checked_div(w).unwrap_or(0);
+        let mut rows: Vec<Vec<f64>> = (0..w).map(|_| Vec::with_capacity(samples)).collect();
+        for start in (0..w).step_by(BLOCK) {
+            let end = (start + BLOCK).min(w);
+            for line in self.data.chunks_exact(w) {
+                for (row, &x) in rows[start..end].iter_mut().zip(&line[start..end]) {
+                    row.push(x);
+                }
+            }
+        }
+        rows
+    }
+}
+
 /// Runs a free chain of spheres struck by its first sphere or a striker (module docs).
 pub fn free_chain(setup: &FreeChainSetup) -> Result<FreeChainResult> {
     free_chain_with_progress(setup, &mut |_| true)
@@ -440,16 +522,16 @@ pub fn free_chain_with_progress(
     let nc = st.laws.len();
     let sphere_contacts = first..first + n_spheres - 1;
     let wall = setup.wall.as_ref().map(|_| nc - 1);
-    let steps = (setup.end_time_s / setup.dt_s).ceil() as usize;
-    let cap = steps / setup.output_every + 2;
+    let steps = setup.steps();
+    let cap = setup.samples_kept(setup.output_every);
     let ke0 = st.kinetic_energy_j();
     let p0 = st.momentum_kg_m_s();
     let initial_velocity_m_s = st.velocity_m_s.clone();
     let mut r = FreeChainResult {
         time_s: Vec::with_capacity(cap),
-        contact_force_n: vec![Vec::with_capacity(cap); n_spheres - 1],
-        contact_approach_m: vec![Vec::with_capacity(cap); n_spheres - 1],
-        velocity_m_s: vec![Vec::with_capacity(cap); n_spheres],
+        contact_force_n: Vec::new(),
+        contact_approach_m: Vec::new(),
+        velocity_m_s: Vec::new(),
         striker_velocity_m_s: setup.striker.as_ref().map(|_| Vec::with_capacity(cap)),
         striker_force_n: setup.striker.as_ref().map(|_| Vec::with_capacity(cap)),
         wall_force_n: wall.map(|_| Vec::with_capacity(cap)),
@@ -473,15 +555,16 @@ pub fn free_chain_with_progress(
         momentum_max_relative_drift: 0.0,
         steps,
     };
-    let record = |st: &Stepper, r: &mut FreeChainResult| {
+    // Issue 45: the many-row series are kept time-major while recording (each sample one
+    // contiguous row), every `output_every`-th step only, and turned into rows at the end.
+    let mut force = TimeMajor::new(n_spheres - 1, cap);
+    let mut approach = TimeMajor::new(n_spheres - 1, cap);
+    let mut velocity = TimeMajor::new(n_spheres, cap);
+    let mut record = |st: &Stepper, r: &mut FreeChainResult| {
         r.time_s.push(st.time_s());
-        for (j, k) in sphere_contacts.clone().enumerate() {
-            r.contact_force_n[j].push(st.evals[k].force_n);
-            r.contact_approach_m[j].push(st.approach_m(k));
-        }
-        for j in 0..n_spheres {
-            r.velocity_m_s[j].push(st.velocity_m_s[first + j]);
-        }
+        force.push(st.evals[sphere_contacts.clone()].iter().map(|e| e.force_n));
+        approach.push(sphere_contacts.clone().map(|k| st.approach_m(k)));
+        velocity.push(st.velocity_m_s[first..first + n_spheres].iter().copied());
         if let Some(v) = r.striker_velocity_m_s.as_mut() {
             v.push(st.velocity_m_s[0]);
         }
@@ -520,6 +603,9 @@ pub fn free_chain_with_progress(
             });
         }
     }
+    r.contact_force_n = force.into_rows();
+    r.contact_approach_m = approach.into_rows();
+    r.velocity_m_s = velocity.into_rows();
     r.final_velocity_m_s = st
         .velocity_m_s
         .iter()
@@ -581,6 +667,7 @@ mod tests {
             dt_s: 0.0,
             end_time_s,
             output_every: 1,
+            output_every_by_budget: false,
         };
         s.dt_s = s.default_time_step(2000.0);
         s
@@ -780,6 +867,98 @@ mod tests {
                 let last_force = r.wall_force_n.as_ref().unwrap().last().copied().unwrap();
                 assert_eq!(last_force, 0.0, "{what}: still pressing on the wall");
             }
+        }
+    }
+
+    /// Issue 45: the `output_every` a scene without one gets is the smallest that keeps the
+    /// series within the budget: at it the samples kept (start, every n-th step, end) times the
+    /// numbers per sample are within the budget, one step less frequent they are not; a chain
+    /// that fits keeps every step; a budget below three samples keeps the start and the end.
+    #[test]
+    fn the_output_budget_rule() {
+        let chain = |n: usize, end_time_s: f64| {
+            let spheres = vec![crate::fixtures::ss440c_pair().sphere1; n];
+            setup(SphereChain { spheres }, LawKind::Hertz, 20.0, end_time_s)
+        };
+        for (s, budget) in [
+            (chain(10_000, 75e-6), CHAIN_OUTPUT_BUDGET_NUMBERS),
+            (chain(2_000, 75e-6), CHAIN_OUTPUT_BUDGET_NUMBERS),
+            (chain(10, 75e-6), 1e4),
+            (chain(10, 75e-6), 37.0 * 3.0),
+        ] {
+            let every = s.output_every_within(budget);
+            let numbers = |n: usize| (s.samples_kept(n) * s.numbers_per_sample()) as f64;
+            println!(
+                "{} spheres, {} steps, budget {budget:e}: output_every {every}, {} numbers",
+                s.chain.len(),
+                s.steps(),
+                numbers(every)
+            );
+            assert!(numbers(every) <= budget, "{every}: {}", numbers(every));
+            assert!(
+                every == 1 || numbers(every - 1) > budget,
+                "{every} not the smallest"
+            );
+        }
+        let fits = chain(10, 75e-6);
+        assert_eq!(fits.output_every_within(CHAIN_OUTPUT_BUDGET_NUMBERS), 1);
+        let tiny = chain(10, 75e-6);
+        assert_eq!(tiny.output_every_within(100.0), tiny.steps());
+        // 10 000 spheres at 20 m/s for 75 µs: 3 × 10⁴ numbers a sample, 666 samples in 2e7.
+        let big = chain(10_000, 75e-6);
+        let every = big.output_every_within(CHAIN_OUTPUT_BUDGET_NUMBERS);
+        assert_eq!(every, big.steps() / 665 + 1);
+    }
+
+    /// The time-major recording turns into the rows the samples were pushed as, for widths
+    /// below, at and across the transpose's block of 64 rows.
+    #[test]
+    fn time_major_lines_become_rows() {
+        for (width, samples) in [(0, 3), (1, 4), (9, 5), (64, 2), (130, 7)] {
+            let mut tm = TimeMajor::new(width, samples);
+            for t in 0..samples {
+                tm.push((0..width).map(|k| (1000 * k + t) as f64));
+            }
+            let rows = tm.into_rows();
+            assert_eq!(rows.len(), width);
+            for (k, row) in rows.iter().enumerate() {
+                let expected: Vec<f64> = (0..samples).map(|t| (1000 * k + t) as f64).collect();
+                assert_eq!(row, &expected, "row {k} of {width}");
+            }
+        }
+    }
+
+    /// Issue 45: the series are decimated as they are recorded, and what is kept is exactly
+    /// the every-step run's samples at the steps kept (the start, every n-th step, the last).
+    #[test]
+    fn a_decimated_run_keeps_the_every_step_run_s_samples() {
+        let mut s = ten_ss440c(LawKind::BurgoyneDaraio, 200.0);
+        let all = free_chain(&s).unwrap();
+        for every in [7, 50] {
+            s.output_every = every;
+            let some = free_chain(&s).unwrap();
+            let steps = s.steps();
+            let kept: Vec<usize> = (0..=steps)
+                .filter(|&n| n % every == 0 || n == steps)
+                .collect();
+            assert_eq!(some.time_s.len(), kept.len());
+            assert!(some.time_s.len() <= s.samples_kept(every));
+            assert!(some.time_s.capacity() <= s.samples_kept(every));
+            let pick = |v: &[f64]| kept.iter().map(|&n| v[n]).collect::<Vec<f64>>();
+            assert_eq!(some.time_s, pick(&all.time_s));
+            for k in 0..9 {
+                assert_eq!(some.contact_force_n[k], pick(&all.contact_force_n[k]));
+                assert_eq!(some.contact_approach_m[k], pick(&all.contact_approach_m[k]));
+            }
+            for j in 0..10 {
+                assert_eq!(some.velocity_m_s[j], pick(&all.velocity_m_s[j]));
+            }
+            assert_eq!(some.final_velocity_m_s, all.final_velocity_m_s);
+            assert_eq!(some.peak_force_n, all.peak_force_n);
+            assert_eq!(
+                some.energy_balance_max_relative_error,
+                all.energy_balance_max_relative_error
+            );
         }
     }
 }

@@ -1,9 +1,7 @@
 //! `kind = "chain"`: a free chain of N ≥ 2 spheres in a line, struck by its first sphere or a
 //! striker mass, optionally against a wall (docs/physics.md §8).
 
-use super::{
-    CHAIN_SPECIMEN, Key, LAW, OUTPUT_EVERY, Parsed, REGION2, SceneKind, UNLOADING, check_every, one,
-};
+use super::{CHAIN_SPECIMEN, Key, LAW, Parsed, REGION2, SceneKind, UNLOADING, check_every};
 use crate::error::{Result, Validator};
 use crate::material::MaterialFile;
 use crate::toml_file::parse_as;
@@ -60,7 +58,12 @@ pub(super) const KIND: SceneKind = SceneKind {
             default: "fidelity: 200, 2000, 20000",
             meaning: "time steps per Hertz contact time of the stiffest contact, 20 to 1e8",
         },
-        OUTPUT_EVERY,
+        Key {
+            key: "output_every",
+            unit: "",
+            default: "1, or the smallest n keeping the series within 2e7 numbers (160 MB)",
+            meaning: "keep every n-th step in the output (1 or more); unset, the run warns when it keeps fewer than every step",
+        },
     ],
     example: "kind = \"chain\"\nvelocity1_m_s = 5.0\nend_time_s = 75e-6\nspecimen = { count = 10, material = \"ss440c\", diameter_m = 6.35e-3 }\n",
     example_dir: None,
@@ -92,8 +95,7 @@ super::sphere_scene_file! {
         wall: Option<WallSpec>,
         time_step_s: Option<f64>,
         steps_per_contact: Option<f64>,
-        #[serde(default = "one")]
-        output_every: usize,
+        output_every: Option<usize>,
     }
 }
 
@@ -189,7 +191,8 @@ fn parse(
         wall,
         dt_s: 0.0,
         end_time_s: 0.0,
-        output_every: check_every(v, f.output_every)?,
+        output_every: f.output_every.map_or(Ok(1), |n| check_every(v, n))?,
+        output_every_by_budget: f.output_every.is_none(),
     };
     let times = setup.hertz_contact_times_s();
     let tc_max = times.iter().copied().fold(0.0, f64::max);
@@ -232,6 +235,11 @@ fn parse(
         Some(t) => v.positive("end_time_s", t, 1.0, "s")?,
         None => default_end,
     };
+    // Issue 45: unless the scene sets it, keep the series within the budget.
+    if setup.output_every_by_budget {
+        setup.output_every =
+            setup.output_every_within(shpb_core::solver::spheres::CHAIN_OUTPUT_BUDGET_NUMBERS);
+    }
     let specimen = Specimen::Spheres(SphereSpecimen {
         chain: setup.chain.clone(),
         law: setup.law,
@@ -347,6 +355,50 @@ mod tests {
             s.hertz_contact_times_s().len(),
             4,
             "striker, 2 sphere contacts, wall"
+        );
+    }
+
+    fn parsed(text: &str) -> Box<FreeChainSetup> {
+        let v = Validator::new("c.toml");
+        match parse(text, "c.toml", Path::new("."), Fidelity::Standard, &v).unwrap() {
+            (_, SceneParams::Chain(s)) => s,
+            (_, p) => panic!("not a chain: {p:?}"),
+        }
+    }
+
+    /// Issue 45: without `output_every` a chain keeps every step when that fits the budget (the
+    /// shipped 10-sphere scene) and otherwise the smallest n that does; a value the scene sets
+    /// is kept as written, whatever the budget.
+    #[test]
+    fn output_every_is_chosen_for_the_budget_unless_set() {
+        let scene = |count: usize, extra: &str| {
+            format!(
+                "kind = \"chain\"\nvelocity1_m_s = 20.0\nend_time_s = 75e-6\n{extra}\n\
+                 [specimen]\ncount = {count}\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3\n"
+            )
+        };
+        let budget = shpb_core::solver::spheres::CHAIN_OUTPUT_BUDGET_NUMBERS;
+        let small = parsed(&scene(10, ""));
+        assert_eq!(
+            (small.output_every, small.output_every_by_budget),
+            (1, true)
+        );
+        let big = parsed(&scene(10_000, ""));
+        assert!(big.output_every_by_budget);
+        assert_eq!(big.output_every, big.output_every_within(budget));
+        assert!(big.output_every > 1);
+        let kept = (big.samples_kept(big.output_every) * big.numbers_per_sample()) as f64;
+        assert!(kept <= budget, "{kept}");
+        let set = parsed(&scene(10_000, "output_every = 3"));
+        assert_eq!((set.output_every, set.output_every_by_budget), (3, false));
+        let one = parsed(&scene(10_000, "output_every = 1"));
+        assert_eq!((one.output_every, one.output_every_by_budget), (1, false));
+        assert!(
+            error(
+                "velocity1_m_s = 20.0\noutput_every = 0",
+                "count = 3\nmaterial = \"ss440c\"\ndiameter_m = 6.35e-3"
+            )
+            .starts_with("c.toml: `output_every`: 0 is out of range; allowed: 1 or more")
         );
     }
 }
