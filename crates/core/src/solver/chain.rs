@@ -645,6 +645,71 @@ mod tests {
         (setup, z, m_s + 0.5 * material.density_kg_m3 * area * dx)
     }
 
+    /// The sphere contact's solve returns plain bisection's crossing of F = law(F) (to 1e-12)
+    /// at every step of a pulse through a Burgoyne–Daraio pair between two bars, loading into
+    /// the plastic range, turning and unloading, under each unloading rule, touching, preloaded
+    /// and gapped: the crossing the shipped results hold, found in a few evaluations.
+    #[test]
+    fn the_contact_solve_keeps_bisections_crossing_through_load_and_turn() {
+        use crate::specimen::Seating;
+        for unloading in [
+            Unloading::Dynamic,
+            Unloading::DynamicContinuous,
+            Unloading::Static,
+        ] {
+            for seating in [
+                Seating::Touching,
+                Seating::Preload { force_n: 300.0 },
+                Seating::Gap { gap_m: 5e-6 },
+            ] {
+                let (mut setup, _, _) = seated_pair(seating, 0.0);
+                let Joint::Spheres { law, .. } = &mut setup.joints[0] else {
+                    unreachable!("seated_pair joins its bars by spheres")
+                };
+                *law = LawSpec {
+                    kind: LawKind::BurgoyneDaraio,
+                    region2: Region2Form::Smooth,
+                    unloading,
+                };
+                // A half-sine pulse of 20 kN over 30 µs at the incident bar's far end.
+                let steps = (setup.end_time_s / setup.dt_s).ceil() as usize;
+                setup.drive_force_n = (0..=steps)
+                    .map(|n| {
+                        let s = n as f64 * setup.dt_s / 30e-6;
+                        if s < 1.0 {
+                            2e4 * (std::f64::consts::PI * s).sin()
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect();
+                let mut chain = Chain::new(&setup).unwrap();
+                let (mut peak, mut last) = (0.0f64, 0.0);
+                for _ in 0..steps {
+                    let p = chain.predict(0);
+                    let f = chain.joints[0].trial_force_n(&p, setup.dt_s);
+                    let r = chain.joints[0].bisection_force_n(&p, setup.dt_s);
+                    // Bisection's 100 halvings leave a crossing at 0 (a preloaded pair at rest)
+                    // within 2⁻¹⁰⁰ of the preload.
+                    let floor = 1e-28 * chain.joints[0].static_force_n;
+                    assert!(
+                        (f - r).abs() <= 4e-12 * r.abs().max(f.abs()) + floor,
+                        "{unloading:?} {seating:?} step {}: {f} against {r}",
+                        chain.step_index()
+                    );
+                    chain.step().unwrap();
+                    last = chain.joints[0].contact_force_n();
+                    peak = peak.max(last);
+                }
+                // The test has teeth: the pair yielded (kN) and unloaded.
+                assert!(
+                    peak > 1e3 && last < 0.5 * peak,
+                    "{unloading:?} {seating:?}: {peak} {last}"
+                );
+            }
+        }
+    }
+
     /// A seating gap g (docs/physics.md §6.11): the incident wave of force F reaches the open
     /// end, whose node carries the sphere (mass m), at t_a = L/c0, and moves it by
     /// u(τ) = (2F/Z) (τ − (m/Z)(1 − e^{−Zτ/m})) (a mass on a free end hit by a step wave); the
