@@ -246,7 +246,7 @@ pub fn illinois(
 /// bracket is within `rel` of its larger end's magnitude (its midpoint), or once a secant step
 /// is within `rel`/4 of the iterate's magnitude (the step's end: the superlinear iteration is
 /// then well inside `rel`), or after `max_iter` evaluations (the bracket's midpoint). For a
-/// nearly linear g (the implicit contact solve, docs/physics.md §6, "Joints") the first secant,
+/// nearly linear g (the implicit contact solve, docs/physics.md §6.6) the first secant,
 /// the regula falsi point of the bracket, is already close, and two or three evaluations do.
 pub fn secant_in_bracket(
     lo: f64,

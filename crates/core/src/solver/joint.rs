@@ -14,7 +14,7 @@
 //! * a **sphere contact** is solved the same way with a contact law ([`Contact`]) at the Newmark
 //!   average approach and the centred approach rate (the law's memory is committed once a step),
 //!   to the crossing of F = law(F) that bisection would find (it need not be unique where the
-//!   contact turns), by the bracketed secant on the branch that holds it, about three law
+//!   contact turns), by the bracketed secant on the branch that holds it, about four law
 //!   evaluations a step ([`JointState::trial_force_n`]);
 //! * a **bonded joint** (a tension specimen threaded or glued to a bar) never opens: the two end
 //!   nodes move as one full node in tension as in compression (docs/physics.md §6.13);
@@ -280,7 +280,7 @@ impl JointPrediction {
 /// Root of F = law(F) for a law that does not grow with F (more force, less closure) on each of
 /// its two branches, in [lo, law(lo)] (lo = 0, or −preload for a preloaded contact, whose change
 /// of force reaches down to it), to 1e-12 of the force: the crossing bisection over that bracket
-/// finds ([`solve_force_bisecting`], the choice the shipped results hold), in about three law
+/// finds ([`solve_force_bisecting`], the choice the shipped results hold), in about four law
 /// evaluations instead of eighteen.
 ///
 /// `loading(f)` tells the branch: whether the contact loads on its virgin curve at force f (its
