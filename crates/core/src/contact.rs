@@ -3,7 +3,31 @@
 //!
 //! Sign convention (docs/physics.md): approach δ and contact force F are positive in compression.
 
+use std::cell::Cell;
 use std::f64::consts::PI;
+
+thread_local! {
+    /// Law evaluations on this thread so far: (trials, commits) ([`law_evaluations`]).
+    static EVALUATIONS: Cell<(u64, u64)> = const { Cell::new((0, 0)) };
+}
+
+/// Evaluations of every contact law on this thread since it started: (trials, commits). A trial
+/// ([`Contact::trial`], [`Contact::trial_force`]) is one evaluation of an implicit solve; a
+/// commit ([`Contact::evaluate`]) is one a step per contact, so trials over commits is the
+/// solves' cost per contact-step (validation/perf/solver.md). Two thread-local counts, so the
+/// counting costs a few instructions of an evaluation's hundreds.
+pub fn law_evaluations() -> (u64, u64) {
+    EVALUATIONS.with(Cell::get)
+}
+
+/// Counts one trial (`commit` false) or committed (`commit` true) evaluation.
+#[inline]
+fn count_evaluation(commit: bool) {
+    EVALUATIONS.with(|c| {
+        let (t, k) = c.get();
+        c.set(if commit { (t, k + 1) } else { (t + 1, k) });
+    });
+}
 
 /// The constant 1.6 of the yield onset, from maximising J2 below a Hertz contact (paper Sec. II).
 pub const YIELD_ONSET_FACTOR: f64 = 1.6;
@@ -487,20 +511,25 @@ impl<L: ContactLaw> Contact for Stateful<L> {
     }
 
     fn evaluate(&mut self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval {
+        count_evaluation(true);
         self.law
             .evaluate(&mut self.state, delta_m, approach_speed_m_s)
     }
 
     fn trial(&self, delta_m: f64, approach_speed_m_s: f64) -> ContactEval {
+        count_evaluation(false);
         self.law
             .evaluate(&mut self.state.clone(), delta_m, approach_speed_m_s)
     }
 
     fn trial_force(&self, delta_m: f64, approach_speed_m_s: f64) -> f64 {
+        count_evaluation(false);
         if self.law.is_loading(&self.state, delta_m) {
             self.law.virgin_force(delta_m, approach_speed_m_s)
         } else {
-            self.trial(delta_m, approach_speed_m_s).force_n
+            self.law
+                .evaluate(&mut self.state.clone(), delta_m, approach_speed_m_s)
+                .force_n
         }
     }
 

@@ -240,6 +240,56 @@ pub fn illinois(
     (lo, hi)
 }
 
+/// Root of g on `[lo, hi]` where g(lo) = `g_lo` > 0 ≥ g(hi) = `g_hi` and g crosses zero once, by
+/// the secant method kept inside the bracket (a step that would leave it, or a bracket that has
+/// not halved over three evaluations, bisects instead): stops at an exact zero, once the
+/// bracket is within `rel` of its larger end's magnitude (its midpoint), or once a secant step
+/// is within `rel`/4 of the iterate's magnitude (the step's end: the superlinear iteration is
+/// then well inside `rel`), or after `max_iter` evaluations (the bracket's midpoint). For a
+/// nearly linear g (the implicit contact solve, docs/physics.md §6.6) the first secant,
+/// the regula falsi point of the bracket, is already close, and two or three evaluations do.
+pub fn secant_in_bracket(
+    lo: f64,
+    hi: f64,
+    g_lo: f64,
+    g_hi: f64,
+    max_iter: usize,
+    rel: f64,
+    g: impl Fn(f64) -> f64,
+) -> f64 {
+    let (mut a, mut b) = (lo, hi);
+    // The two latest points, newest last (the bracket's ends to start: regula falsi).
+    let (mut x0, mut g0, mut x1, mut g1) = (lo, g_lo, hi, g_hi);
+    let mut widths = [b - a; 3];
+    for k in 0..max_iter {
+        let width = b - a;
+        let slow = k >= 3 && width > 0.5 * widths[k % 3];
+        widths[k % 3] = width;
+        let secant = x1 - g1 * (x1 - x0) / (g1 - g0);
+        let x = if !slow && secant > a && secant < b {
+            if (secant - x1).abs() <= 0.25 * rel * secant.abs().max(x1.abs()) {
+                return secant;
+            }
+            secant
+        } else {
+            0.5 * (a + b)
+        };
+        let gx = g(x);
+        if gx > 0.0 {
+            a = x;
+        } else if gx < 0.0 {
+            b = x;
+        } else {
+            return x;
+        }
+        if b - a <= rel * a.abs().max(b.abs()) {
+            break;
+        }
+        (x0, g0, x1, g1) = (x1, g1, x, gx);
+    }
+    0.5 * (a + b)
+}
+
 /// Linear least squares by SVD: the β minimising ‖Σⱼ βⱼ `columns[j]` − `y`‖₂, or None when the
 /// columns are rank-deficient (or any input is not finite).
 ///
@@ -437,6 +487,44 @@ mod tests {
             let (c, d) = bisect(0.0, hi, 100, tol, |f| law(f) > 0.0);
             assert!((0.5 * (a + b) - 0.5 * (c + d)).abs() <= 1e-12 * d);
             assert!(calls.get() <= 25, "{} evaluations", calls.get());
+        }
+    }
+
+    /// The bracketed secant finds the one crossing of smooth, kinked and discontinuous decreasing
+    /// functions to the tolerance bisection reaches, and a nearly linear one (the contact solve's
+    /// g, slope ≈ −1) in at most three evaluations.
+    #[test]
+    fn the_bracketed_secant_finds_the_crossing_bisection_finds() {
+        type Law<'a> = &'a dyn Fn(f64) -> f64;
+        let cases: [(Law, f64, usize); 5] = [
+            (
+                &|f: f64| 10.0 * (1.0 - f / 7.0).powf(1.5).max(0.0) - f,
+                10.0,
+                12,
+            ),
+            (&|f: f64| 5.0 - f * f * f, 5.0, 20),
+            (
+                &|f: f64| if f < 2.0 { 4.0 - f } else { 3.0 - 1.4 * f },
+                4.0,
+                20,
+            ),
+            (&|f: f64| if f < 1.5 { 3.0 - f } else { 0.5 - f }, 3.0, 60),
+            (
+                &|f: f64| 1e4 * (1.0 - f / 3e5).max(0.0).powf(1.5) - f,
+                1e4,
+                3,
+            ),
+        ];
+        for (g, hi, most) in cases {
+            let calls = std::cell::Cell::new(0);
+            let counted = |f: f64| {
+                calls.set(calls.get() + 1);
+                g(f)
+            };
+            let x = secant_in_bracket(0.0, hi, g(0.0), g(hi), 100, 1e-12, counted);
+            let (c, d) = bisect(0.0, hi, 200, |lo, hi| hi - lo <= 1e-13 * hi, |f| g(f) > 0.0);
+            assert!((x - 0.5 * (c + d)).abs() <= 1e-12 * d, "{x} against {c}");
+            assert!(calls.get() <= most, "{} evaluations", calls.get());
         }
     }
 
