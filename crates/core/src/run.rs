@@ -5,6 +5,66 @@
 use crate::reduce::ReductionInput;
 use crate::solver::ContactSeries;
 
+/// What a run records beyond what its summary, its reduction and its warnings read (issue 45):
+/// the bars' x–t snapshots are written only into a run file and drawn only by a figure, and
+/// cost a sample per point every snapshot interval (40 % of a `standard` run), so the runs whose
+/// only product is their summary leave them out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Outputs {
+    /// Every series the scene asks for, the x–t snapshots at its `snapshot_interval_s` included
+    /// (`shpb run -o`/`--plot`, the Python `shpb.run`).
+    #[default]
+    Full,
+    /// The summary, the reduction, the warnings and the series they are computed from (gauges,
+    /// energies, contact, specimen, chain), without the x–t snapshots: sweeps, studies, fits,
+    /// designs, band runs, and `shpb run` writing neither a run file nor a figure.
+    Summary,
+}
+
+impl Outputs {
+    /// The outputs `shpb run` needs: [`Outputs::Full`] when it writes a run file (`-o`, which
+    /// stores `/bars/*/snapshots`) or a figure (`--plot`, which draws the x–t diagram), else
+    /// [`Outputs::Summary`] (the summary table, `--json`, `--csv`: none reads the snapshots).
+    pub fn for_files(run_file: bool, figure: bool) -> Outputs {
+        if run_file || figure {
+            Outputs::Full
+        } else {
+            Outputs::Summary
+        }
+    }
+}
+
+impl crate::scene::Params {
+    /// This scene set to record `outputs` ([`Outputs`]): [`Outputs::Summary`] clears the bars'
+    /// snapshot interval, [`Outputs::Full`] keeps the scene's. Every summary item, the reduction
+    /// and the warnings are the same either way.
+    pub fn with_outputs(mut self, outputs: Outputs) -> crate::scene::Params {
+        self.set_outputs(outputs);
+        self
+    }
+
+    /// [`crate::scene::Params::with_outputs`] in place.
+    pub fn set_outputs(&mut self, outputs: Outputs) {
+        if let (Outputs::Summary, crate::scene::SceneParams::Pulse { options, .. }) =
+            (outputs, &mut self.params)
+        {
+            options.snapshot_interval_s = None;
+        }
+    }
+
+    /// This scene as a summary-only run (`with_outputs(Outputs::Summary)`): what sweeps,
+    /// studies, fits and designs run.
+    pub fn summary_only(self) -> crate::scene::Params {
+        self.with_outputs(Outputs::Summary)
+    }
+
+    /// Whether a run of this scene records the bars' x–t snapshots.
+    pub fn records_snapshots(&self) -> bool {
+        matches!(&self.params, crate::scene::SceneParams::Pulse { options, .. }
+            if options.snapshot_interval_s.is_some())
+    }
+}
+
 /// A scalar result of a run (peak force, restitution, …) with its unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SummaryItem {

@@ -131,14 +131,6 @@ pub fn uncertainty(params: &Params) -> Option<&Uncertainty> {
 /// striker velocity): what the band and Monte-Carlo runs call.
 pub type Perturb<'a> = dyn Fn(&[(String, f64)]) -> Result<Params> + Sync + 'a;
 
-/// `params` as a summary-only run: no x–t snapshots.
-fn summary_only(mut params: Params) -> Params {
-    if let SceneParams::Pulse { options, .. } = &mut params.params {
-        options.snapshot_interval_s = None;
-    }
-    params
-}
-
 /// Scales the striker velocity of a bar scene by `factor` (the gun's shot-to-shot scatter).
 fn scale_velocity(params: &mut Params, factor: f64) {
     if let SceneParams::Pulse { options, .. } = &mut params.params {
@@ -253,7 +245,7 @@ pub fn predict_with(
         .map(|&(i, sign)| {
             let input = &inputs[i];
             let moved = perturb(&[(input.key.clone(), input.value + sign * input.sd)])?;
-            Ok(summary_only(moved).run()?)
+            Ok(moved.summary_only().run()?)
         })
         .collect();
     let mut outs = Vec::with_capacity(runs.len());
@@ -384,7 +376,7 @@ pub fn monte_carlo(
         .collect();
     let outs: Vec<RunOutput> = draws
         .par_iter()
-        .map(|values| Ok(summary_only(perturb(values)?).run()?))
+        .map(|values| Ok(perturb(values)?.summary_only().run()?))
         .collect::<Result<_>>()?;
     Ok(BANDED
         .iter()

@@ -209,14 +209,13 @@ pub fn bench(path: &Path, repeats: usize, mut progress: impl FnMut(&str)) -> Res
     let mut memory = Vec::new();
     for scale in [1.0, 4.0, 16.0, 32.0] {
         progress(&format!("memory, bars × {scale}"));
-        let mut p = base.clone();
+        let mut p = base.clone().summary_only();
         let (length, cell) = match &mut p.params {
             SceneParams::Pulse {
                 apparatus, options, ..
             } => {
                 apparatus.incident.length_m *= scale;
                 apparatus.transmission.length_m *= scale;
-                options.snapshot_interval_s = None;
                 (
                     apparatus.incident.length_m + apparatus.transmission.length_m,
                     options.cell_size_m,

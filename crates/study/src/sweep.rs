@@ -676,7 +676,7 @@ pub fn run_points_on(
     keep_going: &(dyn Fn() -> bool + Sync),
 ) -> Result<Finished<RunSummary>> {
     run_until(pool, points, keep_going, |p, progress| {
-        let params = Params::from_file_overridden(scene, &overrides(axes, p))?;
+        let params = Params::from_file_overridden(scene, &overrides(axes, p))?.summary_only();
         // The scene's warnings first, as `shpb run` prints them (api::run_scene).
         let mut out = params.run_with_progress(progress)?;
         out.warnings.splice(0..0, params.warnings());

@@ -629,7 +629,7 @@ pub fn study_shard_rows_until(
     let (inputs, samples) = study_samples(scene, plan, &pool)?;
     let indices: Vec<usize> = (k - 1..n).step_by(m).collect();
     let finished = crate::sweep::run_until(&pool, &indices, keep_going, |&i, progress| {
-        let params = Params::from_file_overridden(scene, &samples.overrides[i])?;
+        let params = Params::from_file_overridden(scene, &samples.overrides[i])?.summary_only();
         // Every warning of the run kept in its row, the scene's first.
         let mut out = params.run_with_progress(progress)?;
         out.warnings.splice(0..0, params.warnings());

@@ -1,9 +1,9 @@
 //! `shpb run`: run a scene file (or rerun a run file from the inputs it stored), print its
 //! summary and write its results.
 
-use super::common::{ProgressLine, finite, plan, report, warn, write_all};
+use super::common::{ProgressLine, finite, json_mode, plan, quiet_mode, report, warn, write_all};
 use shpb_core::fidelity::Fidelity;
-use shpb_core::run::RunOutput;
+use shpb_core::run::{Outputs, RunOutput};
 use shpb_core::scene::{Params, SceneParams};
 use shpb_input::Result;
 use shpb_input::files::Provenance;
@@ -14,7 +14,9 @@ use std::path::{Path, PathBuf};
 /// [--set KEY=VALUE …] [--no-bands]`;
 /// SCENE may be a run file (`.h5` written by `shpb run -o`): the test is run again from the
 /// scene and input files stored in its `/provenance`, not from the disk. `bands`: the summary's
-/// 90 % bands (docs/physics.md §10.6; false with `--no-bands`).
+/// 90 % bands (docs/physics.md §10.6; false with `--no-bands`), computed only when the summary
+/// is shown or a file is written. The bars' x–t snapshots are recorded only for `-o` and
+/// `--plot` ([`Outputs::for_files`]).
 #[allow(clippy::too_many_arguments)]
 pub fn run(
     scene: &Path,
@@ -36,7 +38,13 @@ pub fn run(
         ],
     )?;
     let data_on_stdout = outputs.to_stdout();
-    let (params, provenance) = load(scene, fidelity, &overrides)?;
+    let (params, provenance) = load_for_outputs(
+        scene,
+        fidelity,
+        &overrides,
+        output.is_some(),
+        plot.is_some(),
+    )?;
     // An output may never be one of the inputs (not even with --force).
     let mut inputs: Vec<PathBuf> = vec![scene.to_path_buf()];
     inputs.extend(
@@ -61,6 +69,9 @@ pub fn run(
     .collect();
     outputs.check_space(&sizes)?;
     let mut progress = ProgressLine::new(&params.source);
+    // The bands only when something shows them: the summary printed (or `--json`), or a file.
+    let shown = !quiet_mode() || json_mode();
+    let bands = bands && (shown || output.is_some() || csv.is_some() || plot.is_some());
     let out = shpb_study::api::run_scene_with_bands(&params, &provenance, bands, &mut |f| {
         progress.update(f);
         true
@@ -87,6 +98,23 @@ pub fn run(
         }
         Ok(())
     })
+}
+
+/// The scene `shpb run` runs (read by [`load`]) set to record what its outputs hold
+/// ([`Outputs::for_files`]): the bars' x–t snapshots only when a run file (`run_file`, `-o`) or
+/// a figure (`figure`, `--plot`) is written.
+pub fn load_for_outputs(
+    scene: &Path,
+    fidelity: Option<Fidelity>,
+    overrides: &[(String, shpb_input::scene::Value)],
+    run_file: bool,
+    figure: bool,
+) -> Result<(Params, Provenance)> {
+    let (params, provenance) = load(scene, fidelity, overrides)?;
+    Ok((
+        params.with_outputs(Outputs::for_files(run_file, figure)),
+        provenance,
+    ))
 }
 
 /// Reads the scene (recording every input it reads), or a run file's stored scene and inputs.

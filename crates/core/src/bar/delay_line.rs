@@ -86,10 +86,15 @@ impl Waves {
         }
     }
 
-    /// Stretch u_{e+1}^n − u_e^n = D_{e−n} + E_{e+n} of element e, m.
+    /// Stretch u_{e+1}^n − u_e^n = D_{e−n} + E_{e+n} of element e, m (without dispersion read
+    /// straight from the ring buffers, the values [`Waves::d`] and [`Waves::e`] give: the x–t
+    /// snapshots and the gauges read it at every sample).
     #[inline]
     fn stretch(&self, e: usize) -> f64 {
-        self.d(e) + self.e(e)
+        match self.transit {
+            None => self.right[self.right_slot(e)] + self.left[self.left_slot(e)],
+            Some(_) => self.d(e) + self.e(e),
+        }
     }
 
     /// Δt v_i^{n−1/2} = E_{i−1+n} − D_{i−n} of interior node i (1 ≤ i ≤ N − 1), m.
@@ -166,6 +171,18 @@ impl DelayLine {
         line.waves.transit = Some(Box::new(Transit::new(design, elements)));
         line.waves.restart_transit();
         line
+    }
+
+    /// The ring buffers of a delay line without dispersion, for the x–t snapshots to read
+    /// ([`super::Bar::sample_stress`]): `(right, left, n mod N)`, the stretch of element e being
+    /// `right[(e + N − n) mod N] + left[(e + n) mod N]` as [`Waves::stretch`] reads it; None
+    /// for a dispersive line.
+    pub(super) fn rings(&self) -> Option<(&[f64], &[f64], usize)> {
+        let w = &self.waves;
+        match w.transit {
+            None => Some((&w.right, &w.left, w.shift)),
+            Some(_) => None,
+        }
     }
 
     /// The impulse the coming step gives the interior nodes of a dispersive delay line,

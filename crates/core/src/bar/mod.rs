@@ -744,6 +744,54 @@ impl Bar {
         self.segments[self.segment_at(x_m)].youngs_modulus_pa * self.strain_at(x_m)
     }
 
+    /// [`Bar::stress_at`] at each of `x_m` found once (segment, element and weight), for
+    /// [`Bar::sample_stress`] to read the bar at the same points step after step without the
+    /// search (the x–t snapshots, docs/physics.md §6.2).
+    pub fn stress_sampler(&self, x_m: &[f64]) -> StressSampler {
+        let points = x_m
+            .iter()
+            .map(|&x| {
+                let (k, element, weight) = self.strain_point(x);
+                let s = &self.segments[k];
+                StressPoint {
+                    element,
+                    weight,
+                    dx_m: s.dx_m,
+                    youngs_modulus_pa: s.youngs_modulus_pa,
+                }
+            })
+            .collect();
+        StressSampler { points }
+    }
+
+    /// The stresses [`Bar::stress_at`] gives at the points of `sampler` (made by
+    /// [`Bar::stress_sampler`] for this bar), the same formula on the same operands: E·ε with
+    /// ε = (1 − t) ε_e + t ε_{e+1} (ε_e alone where t = 0), ε_e = (u_{e+1} − u_e)/Δx, Pa.
+    pub fn sample_stress(&self, sampler: &StressSampler) -> Vec<f64> {
+        // One call per theory, so that each reads its elements without dynamic dispatch; a
+        // plain delay line straight from its ring buffers (the values `stretch` gives).
+        let (c, points) = (&self.nodes, &sampler.points);
+        match &self.interior {
+            Theory::Leapfrog(t) => sample_stress(|e| t.stretch(c, e), points),
+            Theory::Love(t) => sample_stress(|e| t.stretch(c, e), points),
+            Theory::DelayLine(t) => match t.rings() {
+                Some((right, left, shift)) => {
+                    let n = right.len();
+                    sample_stress(
+                        |e| {
+                            let r = e + n - shift;
+                            let l = e + shift;
+                            right[if r >= n { r - n } else { r }]
+                                + left[if l >= n { l - n } else { l }]
+                        },
+                        points,
+                    )
+                }
+                None => sample_stress(|e| t.stretch(c, e), points),
+            },
+        }
+    }
+
     /// The dispersive transit of a delay line, if the bar has one.
     fn transit(&self) -> Option<&Transit> {
         self.interior.get().transit()
@@ -763,6 +811,55 @@ impl Bar {
     pub fn step_index(&self) -> usize {
         self.step_index
     }
+}
+
+/// One point of a [`StressSampler`]: what [`Bar::strain_at`] finds for its x.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct StressPoint {
+    /// Element e (strain = (1 − t) ε_e + t ε_{e+1}).
+    element: usize,
+    /// Weight t of element e + 1 (0: ε_e alone).
+    weight: f64,
+    /// Cell size Δx of the segment holding the point, m.
+    dx_m: f64,
+    /// Young's modulus E of that segment, Pa.
+    youngs_modulus_pa: f64,
+}
+
+/// Points along a bar with their elements and weights found once ([`Bar::stress_sampler`]), read
+/// by [`Bar::sample_stress`] (docs/physics.md §6.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StressSampler {
+    points: Vec<StressPoint>,
+}
+
+impl StressSampler {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether it has no point.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+}
+
+/// [`Bar::sample_stress`] with `stretch(e)` the stretch s_e of element e: E·((1 − t) s_e/Δx +
+/// t s_{e+1}/Δx), as [`Bar::strain_at`] and [`Bar::stress_at`] compute it, Pa.
+fn sample_stress(stretch: impl Fn(usize) -> f64, points: &[StressPoint]) -> Vec<f64> {
+    points
+        .iter()
+        .map(|p| {
+            let strain = |e: usize| stretch(e) / p.dx_m;
+            let strain = if p.weight == 0.0 {
+                strain(p.element)
+            } else {
+                (1.0 - p.weight) * strain(p.element) + p.weight * strain(p.element + 1)
+            };
+            p.youngs_modulus_pa * strain
+        })
+        .collect()
 }
 
 /// The largest cell ≤ `at_most_m` that makes every length of `lengths_m` a whole number of cells
@@ -796,5 +893,84 @@ mod tests {
         let fast = delay_line_cell_m(&bars, 4e-3).unwrap();
         assert!((fast - 1e-2 / 3.0).abs() < 1e-15, "{fast}");
         assert_eq!(delay_line_cell_m(&[1.0, 0.3333333], 1e-3), None);
+    }
+
+    /// A steel (or aluminium) segment, 19.05 mm.
+    fn segment(length_m: f64, youngs_modulus_pa: f64, density_kg_m3: f64) -> Segment {
+        Segment {
+            length_m,
+            diameter_m: 0.01905,
+            material: BarMaterial {
+                density_kg_m3,
+                youngs_modulus_pa,
+                poisson_ratio: 0.29,
+            },
+        }
+    }
+
+    /// The x–t snapshots' sampler reads every theory as [`Bar::stress_at`] does, bit for bit (the
+    /// same formula on the same operands, the search done once): a delay line plain and
+    /// dispersive, the leapfrog, the Love rod and a two-segment bar (steel then aluminium, an
+    /// interface between cells), each struck and pushed at its ends for a few hundred steps, at
+    /// points before, on and beyond the ends, on nodes, element centres and the interface.
+    #[test]
+    fn sampled_stresses_are_stress_at() {
+        let steel = segment(0.3, 200e9, 7850.0);
+        let one = |dispersion| BarSpec {
+            name: "probe".into(),
+            segments: vec![steel],
+            left_end: EndCondition::Free,
+            right_end: EndCondition::Absorbing,
+            dispersion,
+        };
+        let two = BarSpec {
+            segments: vec![segment(0.17, 200e9, 7850.0), segment(0.13, 70e9, 2700.0)],
+            ..one(Dispersion::None)
+        };
+        let dt = Bar::courant_time_step(&one(Dispersion::None), 300);
+        let bars = [
+            Bar::with_scheme(&one(Dispersion::None), dt, BarScheme::Auto).unwrap(),
+            Bar::with_scheme(&one(Dispersion::PochhammerChree), dt, BarScheme::Auto).unwrap(),
+            Bar::with_scheme(&one(Dispersion::None), dt, BarScheme::FiniteDifference).unwrap(),
+            Bar::with_scheme(&one(Dispersion::LoveRod), dt, BarScheme::Auto).unwrap(),
+            Bar::with_scheme(&two, dt, BarScheme::Auto).unwrap(),
+        ];
+        assert!(bars[0].is_delay_line() && bars[0].transit_model().is_none());
+        assert!(bars[1].is_delay_line() && bars[1].transit_model().is_some());
+        assert!(!bars[2].is_delay_line() && !bars[4].is_delay_line());
+        let mut x_m: Vec<f64> = (-2..=62).map(|k| 0.3 * k as f64 / 60.0).collect();
+        x_m.extend([
+            0.0005,
+            0.17,
+            0.1699,
+            0.1701,
+            0.2995,
+            0.3,
+            1e-9,
+            f64::MIN_POSITIVE,
+        ]);
+        for mut bar in bars {
+            bar.set_initial_velocity(3.0);
+            let sampler = bar.stress_sampler(&x_m);
+            assert_eq!(sampler.len(), x_m.len());
+            let mut compared = 0;
+            for n in 0..700 {
+                let push = 1e4 * (n as f64 * 0.05).sin().max(0.0);
+                bar.step(push, -0.3 * push);
+                if n % 7 == 0 {
+                    let sampled = bar.sample_stress(&sampler);
+                    for (x, s) in x_m.iter().zip(&sampled) {
+                        let reference = bar.stress_at(*x);
+                        assert_eq!(s.to_bits(), reference.to_bits(), "{} at {x}", bar.name());
+                        compared += usize::from(reference != 0.0);
+                    }
+                }
+            }
+            assert!(
+                compared > 1000,
+                "{}: only {compared} loaded points",
+                bar.name()
+            );
+        }
     }
 }

@@ -261,6 +261,41 @@ impl PlasticCylinder {
         e_mod * strain
     }
 
+    /// [`PlasticCylinder::stress_at`] at each of `x_m` found once (element and weight), for
+    /// [`PlasticCylinder::sample_stress`] to read the specimen at the same points step after step (the
+    /// x–t snapshots).
+    pub fn stress_sampler(&self, x_m: &[f64]) -> Vec<(usize, f64)> {
+        let n = self.element_count();
+        x_m.iter()
+            .map(|&x| {
+                if n == 1 {
+                    return (0, 0.0);
+                }
+                let xi = (x / self.dx0_m - 0.5).clamp(0.0, (n - 1) as f64);
+                let j = (xi as usize).min(n - 2);
+                (j, xi - j as f64)
+            })
+            .collect()
+    }
+
+    /// The stresses [`PlasticCylinder::stress_at`] gives at the points of `sampler` (made by
+    /// [`PlasticCylinder::stress_sampler`] for this specimen), the same formula on the same operands:
+    /// E·((1 − t) ε_j + t ε_{j+1}), ε_j alone where t = 0, Pa.
+    pub fn sample_stress(&self, sampler: &[(usize, f64)]) -> Vec<f64> {
+        let e_mod = self.spec.material.youngs_modulus_pa;
+        sampler
+            .iter()
+            .map(|&(j, t)| {
+                let strain = if t == 0.0 {
+                    self.elastic_strain(j)
+                } else {
+                    (1.0 - t) * self.elastic_strain(j) + t * self.elastic_strain(j + 1)
+                };
+                e_mod * strain
+            })
+            .collect()
+    }
+
     /// The sample taken by the last step (the level of its end forces).
     pub fn sample(&self) -> &SpecimenSample {
         &self.sample

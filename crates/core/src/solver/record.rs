@@ -364,6 +364,19 @@ pub struct SnapshotRecorder {
     pub snapshots: Vec<BarSnapshots>,
     /// Steps recorded.
     steps: Vec<usize>,
+    /// Each field's points with their elements and weights, found once (None: a dispersive
+    /// delay line, filled by [`SnapshotRecorder::finish`]).
+    samplers: Vec<Option<FieldSampler>>,
+}
+
+/// Where a snapshot reads one body, found once ([`Bar::stress_sampler`],
+/// [`super::cylinder::PlasticCylinder::stress_sampler`]).
+#[derive(Debug, Clone, PartialEq)]
+enum FieldSampler {
+    /// A bar stepped node by node or a plain delay line.
+    Bar(crate::bar::StressSampler),
+    /// A cylindrical specimen: (element, weight) per point.
+    Cylinder(Vec<(usize, f64)>),
 }
 
 impl SnapshotRecorder {
@@ -388,11 +401,24 @@ impl SnapshotRecorder {
                     stress_pa: Vec::new(),
                 }
             })
+            .collect::<Vec<BarSnapshots>>();
+        let samplers = bodies
+            .iter()
+            .filter(|b| !matches!(b, Body::Mass(_)))
+            .zip(&snapshots)
+            .map(|(b, s)| match b {
+                Body::Bar(b) if b.transit_model().is_none() => {
+                    Some(FieldSampler::Bar(b.stress_sampler(&s.x_m)))
+                }
+                Body::Cylinder(c) => Some(FieldSampler::Cylinder(c.stress_sampler(&s.x_m))),
+                _ => None,
+            })
             .collect();
         SnapshotRecorder {
             every,
             snapshots,
             steps: Vec::new(),
+            samplers,
         }
     }
 
@@ -420,20 +446,19 @@ impl Recorder for SnapshotRecorder {
             return;
         }
         self.steps.push(step);
-        for (b, s) in bodies
+        for ((b, s), sampler) in bodies
             .iter()
             .filter(|b| !matches!(b, Body::Mass(_)))
             .zip(self.snapshots.iter_mut())
+            .zip(&self.samplers)
         {
             s.time_s.push(time_s);
-            match b {
-                Body::Bar(b) if b.transit_model().is_none() => {
-                    s.stress_pa
-                        .push(s.x_m.iter().map(|&x| b.stress_at(x)).collect());
-                }
-                Body::Cylinder(c) => {
-                    s.stress_pa
-                        .push(s.x_m.iter().map(|&x| c.stress_at(x)).collect());
+            // The points' elements and weights were found once (`new`): the same values as
+            // `stress_at` at each x.
+            match (b, sampler) {
+                (Body::Bar(b), Some(FieldSampler::Bar(p))) => s.stress_pa.push(b.sample_stress(p)),
+                (Body::Cylinder(c), Some(FieldSampler::Cylinder(p))) => {
+                    s.stress_pa.push(c.sample_stress(p))
                 }
                 _ => {}
             }

@@ -19,7 +19,7 @@ use crate::uq::student_t_quantile;
 use rayon::prelude::*;
 use shpb_core::apparatus::Apparatus;
 use shpb_core::reduce::{ReductionOptions, ReductionSetup};
-use shpb_core::scene::{Params, SceneParams};
+use shpb_core::scene::SceneParams;
 use shpb_core::uncertainty::SCATTER_OUTPUTS;
 use shpb_input::{Error, Result};
 
@@ -101,18 +101,16 @@ pub fn simulate(data: &Data, c: &Calibration) -> Result<Vec<ShotResiduals>> {
         .par_iter()
         .map(|s| {
             let scene = s.shot.scene.as_deref().expect("filtered on scene");
-            let (mut params, _) = crate::api::load_scene(
+            let (params, _) = crate::api::load_scene(
                 crate::api::Scene::File(scene),
                 None,
                 &[("bars".to_string(), bars.clone())],
                 String::new(),
             )?;
-            if let SceneParams::Pulse { options, .. } = &mut params.params {
-                options.snapshot_interval_s = None;
-            } else {
+            if !matches!(params.params, SceneParams::Pulse { .. }) {
                 return Err(not_a_bar_test(scene));
             }
-            let out = Params::run(&params)?;
+            let out = params.summary_only().run()?;
             Ok(ShotResiduals {
                 label: s.shot.label.clone(),
                 measured: measured(&data.base, s)?,

@@ -376,11 +376,7 @@ impl Problem {
                 )
             }
         };
-        if let SceneParams::Pulse {
-            options, apparatus, ..
-        } = &mut params.params
-        {
-            options.snapshot_interval_s = None;
+        if let SceneParams::Pulse { apparatus, .. } = &mut params.params {
             for (i, ch) in apparatus.gauges.channels.iter_mut().enumerate() {
                 match noise_seed {
                     // The model of a record is its expectation: no noise, and no quantisation
@@ -394,6 +390,7 @@ impl Problem {
                 }
             }
         }
+        let params = params.summary_only();
         Some((params.run().ok()?, params, shift))
     }
 

@@ -517,3 +517,37 @@ fn a_tension_chain_mirrors_the_striker_and_closes_its_ledger() {
         assert!(pulled.strain[1].iter().fold(0.0f64, |a, &e| a.max(e)) > 1e-4);
     }
 }
+
+/// The x–t snapshots' sampler reads a cylinder as [`PlasticCylinder::stress_at`] does, bit for
+/// bit (the same formula on the same operands, element and weight found once): a copper cylinder
+/// squeezed into plastic flow (slack in its elements) and a one-element one, at points before,
+/// on and beyond its ends, on element centres and between them.
+#[test]
+fn sampled_stresses_are_stress_at() {
+    for (d, l) in [(5e-3, 5e-3), (8e-3, 4e-3)] {
+        let spec = cylinder(COPPER, d, l, FlowModel::JohnsonCook(copper_jc(false)));
+        let dt = if d == l {
+            l / (1.5 * COPPER.wave_speed_m_s())
+        } else {
+            2e-9
+        };
+        let mut c = PlasticCylinder::new(&spec, dt).unwrap();
+        let length = c.initial_length_m();
+        let mut x_m: Vec<f64> = (-2..=42).map(|k| length * k as f64 / 40.0).collect();
+        x_m.extend([0.5 * length / c.element_count() as f64, 1e-12, length]);
+        let sampler = c.stress_sampler(&x_m);
+        let mut compared = 0;
+        for k in 0..400 {
+            c.step_with_end_velocities(10.0 * (k as f64 / 50.0).min(1.0), -3.0);
+            let sampled = c.sample_stress(&sampler);
+            for (x, s) in x_m.iter().zip(&sampled) {
+                let reference = c.stress_at(*x);
+                assert_eq!(s.to_bits(), reference.to_bits(), "at {x}");
+                compared += usize::from(reference != 0.0);
+            }
+        }
+        assert!(c.plastic_strain(0) > 0.0, "the cylinder did not yield");
+        assert!(compared > 10_000, "only {compared} loaded points");
+        eprintln!("{} elements: {compared} points", c.element_count());
+    }
+}
