@@ -270,6 +270,68 @@ pub fn merge_shards(parts: Vec<(PathBuf, SweepFile)>) -> Result<SweepFile> {
     Ok(merged)
 }
 
+/// The study file of a sweep ([`write_sweep_hdf5`]) with each run's
+/// `/runs/<index>` group written as `run` hands over its finished row, on this thread, while the
+/// other runs go on (issue 45: that work leaves the serial end of the sweep). `points` are all
+/// the sweep's rows-to-be (this shard's points, finished or not): their labels fix before any
+/// run which input columns are SI numbers, as [`crate::sweep::input_columns`] of the finished table decides.
+/// `run` gets the sink and returns the rows; they come back in index order. The file appears
+/// only complete (written under a temporary name, [`shpb_output::study::write_study_hdf5_streamed`]).
+#[allow(clippy::too_many_arguments)]
+pub fn write_sweep_hdf5_streamed(
+    path: &Path,
+    force: bool,
+    scene_text: &str,
+    spec: &[String],
+    identity: Option<&shpb_output::study::Identity>,
+    (axes, points): (&[crate::sweep::Axis], &[crate::sweep::Point]),
+    run: impl FnOnce(&mut dyn FnMut(&RunSummary) -> Result<()>) -> Result<Vec<RunSummary>>,
+) -> Result<Vec<RunSummary>> {
+    let keys: Vec<String> = axes.iter().map(|a| a.key.clone()).collect();
+    let numeric: Vec<bool> = {
+        let labelled: Vec<RunSummary> = points
+            .iter()
+            .map(|p| {
+                let inputs = axes
+                    .iter()
+                    .zip(&p.coords)
+                    .map(|(a, &c)| a.labels[c].clone())
+                    .collect();
+                RunSummary::from_values(p.index, inputs, [f64::NAN; 5])
+            })
+            .collect();
+        input_columns(&keys, &labelled)
+            .iter()
+            .map(|c| c.si.is_some())
+            .collect()
+    };
+    shpb_output::study::write_study_hdf5_streamed(path, force, |sink| {
+        let mut rows = run(&mut |row: &RunSummary| {
+            let mut one = sweep_table(scene_text, spec, &keys, std::slice::from_ref(row), identity);
+            for (c, &si) in one.inputs.iter_mut().zip(&numeric) {
+                if !si {
+                    c.si = None;
+                }
+            }
+            sink(&one)
+        })?;
+        rows.sort_by_key(|r| r.index);
+        let table = sweep_table(scene_text, spec, &keys, &rows, identity);
+        let same_columns = table
+            .inputs
+            .iter()
+            .zip(&numeric)
+            .all(|(c, &si)| c.si.is_some() == si);
+        if !same_columns {
+            return Err(Error::Hdf5 {
+                file: path.display().to_string(),
+                message: "the runs finished are not the points of the sweep".into(),
+            });
+        }
+        Ok((table, rows))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

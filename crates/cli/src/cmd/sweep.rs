@@ -314,7 +314,7 @@ pub fn sweep(
     match output {
         // The study file is written as the runs finish, the other outputs once they all have.
         Some(out) => write_all(&out_plan, || {
-            let rows = shpb_study::sweep::write_sweep_hdf5_streamed(
+            let rows = shpb_study::file::write_sweep_hdf5_streamed(
                 out,
                 replace,
                 &scene_text,
