@@ -34,37 +34,6 @@ impl Outputs {
     }
 }
 
-impl crate::scene::Params {
-    /// This scene set to record `outputs` ([`Outputs`]): [`Outputs::Summary`] clears the bars'
-    /// snapshot interval, [`Outputs::Full`] keeps the scene's. Every summary item, the reduction
-    /// and the warnings are the same either way.
-    pub fn with_outputs(mut self, outputs: Outputs) -> crate::scene::Params {
-        self.set_outputs(outputs);
-        self
-    }
-
-    /// [`crate::scene::Params::with_outputs`] in place.
-    pub fn set_outputs(&mut self, outputs: Outputs) {
-        if let (Outputs::Summary, crate::scene::SceneParams::Pulse { options, .. }) =
-            (outputs, &mut self.params)
-        {
-            options.snapshot_interval_s = None;
-        }
-    }
-
-    /// This scene as a summary-only run (`with_outputs(Outputs::Summary)`): what sweeps,
-    /// studies, fits and designs run.
-    pub fn summary_only(self) -> crate::scene::Params {
-        self.with_outputs(Outputs::Summary)
-    }
-
-    /// Whether a run of this scene records the bars' x–t snapshots.
-    pub fn records_snapshots(&self) -> bool {
-        matches!(&self.params, crate::scene::SceneParams::Pulse { options, .. }
-            if options.snapshot_interval_s.is_some())
-    }
-}
-
 /// A scalar result of a run (peak force, restitution, …) with its unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SummaryItem {

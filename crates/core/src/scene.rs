@@ -9,7 +9,7 @@ use crate::error::{Error, Result, format_si};
 use crate::fidelity::Fidelity;
 use crate::material::JOHNSON_COOK_RATE_LIMIT_PER_S;
 use crate::numeric::resample;
-use crate::run::{RunOutput, SummaryItem, item};
+use crate::run::{Outputs, RunOutput, SummaryItem, item};
 use crate::solver::{self, CollisionSetup, ContactSeries, ForceDrivenSetup, ForceHistory};
 use crate::specimen::{MODEL_APPROACH_LIMIT_OF_RADIUS, Specimen, SpherePair};
 
@@ -1253,6 +1253,36 @@ pub fn explain_unavailable(out: &mut RunOutput) {
             "`{k}` is not available (NaN): the run gave it no value (a run shorter than the \
              events it measures, or a record with too few samples); raise end_time_s"
         ));
+    }
+}
+
+impl Params {
+    /// This scene set to record `outputs` ([`Outputs`]): [`Outputs::Summary`] clears the bars'
+    /// snapshot interval, [`Outputs::Full`] keeps the scene's. Every summary item, the reduction
+    /// and the warnings are the same either way.
+    pub fn with_outputs(mut self, outputs: Outputs) -> Params {
+        self.set_outputs(outputs);
+        self
+    }
+
+    /// [`Params::with_outputs`] in place.
+    pub fn set_outputs(&mut self, outputs: Outputs) {
+        if let (Outputs::Summary, SceneParams::Pulse { options, .. }) = (outputs, &mut self.params)
+        {
+            options.snapshot_interval_s = None;
+        }
+    }
+
+    /// This scene as a summary-only run (`with_outputs(Outputs::Summary)`): what sweeps,
+    /// studies, fits and designs run.
+    pub fn summary_only(self) -> Params {
+        self.with_outputs(Outputs::Summary)
+    }
+
+    /// Whether a run of this scene records the bars' x–t snapshots.
+    pub fn records_snapshots(&self) -> bool {
+        matches!(&self.params, SceneParams::Pulse { options, .. }
+            if options.snapshot_interval_s.is_some())
     }
 }
 
