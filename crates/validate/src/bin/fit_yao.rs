@@ -17,19 +17,20 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// Sampler settings of every fit: walkers, steps, burn-in, seed, threads.
-const WALKERS: usize = 8;
+const WALKERS: usize = 16;
 /// Sampler steps.
-const STEPS: usize = 16;
+const STEPS: usize = 60;
 /// Steps dropped as burn-in.
-const BURN_IN: usize = 6;
+const BURN_IN: usize = 20;
 /// Seed of the start design, the sampler and the band's noise draws.
 const SEED: u64 = 44;
 /// Worker threads (the machine's 2 cores).
 const JOBS: usize = 2;
 /// Posterior draws run again for the predictive band.
 const DRAWS: usize = 16;
-/// Most forward runs of the least-squares search (after its 17-point start design).
-const LEAST_SQUARES_RUNS: usize = 30;
+/// Most forward runs of the least-squares search (0: `shpb fit`'s own, Levenberg–Marquardt then
+/// Nelder–Mead from the best of a 17-point start design).
+const LEAST_SQUARES_RUNS: usize = 0;
 
 /// One fit of the report: its tag (file stem), the shots, the fit and its time.
 struct Case {
@@ -286,7 +287,7 @@ fn main() -> Result<()> {
          incident wave (`Problem::drives`).\n\
          - **Free constants** (uniform priors): {}.\n\
          - **Sampler**: {WALKERS} walkers × {STEPS} steps, {BURN_IN} burn-in, seed {SEED}, \
-         after a least-squares fit (Nelder–Mead, at most {LEAST_SQUARES_RUNS} runs, from the best of a 17-point start design); noise \
+         after `shpb fit`'s least-squares fit (Levenberg–Marquardt then Nelder–Mead, from the best of a 17-point start design); noise \
          model from the best fit's residuals (docs/physics.md §12); the 90 % \
          posterior-predictive band from {DRAWS} posterior draws plus that noise.\n\
          - **Inside the band**: the fraction of the record's loading-branch points (the \
