@@ -412,22 +412,36 @@ impl Problem {
     /// [`Problem::model`] with the digitisers' noise drawn from `noise_seed` (None: without it).
     pub fn model_with(&self, theta: &[f64], noise_seed: Option<u64>) -> Option<Vec<Vec<f64>>> {
         let mut values: Vec<Option<Vec<f64>>> = vec![None; self.series.len()];
-        // A series without an entry in `drives` is driven by the scene's own drive.
-        let drive_of = |j: usize| self.drives.get(j).cloned().flatten();
         for i in 0..self.series.len() {
             if values[i].is_some() {
                 continue;
             }
-            let drive = drive_of(i);
-            let (out, params, shift) = self.run_driven(theta, noise_seed, drive.as_deref())?;
-            let m = self.observe(&out, &params)?;
+            let drive = self.drive_of(i);
+            let (m, shift) = self.observed(theta, noise_seed, drive.as_deref())?;
             for (j, s) in self.series.iter().enumerate() {
-                if drive_of(j) == drive {
+                if self.drive_of(j) == drive {
                     values[j] = Some(s.model(&m, shift)?);
                 }
             }
         }
         values.into_iter().collect()
+    }
+
+    /// The drive of series `j` ([`Problem::drives`]; None, also without an entry: the scene's own).
+    pub fn drive_of(&self, j: usize) -> Option<PathBuf> {
+        self.drives.get(j).cloned().flatten()
+    }
+
+    /// The run at `theta` with `noise_seed` and `drive` ([`Problem::run_driven`]) as the records
+    /// are compared with it ([`Problem::observe`]), with its time shift.
+    pub fn observed(
+        &self,
+        theta: &[f64],
+        noise_seed: Option<u64>,
+        drive: Option<&Path>,
+    ) -> Option<(Observables, f64)> {
+        let (out, params, shift) = self.run_driven(theta, noise_seed, drive)?;
+        Some((self.observe(&out, &params)?, shift))
     }
 
     /// Whether `theta` lies inside every bound.
@@ -557,27 +571,26 @@ fn calibrate_noise(
         };
         points.push(p);
     }
-    let drive_of = |j: usize| problem.drives.get(j).cloned().flatten();
     let mut drives: Vec<Option<PathBuf>> = Vec::new();
     for j in 0..problem.series.len() {
-        if !drives.contains(&drive_of(j)) {
-            drives.push(drive_of(j));
+        if !drives.contains(&problem.drive_of(j)) {
+            drives.push(problem.drive_of(j));
         }
     }
-    let observe = |theta: &[f64], seed: Option<u64>, drive: &Option<PathBuf>| {
-        let (out, params, shift) = problem.run_driven(theta, seed, drive.as_deref())?;
-        Some((problem.observe(&out, &params)?, shift))
-    };
     let base = settings.seed ^ 0x6e6f_6973_6521_0000;
     let mut factors = vec![None; problem.series.len()];
     let mut runs = 0;
     for drive in &drives {
-        let clean: Vec<Option<(Observables, f64)>> =
-            pool.install(|| points.par_iter().map(|p| observe(p, None, drive)).collect());
+        let clean: Vec<Option<(Observables, f64)>> = pool.install(|| {
+            points
+                .par_iter()
+                .map(|p| problem.observed(p, None, drive.as_deref()))
+                .collect()
+        });
         let simulated: Vec<Option<(Observables, f64)>> = pool.install(|| {
             (0..settings.noise_draws as u64)
                 .into_par_iter()
-                .map(|k| observe(best, Some(base.wrapping_add(k)), drive))
+                .map(|k| problem.observed(best, Some(base.wrapping_add(k)), drive.as_deref()))
                 .collect()
         });
         runs += points.len() + simulated.len();
@@ -585,7 +598,7 @@ fn calibrate_noise(
             continue;
         };
         for (j, s) in problem.series.iter().enumerate() {
-            if drive_of(j) != *drive {
+            if problem.drive_of(j) != *drive {
                 continue;
             }
             let records: Option<Vec<noise::SimulatedRecord>> = simulated
